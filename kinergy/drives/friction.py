@@ -1,0 +1,158 @@
+"""Friction models of a joint drive, all on the motor side.
+
+Each model is a name, the ordered names of its parameters, and a function of the motor speed
+``wm`` (rad/s, motor side) and, where the model needs it, the load torque the drive delivers
+(``tau_load``, N m, motor side; its sign together with the speed's gives the direction of power flow).
+A robot file selects a model per joint in ``[joints.drive.friction]`` with ``model = "name"`` and
+one entry per parameter.
+
+Models
+------
+``none``
+    No friction.
+``viscous_coulomb``
+    ``viscous * wm + coulomb * tanh(wm / smoothing)``.
+``motor_reducer``
+    Framework Table 1: motor viscous friction plus tanh-smoothed Coulomb friction of the motor and
+    of the reducer, ``motor_viscous * wm + (motor_coulomb + reducer_coulomb) * tanh(wm / smoothing)``.
+``power_flow``
+    UR5e eqs 11-16: ``viscous * wm + tanh(wm / smoothing) * Tc`` with ``Tc = coulomb_direct`` when
+    power flows from the motor to the load (``wm * tau_load > 0``) and ``coulomb_reverse`` otherwise.
+``makkar``
+    Nursing eq 13: ``gamma1 (tanh(gamma2 wm) - tanh(gamma3 wm)) + gamma4 tanh(gamma5 wm) + gamma6 wm``.
+``stribeck``
+    ``(coulomb + (static - coulomb) exp(-(wm / stribeck_speed)^2)) tanh(wm / smoothing) + viscous wm``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kinergy.errors import KinergyError
+
+__all__ = ["FRICTION_MODELS", "check_friction", "friction_torque"]
+
+Array = NDArray[np.float64]
+
+
+def _none(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    return np.zeros_like(wm)
+
+
+def _viscous_coulomb(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    return p["viscous"] * wm + p["coulomb"] * np.tanh(wm / p["smoothing"])
+
+
+def _motor_reducer(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    coulomb = p["motor_coulomb"] + p["reducer_coulomb"]
+    return p["motor_viscous"] * wm + coulomb * np.tanh(wm / p["smoothing"])
+
+
+def _power_flow(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    if tau_load is None:
+        raise KinergyError(
+            "friction model 'power_flow' needs the load torque to tell the direction of power flow"
+        )
+    direct = wm * tau_load > 0.0
+    coulomb = np.where(direct, p["coulomb_direct"], p["coulomb_reverse"])
+    return p["viscous"] * wm + coulomb * np.tanh(wm / p["smoothing"])
+
+
+def _makkar(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    g1, g2, g3, g4, g5, g6 = (p[f"gamma{k}"] for k in range(1, 7))
+    return g1 * (np.tanh(g2 * wm) - np.tanh(g3 * wm)) + g4 * np.tanh(g5 * wm) + g6 * wm
+
+
+def _stribeck(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    level = p["coulomb"] + (p["static"] - p["coulomb"]) * np.exp(-((wm / p["stribeck_speed"]) ** 2))
+    return level * np.tanh(wm / p["smoothing"]) + p["viscous"] * wm
+
+
+_Eval = Callable[[Mapping[str, float], Array, Array | None], Array]
+
+#: model name -> (ordered parameter names, evaluation function)
+FRICTION_MODELS: dict[str, tuple[tuple[str, ...], _Eval]] = {
+    "none": ((), _none),
+    "viscous_coulomb": (("viscous", "coulomb", "smoothing"), _viscous_coulomb),
+    "motor_reducer": (
+        ("motor_viscous", "motor_coulomb", "reducer_coulomb", "smoothing"),
+        _motor_reducer,
+    ),
+    "power_flow": (("viscous", "coulomb_direct", "coulomb_reverse", "smoothing"), _power_flow),
+    "makkar": (tuple(f"gamma{k}" for k in range(1, 7)), _makkar),
+    "stribeck": (("coulomb", "static", "stribeck_speed", "viscous", "smoothing"), _stribeck),
+}
+
+#: parameters that must be strictly positive (they divide)
+_POSITIVE = {"smoothing", "stribeck_speed"}
+
+
+def check_friction(model: str, params: Mapping[str, float]) -> dict[str, float]:
+    """Validate a friction model name and its parameters; return them as plain floats.
+
+    Raises
+    ------
+    KinergyError
+        Unknown model, a missing or unknown parameter, a non-finite value, or a non-positive
+        smoothing or Stribeck speed. The message names the model and the parameter.
+    """
+    if model not in FRICTION_MODELS:
+        known = ", ".join(sorted(FRICTION_MODELS))
+        raise KinergyError(f"unknown friction model {model!r} (known: {known})")
+    names = FRICTION_MODELS[model][0]
+    missing = [n for n in names if n not in params]
+    if missing:
+        raise KinergyError(
+            f"friction model {model!r} is missing parameter(s): {', '.join(missing)}"
+        )
+    extra = sorted(set(params) - set(names))
+    if extra:
+        raise KinergyError(
+            f"friction model {model!r} has unknown parameter(s): {', '.join(extra)} "
+            f"(expected: {', '.join(names)})"
+        )
+    out: dict[str, float] = {}
+    for name in names:
+        value = params[name]
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise KinergyError(f"friction parameter {name!r} must be a number, got {value!r}")
+        if not np.isfinite(value):
+            raise KinergyError(f"friction parameter {name!r} must be finite, got {value!r}")
+        if name in _POSITIVE and value <= 0.0:
+            raise KinergyError(f"friction parameter {name!r} must be > 0, got {value!r}")
+        out[name] = float(value)
+    return out
+
+
+def friction_torque(
+    model: str,
+    params: Mapping[str, float],
+    wm: Array,
+    tau_load: Array | None = None,
+) -> Array:
+    """Friction torque on the motor side.
+
+    Parameters
+    ----------
+    model : str
+        One of :data:`FRICTION_MODELS`.
+    params : mapping
+        The model's parameters (see the module docstring), SI units, motor side.
+    wm : array_like, shape (N,) or ()
+        Motor speed, rad/s.
+    tau_load : array_like, shape like ``wm``, optional
+        Torque the motor delivers to the load without friction, N m, motor side. Needed by
+        ``power_flow`` only (UR5e eqs 12-13).
+
+    Returns
+    -------
+    ndarray, shape like ``wm``
+        Friction torque, N m, opposing the motion (same sign as ``wm``).
+    """
+    fn = FRICTION_MODELS[model][1]
+    wm = np.asarray(wm, dtype=float)
+    load = None if tau_load is None else np.asarray(tau_load, dtype=float)
+    return fn(params, wm, load)

@@ -1,0 +1,230 @@
+"""What every dynamics algorithm needs from a robot: constant joint geometry, link inertials,
+and validated joint-state arrays.
+
+Both DH conventions are written as one chain: link frame i is
+``F_i = F_{i-1} · P_i · Rz(q_i) · C_i`` with constant transforms
+
+- ``dh``:  ``P_i = I``,  ``C_i = Rz(offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i)``
+- ``mdh``: ``P_i = Rx(alpha_{i-1}) · Tx(a_{i-1}) · Rz(offset_i) · Tz(d_i)``,  ``C_i = I``
+
+(see DESIGN.md; for ``mdh`` Rz(q) commutes with Rz(offset) Tz(d)). Joint i turns about the z axis
+of ``F_{i-1} · P_i``. Frame 0 sits at ``robot.base`` in the base frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from kinergy.errors import KinergyError
+from kinergy.model.robot import Robot, inertia_matrix
+
+__all__ = [
+    "Chain",
+    "LinkInertials",
+    "check_state",
+    "kernel_geometry",
+    "link_inertials",
+    "make_chain",
+]
+
+Array = NDArray[np.float64]
+
+
+def _rot_x(angle: float) -> Array:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def _rot_z(angle: float) -> Array:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _hom(rot: ArrayLike, pos: ArrayLike) -> Array:
+    out = np.eye(4)
+    out[:3, :3] = rot
+    out[:3, 3] = pos
+    return out
+
+
+@dataclass(frozen=True)
+class Chain:
+    """Constant geometry of a robot's joints.
+
+    Attributes
+    ----------
+    pre, post : ndarray, shape (n, 4, 4)
+        ``P_i`` and ``C_i`` of the module docstring.
+    axis : ndarray, shape (n, 3)
+        Joint axis direction in link frame i (``R_C^T e_z``).
+    point : ndarray, shape (n, 3)
+        A point of the joint axis in link frame i (``-R_C^T p_C``).
+    base, flange : ndarray, shape (4, 4)
+        Pose of frame 0 in the base frame; pose of the flange in frame n.
+    gravity0 : ndarray, shape (3,)
+        Gravity in frame 0, m/s^2.
+    """
+
+    pre: Array
+    post: Array
+    axis: Array
+    point: Array
+    base: Array
+    flange: Array
+    gravity0: Array
+
+
+def make_chain(robot: Robot) -> Chain:
+    """Constant geometry of ``robot`` (a few 4x4 products; cheap)."""
+    n = robot.n
+    pre = np.tile(np.eye(4), (n, 1, 1))
+    post = np.tile(np.eye(4), (n, 1, 1))
+    for i, j in enumerate(robot.joints):
+        if robot.convention == "dh":
+            post[i] = (
+                _hom(_rot_z(j.offset), np.zeros(3))
+                @ _hom(np.eye(3), [0.0, 0.0, j.d])
+                @ _hom(np.eye(3), [j.a, 0.0, 0.0])
+                @ _hom(_rot_x(j.alpha), np.zeros(3))
+            )
+        else:
+            pre[i] = (
+                _hom(_rot_x(j.alpha), np.zeros(3))
+                @ _hom(np.eye(3), [j.a, 0.0, 0.0])
+                @ _hom(_rot_z(j.offset), np.zeros(3))
+                @ _hom(np.eye(3), [0.0, 0.0, j.d])
+            )
+    rc = post[:, :3, :3]
+    pc = post[:, :3, 3]
+    axis = rc[:, 2, :]  # R_C^T e_z = third row of R_C
+    point = -np.einsum("nji,nj->ni", rc, pc)
+    gravity0 = robot.base[:3, :3].T @ robot.gravity
+    return Chain(pre, post, axis, point, robot.base, np.asarray(robot.flange), gravity0)
+
+
+_E1 = np.diag([1.0, 1.0, 0.0])  # Rz(q) = cos q E1 + sin q E2 + E3
+_E2 = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+_E3 = np.diag([0.0, 0.0, 1.0])
+
+
+def kernel_geometry(chain: Chain) -> tuple[Array, Array, Array, Array, Array, Array, Array, Array]:
+    """Constants for :mod:`kinergy.dynamics.newton_euler`: ``(A, B, C, pa, pb, pc, axis, axis_v)``
+    with the pose of F_i in F_{i-1} ``R_i = c A_i + s B_i + C_i``, ``p_i = c pa_i + s pb_i + pc_i``
+    and the motion subspace ``S_i = (axis_i, point_i x axis_i)``."""
+    rp, pp = chain.pre[:, :3, :3], chain.pre[:, :3, 3]
+    rc, pc = chain.post[:, :3, :3], chain.post[:, :3, 3]
+    a, b, c = (rp @ e @ rc for e in (_E1, _E2, _E3))
+    pa = np.einsum("nij,nj->ni", rp, (_E1 @ pc.T).T)
+    pb = np.einsum("nij,nj->ni", rp, (_E2 @ pc.T).T)
+    pcc = pp + np.einsum("nij,nj->ni", rp, (_E3 @ pc.T).T)
+    axis_v = np.cross(chain.point, chain.axis)
+    return tuple(np.ascontiguousarray(x) for x in (a, b, c, pa, pb, pcc, chain.axis, axis_v))  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class LinkInertials:
+    """Rigid-body data of every link in its own frame, the payload merged into the last link.
+
+    Attributes
+    ----------
+    mass : ndarray, shape (n,)
+        kg.
+    com : ndarray, shape (n, 3)
+        m, link frame.
+    inertia_com : ndarray, shape (n, 3, 3)
+        About the centre of mass, link-frame axes, kg m^2.
+    """
+
+    mass: Array
+    com: Array
+    inertia_com: Array
+
+    @property
+    def first_moment(self) -> Array:
+        """m c, shape (n, 3), kg m."""
+        return self.mass[:, None] * self.com
+
+    @property
+    def inertia_origin(self) -> Array:
+        """Inertia about the link frame origin, shape (n, 3, 3) (parallel-axis theorem)."""
+        c = self.com
+        shift = np.einsum("ni,ni->n", c, c)[:, None, None] * np.eye(3) - np.einsum(
+            "ni,nj->nij", c, c
+        )
+        return self.inertia_com + self.mass[:, None, None] * shift
+
+
+def _parallel(mass: float, com: Array, about: Array) -> Array:
+    d = com - about
+    return mass * (float(d @ d) * np.eye(3) - np.outer(d, d))
+
+
+def link_inertials(robot: Robot, *, include_payload: bool = True) -> LinkInertials:
+    """Masses, centres of mass and inertias of the links; the payload (if any) merged rigidly
+    into the last link, expressed in its frame through ``robot.flange``."""
+    mass = np.array([j.link.mass for j in robot.joints])
+    com = np.array([j.link.com for j in robot.joints])
+    inertia = np.array([inertia_matrix(j.link.inertia) for j in robot.joints])
+    payload = robot.payload
+    if include_payload and payload is not None and payload.mass > 0.0:
+        rot, pos = robot.flange[:3, :3], robot.flange[:3, 3]
+        pcom = rot @ payload.com + pos
+        pin = rot @ inertia_matrix(payload.inertia) @ rot.T
+        m_l, c_l, i_l = mass[-1], com[-1], inertia[-1]
+        m_t = m_l + payload.mass
+        c_t = (m_l * c_l + payload.mass * pcom) / m_t
+        inertia[-1] = i_l + _parallel(m_l, c_l, c_t) + pin + _parallel(payload.mass, pcom, c_t)
+        mass[-1], com[-1] = m_t, c_t
+    return LinkInertials(mass, com, inertia)
+
+
+def check_state(robot: Robot, **arrays: ArrayLike | None) -> tuple[bool, dict[str, Array]]:
+    """Validate joint-state arrays at the public boundary.
+
+    Each array must have shape ``(n,)`` (one sample) or ``(N, n)`` (a batch), all the same,
+    finite. ``None`` entries become zeros.
+
+    Returns
+    -------
+    single : bool
+        True when the inputs were one sample (results are squeezed back to that rank).
+    out : dict of str to ndarray, shape (N, n)
+    """
+    n = robot.n
+    shape: tuple[int, ...] | None = None
+    out: dict[str, Array] = {}
+    for name, value in arrays.items():
+        if value is None:
+            continue
+        try:
+            arr = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise KinergyError(f"{name}: must be numbers, shape (n,) or (N, n)") from None
+        if arr.ndim not in (1, 2) or arr.shape[-1] != n:
+            raise KinergyError(
+                f"{name}: expected shape ({n},) or (N, {n}) for {robot.name}, got {arr.shape}"
+            )
+        if shape is not None and arr.shape != shape:
+            raise KinergyError(f"{name}: shape {arr.shape} differs from the other inputs' {shape}")
+        shape = arr.shape
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            idx = np.argwhere(bad)[0]
+            where = (
+                f"sample {idx[0]}, joint {idx[-1] + 1}" if arr.ndim == 2 else f"joint {idx[0] + 1}"
+            )
+            raise KinergyError(f"{name}: not finite ({arr[tuple(idx)]}) at {where}")
+        out[name] = arr
+    if shape is None:
+        raise KinergyError("no joint-state array given")
+    single = len(shape) == 1
+    rows = 1 if single else shape[0]
+    for name, value in arrays.items():
+        if value is None:
+            out[name] = np.zeros((rows, n))
+        elif single:
+            out[name] = out[name][None, :]
+    return single, out

@@ -1,0 +1,106 @@
+"""Batched forward kinematics and the geometric Jacobian.
+
+All functions take joint angles of shape ``(n,)`` or ``(N, n)`` (rad) and return arrays with the
+same leading rank. Poses are 4x4 homogeneous transforms in the robot's base frame.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from kinergy.dynamics.chain import Chain, check_state, make_chain
+from kinergy.model.robot import Robot
+
+__all__ = ["flange_pose", "jacobian", "joint_axes", "link_poses", "rot_z_batch"]
+
+Array = NDArray[np.float64]
+
+
+def rot_z_batch(q: Array) -> Array:
+    """Rotations about z by angles ``q``, shape (N,) -> (N, 3, 3)."""
+    c, s = np.cos(q), np.sin(q)
+    out = np.zeros((*q.shape, 3, 3))
+    out[..., 0, 0] = c
+    out[..., 0, 1] = -s
+    out[..., 1, 0] = s
+    out[..., 1, 1] = c
+    out[..., 2, 2] = 1.0
+    return out
+
+
+def _poses(chain: Chain, q: Array) -> tuple[Array, Array]:
+    """Joint frames ``F_{i-1} P_i Rz(q_i)`` and link frames ``F_i`` in the base frame.
+
+    q : (N, n). Returns two arrays of shape (N, n, 4, 4).
+    """
+    big_n, n = q.shape
+    joint = np.empty((big_n, n, 4, 4))
+    link = np.empty((big_n, n, 4, 4))
+    current = np.broadcast_to(chain.base, (big_n, 4, 4))
+    rz = np.zeros((big_n, 4, 4))
+    rz[:, 3, 3] = 1.0
+    for i in range(n):
+        rz[:, :3, :3] = rot_z_batch(q[:, i])
+        joint[:, i] = (current @ chain.pre[i]) @ rz
+        link[:, i] = joint[:, i] @ chain.post[i]
+        current = link[:, i]
+    return joint, link
+
+
+def link_poses(robot: Robot, q: ArrayLike) -> Array:
+    """Pose of every link frame (DH or MDH frame i, i = 1..n) in the base frame.
+
+    Parameters
+    ----------
+    robot : Robot
+    q : array_like, shape (n,) or (N, n)
+        Joint angles, rad.
+
+    Returns
+    -------
+    ndarray, shape (n, 4, 4) or (N, n, 4, 4)
+    """
+    single, s = check_state(robot, q=q)
+    _, link = _poses(make_chain(robot), s["q"])
+    return link[0] if single else link
+
+
+def flange_pose(robot: Robot, q: ArrayLike) -> Array:
+    """Pose of the flange in the base frame, shape (4, 4) or (N, 4, 4)."""
+    single, s = check_state(robot, q=q)
+    chain = make_chain(robot)
+    _, link = _poses(chain, s["q"])
+    out = link[:, -1] @ chain.flange
+    return out[0] if single else out
+
+
+def joint_axes(chain: Chain, q: Array) -> tuple[Array, Array, Array]:
+    """Axis directions ``z`` (N, n, 3), axis points ``o`` (N, n, 3) and link frames (N, n, 4, 4)."""
+    joint, link = _poses(chain, q)
+    return joint[..., :3, 2], joint[..., :3, 3], link
+
+
+def jacobian(robot: Robot, q: ArrayLike) -> Array:
+    """Geometric Jacobian of the flange in the base frame.
+
+    ``[v; w] = J qd`` with ``v`` the linear velocity of the flange origin (m/s) and ``w`` the
+    angular velocity (rad/s), both in base-frame coordinates.
+
+    Parameters
+    ----------
+    robot : Robot
+    q : array_like, shape (n,) or (N, n)
+        Joint angles, rad.
+
+    Returns
+    -------
+    ndarray, shape (6, n) or (N, 6, n)
+    """
+    single, s = check_state(robot, q=q)
+    chain = make_chain(robot)
+    z, o, link = joint_axes(chain, s["q"])
+    tip = (link[:, -1] @ chain.flange)[:, :3, 3]
+    jv = np.cross(z, tip[:, None, :] - o)
+    out = np.concatenate([np.swapaxes(jv, 1, 2), np.swapaxes(z, 1, 2)], axis=1)
+    return out[0] if single else out

@@ -1,0 +1,212 @@
+"""The joint-torque regressor, linear in the standard inertial parameters, and the base
+(identifiable) parameter set.
+
+Standard parameters: 10 per link, in link frame i (the frame the robot file uses), ordered ::
+
+    [m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]
+
+with ``(mx, my, mz) = m c`` (kg m) and the inertia about the link frame *origin* (kg m^2), the
+order Pinocchio uses for its dynamic parameters. ``regressor(robot, q, qd, qdd) @
+inertial_parameters(robot) == rnea(robot, q, qd, qdd)`` (nursing eq 15).
+
+Base parameters (nursing eq 16): the columns of the stacked regressor that are linearly
+independent, found by QR with column pivoting on random states; every other column is a fixed
+linear combination of them, so ``regressor[..., independent] @ base == regressor @ standard`` with
+``base = standard[independent] + beta @ standard[dependent]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import ArrayLike, NDArray
+
+from kinergy.dynamics.chain import check_state, kernel_geometry, link_inertials, make_chain
+from kinergy.dynamics.newton_euler import regressor_kernel
+from kinergy.errors import KinergyError
+from kinergy.model.robot import Robot
+
+__all__ = [
+    "PARAMETER_NAMES",
+    "BaseParameters",
+    "base_parameters",
+    "inertial_parameters",
+    "parameter_names",
+    "regressor",
+]
+
+Array = NDArray[np.float64]
+
+#: Names of the 10 standard parameters of one link, in order.
+PARAMETER_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
+
+
+def parameter_names(robot: Robot) -> list[str]:
+    """``["m1", "mx1", ..., "Izz{n}"]``, the names of the 10 n standard parameters."""
+    return [f"{p}{i + 1}" for i in range(robot.n) for p in PARAMETER_NAMES]
+
+
+def inertial_parameters(robot: Robot, *, include_payload: bool = True) -> Array:
+    """Standard inertial parameters, shape (10 n,), in :data:`PARAMETER_NAMES` order per link.
+
+    The payload, if any, is merged into the last link (``include_payload=False`` leaves it out).
+    """
+    body = link_inertials(robot, include_payload=include_payload)
+    h = body.first_moment
+    i_o = body.inertia_origin
+    per_link = np.column_stack(
+        [
+            body.mass,
+            h,
+            i_o[:, 0, 0],
+            i_o[:, 0, 1],
+            i_o[:, 1, 1],
+            i_o[:, 0, 2],
+            i_o[:, 1, 2],
+            i_o[:, 2, 2],
+        ]
+    )
+    return per_link.reshape(-1)
+
+
+def regressor(
+    robot: Robot,
+    q: ArrayLike,
+    qd: ArrayLike | None = None,
+    qdd: ArrayLike | None = None,
+    *,
+    gravity: ArrayLike | None = None,
+) -> Array:
+    """Joint-torque regressor Y with ``Y @ inertial_parameters(robot) == rnea(...)`` (nursing eq 15).
+
+    Parameters
+    ----------
+    robot : Robot
+        Only the kinematics and gravity are used.
+    q, qd, qdd : array_like, shape (n,) or (N, n)
+        rad, rad/s, rad/s^2; ``None`` means zero.
+    gravity : array_like, shape (3,), optional
+        Overrides ``robot.gravity``.
+
+    Returns
+    -------
+    ndarray, shape (n, 10 n) or (N, n, 10 n)
+        N m per unit parameter.
+    """
+    single, s = check_state(robot, q=q, qd=qd, qdd=qdd)
+    chain = make_chain(robot)
+    q_, qd_, qdd_ = s["q"], s["qd"], s["qdd"]
+    g0 = chain.gravity0
+    if gravity is not None:
+        g = np.asarray(gravity, dtype=float)
+        if g.shape != (3,) or not np.all(np.isfinite(g)):
+            raise KinergyError(f"gravity: expected 3 finite numbers, got {g.tolist()}")
+        g0 = robot.base[:3, :3].T @ g
+    # numpy's allocator asks for transparent huge pages: far fewer page faults than numba's
+    y = np.zeros((q_.shape[0], robot.n, 10 * robot.n))
+    regressor_kernel(
+        kernel_geometry(chain),
+        g0,
+        np.ascontiguousarray(q_),
+        np.ascontiguousarray(qd_),
+        np.ascontiguousarray(qdd_),
+        y,
+    )
+    return y[0] if single else y
+
+
+@dataclass(frozen=True)
+class BaseParameters:
+    """The base (identifiable) parameter set of a robot's standard inertial parameters.
+
+    Attributes
+    ----------
+    independent : ndarray of int, shape (b,)
+        Indices of the standard parameters that form the base set (sorted).
+    dependent : ndarray of int, shape (p - b,)
+        The remaining indices.
+    beta : ndarray, shape (b, p - b)
+        ``Y[:, dependent] = Y[:, independent] @ beta`` for every state.
+    names : list of str
+        Standard parameter names (length p).
+    """
+
+    independent: NDArray[np.int_]
+    dependent: NDArray[np.int_]
+    beta: Array
+    names: list[str]
+
+    @property
+    def size(self) -> int:
+        return len(self.independent)
+
+    def project(self, standard: ArrayLike) -> Array:
+        """Base parameters from standard ones: ``pi[ind] + beta @ pi[dep]``, shape (b,)."""
+        pi = np.asarray(standard, dtype=float)
+        return pi[self.independent] + self.beta @ pi[self.dependent]
+
+    def regressor(self, full: Array) -> Array:
+        """Base regressor: the independent columns of a full regressor (..., n, p) -> (..., n, b)."""
+        return full[..., self.independent]
+
+    def expressions(self, tol: float = 1e-10) -> list[str]:
+        """Each base parameter as a readable combination, e.g. ``Izz2 + 0.1806*m3 + ...``."""
+        out = []
+        for row, k in enumerate(self.independent):
+            terms = [self.names[k]]
+            for col, d in enumerate(self.dependent):
+                c = self.beta[row, col]
+                if abs(c) > tol:
+                    terms.append(f"{c:+.6g}*{self.names[d]}")
+            out.append(" ".join(terms))
+        return out
+
+
+def base_parameters(
+    robot: Robot,
+    *,
+    samples: int = 300,
+    seed: int = 0,
+    rtol: float = 1e-9,
+) -> BaseParameters:
+    """Find the base parameter set by numerical QR with column pivoting (Gautier's method).
+
+    The regressor is stacked over ``samples`` random states (angles uniform over the joint
+    ranges clipped to [-pi, pi], speeds and accelerations standard normal), seeded so the set is
+    reproducible. Columns whose pivoted R diagonal falls below ``rtol`` times the largest are
+    dependent.
+
+    Returns
+    -------
+    BaseParameters
+    """
+    rng = np.random.default_rng(seed)
+    lo = np.array([max(j.limits.position[0], -np.pi) for j in robot.joints])
+    hi = np.array([min(j.limits.position[1], np.pi) for j in robot.joints])
+    q = rng.uniform(lo, hi, (samples, robot.n))
+    qd = rng.standard_normal((samples, robot.n))
+    qdd = rng.standard_normal((samples, robot.n))
+    w = regressor(robot, q, qd, qdd).reshape(-1, 10 * robot.n)
+    scale = np.linalg.norm(w, axis=0)
+    nonzero = scale > 1e-9 * scale.max()  # columns that are zero up to round-off
+    ws = np.where(nonzero, w / np.where(nonzero, scale, 1.0), 0.0)
+    _, r, piv = scipy.linalg.qr(ws, mode="economic", pivoting=True)
+    diag = np.abs(np.diag(r))
+    rank = int(np.sum(diag > rtol * diag[0]))
+    ind, dep = piv[:rank], piv[rank:]
+    # ws[:, dep] = ws[:, ind] @ beta_s (in scaled columns), then undo the scaling
+    beta_s = scipy.linalg.solve_triangular(r[:rank, :rank], r[:rank, rank:])
+    beta = beta_s * scale[dep][None, :] / scale[ind][:, None]
+    beta[:, ~nonzero[dep]] = 0.0
+    order = np.argsort(ind)
+    dep_order = np.argsort(dep)
+    beta = beta[order][:, dep_order]
+    beta[np.abs(beta) < 1e-12] = 0.0
+    return BaseParameters(
+        independent=ind[order],
+        dependent=dep[dep_order],
+        beta=beta,
+        names=parameter_names(robot),
+    )

@@ -1,0 +1,47 @@
+"""Robot models as data: dataclasses, robot files (TOML, URDF) and the built-in library."""
+
+from kinergy.model.io import (
+    library_names,
+    load_robot,
+    parse_payload,
+    read_robot_file,
+    robot_from_dict,
+    robot_to_dict,
+    save_robot,
+)
+from kinergy.model.robot import (
+    CONVENTIONS,
+    SOURCE_CATEGORIES,
+    SOURCE_STATUSES,
+    Drive,
+    Friction,
+    Joint,
+    Limits,
+    Link,
+    Payload,
+    Robot,
+    Source,
+    inertia_matrix,
+)
+
+__all__ = [
+    "CONVENTIONS",
+    "SOURCE_CATEGORIES",
+    "SOURCE_STATUSES",
+    "Drive",
+    "Friction",
+    "Joint",
+    "Limits",
+    "Link",
+    "Payload",
+    "Robot",
+    "Source",
+    "inertia_matrix",
+    "library_names",
+    "load_robot",
+    "parse_payload",
+    "read_robot_file",
+    "robot_from_dict",
+    "robot_to_dict",
+    "save_robot",
+]

@@ -1,0 +1,452 @@
+"""Robot files: TOML in and out, the built-in library, and the plain-dict form used for JSON.
+
+A robot file is TOML with the same structure as :func:`robot_to_dict` (which is also the
+``robot show --json`` shape of DESIGN.md)::
+
+    name = "ur5e"
+    convention = "dh"                 # or "mdh"
+    gravity = [0.0, 0.0, -9.81]       # optional
+    description = "..."               # optional
+    coupling = [[...], ...]           # optional, n x n (differential joints)
+    [flange]                          # optional: pose of the flange in the last link frame
+    xyz = [0, 0, 0]
+    rpy = [0, 0, 0]                   # rad, fixed-axis roll-pitch-yaw (URDF's convention)
+    [base]                            # optional: pose of frame 0 in the base frame
+    xyz = [0, 0, 0]
+    rpy = [0, 0, 0]
+    [payload]                         # optional
+    mass = 1.0
+    com = [0, 0, 0.05]
+    inertia = [0, 0, 0, 0, 0, 0]
+    [sources.inertia]                 # optional provenance per parameter group
+    status = "seed"
+    ref = "UR5e doc Table III"
+    [[joints]]
+    name = "shoulder_pan"
+    d = 0.1625
+    a = 0.0
+    alpha = 1.5707963267948966
+    offset = 0.0
+    mass = 3.761
+    com = [0.0, -0.02561, 0.00193]
+    inertia = [0.0067, 0.0064, 0.0067, 0.0, 0.0, 0.0]   # Ixx Iyy Izz Ixy Iyz Ixz, about the CoM
+    [joints.drive]
+    gear_ratio = 100.0
+    ...
+    [joints.drive.friction]
+    model = "power_flow"
+    ...
+    [joints.limits]
+    position = [-6.283185307179586, 6.283185307179586]
+    speed = 3.141592653589793
+    torque = 150.0
+
+Every error names the file and the field, e.g.
+``ur5e.toml: joints[4] (wrist_2).inertia: ... violates the triangle inequality``.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import tomllib
+from collections.abc import Callable, Mapping
+from importlib import resources
+from pathlib import Path
+from typing import Any, TypeVar
+
+import numpy as np
+import tomli_w
+from scipy.spatial.transform import Rotation
+
+from kinergy.errors import KinergyError
+from kinergy.model.robot import (
+    SOURCE_CATEGORIES,
+    Drive,
+    Friction,
+    Joint,
+    Limits,
+    Link,
+    Payload,
+    Robot,
+    Source,
+)
+
+__all__ = [
+    "library_names",
+    "load_robot",
+    "parse_payload",
+    "read_robot_file",
+    "robot_from_dict",
+    "robot_to_dict",
+    "save_robot",
+]
+
+T = TypeVar("T")
+
+_ROBOT_KEYS = {
+    "name",
+    "convention",
+    "gravity",
+    "description",
+    "coupling",
+    "flange",
+    "base",
+    "payload",
+    "sources",
+    "joints",
+}
+_JOINT_KEYS = {"name", "d", "a", "alpha", "offset", "mass", "com", "inertia", "drive", "limits"}
+_DRIVE_KEYS = {
+    "gear_ratio",
+    "motor_inertia",
+    "reducer_inertia",
+    "torque_constant",
+    "motor_constant",
+    "kt_over_kb",
+    "friction",
+    "winding_resistance",
+}
+_LIMIT_KEYS = {"position", "speed", "torque", "acceleration"}
+
+
+def _at(where: str, build: Callable[[], T]) -> T:
+    """Run ``build``; prefix any KinergyError (or missing key) with ``where``."""
+    try:
+        return build()
+    except KinergyError as exc:
+        raise exc.prefixed(where) from None
+
+
+def _table(data: Any, where: str) -> Mapping[str, Any]:
+    if not isinstance(data, Mapping):
+        raise KinergyError(f"{where}: must be a table, got {type(data).__name__}")
+    return data
+
+
+def _take(data: Mapping[str, Any], key: str, where: str) -> Any:
+    if key not in data:
+        raise KinergyError(f"{where}: missing field {key!r}")
+    return data[key]
+
+
+def _no_unknown(data: Mapping[str, Any], allowed: set[str], where: str) -> None:
+    unknown = sorted(set(data) - allowed)
+    if unknown:
+        raise KinergyError(
+            f"{where}: unknown field(s) {', '.join(repr(u) for u in unknown)} "
+            f"(allowed: {', '.join(sorted(allowed))})"
+        )
+
+
+def _joint_from_dict(data: Any, index: int) -> Joint:
+    where = f"joints[{index}]"
+    data = _table(data, where)
+    if isinstance(data.get("name"), str):
+        where = f"joints[{index}] ({data['name']})"
+    _no_unknown(data, _JOINT_KEYS, where)
+
+    link = _at(
+        where,
+        lambda: Link(
+            mass=_take(data, "mass", where),
+            com=_take(data, "com", where),
+            inertia=_take(data, "inertia", where),
+        ),
+    )
+    dwhere = f"{where}.drive"
+    drive_data = _table(_take(data, "drive", where), dwhere)
+    _no_unknown(drive_data, _DRIVE_KEYS, dwhere)
+    fwhere = f"{dwhere}.friction"
+    fric_data = dict(_table(_take(drive_data, "friction", dwhere), fwhere))
+    model = fric_data.pop("model", None)
+    if model is None:
+        raise KinergyError(f"{fwhere}: missing field 'model'")
+    friction = _at(fwhere, lambda: Friction(model=model, params=fric_data))
+    drive = _at(
+        dwhere,
+        lambda: Drive(
+            gear_ratio=_take(drive_data, "gear_ratio", dwhere),
+            motor_inertia=_take(drive_data, "motor_inertia", dwhere),
+            reducer_inertia=_take(drive_data, "reducer_inertia", dwhere),
+            torque_constant=_take(drive_data, "torque_constant", dwhere),
+            motor_constant=_take(drive_data, "motor_constant", dwhere),
+            kt_over_kb=_take(drive_data, "kt_over_kb", dwhere),
+            friction=friction,
+            winding_resistance=drive_data.get("winding_resistance"),
+        ),
+    )
+    lwhere = f"{where}.limits"
+    lim_data = _table(_take(data, "limits", where), lwhere)
+    _no_unknown(lim_data, _LIMIT_KEYS, lwhere)
+    limits = _at(
+        where,
+        lambda: Limits(
+            position=_take(lim_data, "position", lwhere),
+            speed=_take(lim_data, "speed", lwhere),
+            torque=_take(lim_data, "torque", lwhere),
+            acceleration=lim_data.get("acceleration"),
+        ),
+    )
+    return _at(
+        where,
+        lambda: Joint(
+            name=_take(data, "name", where),
+            d=_take(data, "d", where),
+            a=_take(data, "a", where),
+            alpha=_take(data, "alpha", where),
+            offset=data.get("offset", 0.0),
+            link=link,
+            drive=drive,
+            limits=limits,
+        ),
+    )
+
+
+def _pose_from_dict(data: Any, where: str) -> np.ndarray:
+    data = _table(data, where)
+    _no_unknown(data, {"xyz", "rpy"}, where)
+    try:
+        xyz = np.asarray(data.get("xyz", [0.0, 0.0, 0.0]), dtype=float)
+        rpy = np.asarray(data.get("rpy", [0.0, 0.0, 0.0]), dtype=float)
+    except (TypeError, ValueError):
+        raise KinergyError(f"{where}: xyz and rpy must be 3 numbers each") from None
+    if xyz.shape != (3,) or rpy.shape != (3,):
+        raise KinergyError(f"{where}: xyz and rpy must be 3 numbers each")
+    out = np.eye(4)
+    out[:3, :3] = Rotation.from_euler("xyz", rpy).as_matrix()
+    out[:3, 3] = xyz
+    return out
+
+
+def robot_from_dict(data: Mapping[str, Any]) -> Robot:
+    """Build a :class:`Robot` from the plain-dict form (see the module docstring).
+
+    Raises
+    ------
+    KinergyError
+        Naming the field at fault (``joints[2] (elbow).drive.gear_ratio: ...``).
+    """
+    data = _table(data, "robot")
+    _no_unknown(data, _ROBOT_KEYS, "robot")
+    joints_data = _take(data, "joints", "robot")
+    if not isinstance(joints_data, list) or not joints_data:
+        raise KinergyError("joints: must be a non-empty array of tables ([[joints]])")
+    joints = [_joint_from_dict(j, i) for i, j in enumerate(joints_data)]
+    payload = None
+    if "payload" in data:
+        pdata = _table(data["payload"], "payload")
+        _no_unknown(pdata, {"mass", "com", "inertia"}, "payload")
+        payload = Payload(
+            mass=_take(pdata, "mass", "payload"),
+            com=pdata.get("com", [0.0, 0.0, 0.0]),
+            inertia=pdata.get("inertia", [0.0] * 6),
+        )
+    sources = {}
+    for cat, sdata in _table(data.get("sources", {}), "sources").items():
+        sdata = _table(sdata, f"sources.{cat}")
+        _no_unknown(sdata, {"status", "ref"}, f"sources.{cat}")
+        status = _take(sdata, "status", f"sources.{cat}")
+        try:
+            sources[cat] = Source(status=status, ref=str(sdata.get("ref", "")))
+        except KinergyError as exc:
+            raise exc.prefixed(f"sources.{cat}") from None
+    flange = _pose_from_dict(data["flange"], "flange") if "flange" in data else np.eye(4)
+    base = _pose_from_dict(data["base"], "base") if "base" in data else np.eye(4)
+    return Robot(
+        name=_take(data, "name", "robot"),
+        convention=_take(data, "convention", "robot"),
+        joints=tuple(joints),
+        gravity=data.get("gravity", [0.0, 0.0, -9.81]),
+        payload=payload,
+        flange=flange,
+        base=base,
+        coupling=data.get("coupling"),
+        sources=sources,
+        description=str(data.get("description", "")),
+    )
+
+
+def _floats(arr: Any) -> Any:
+    return np.asarray(arr, dtype=float).tolist()
+
+
+def robot_to_dict(robot: Robot) -> dict[str, Any]:
+    """The plain-dict form of a robot: TOML file content and the ``robot show --json`` shape.
+
+    Optional items that are absent (no payload, identity flange, no coupling, no winding
+    resistance, no acceleration limit) are left out.
+    """
+    out: dict[str, Any] = {
+        "name": robot.name,
+        "description": robot.description,
+        "convention": robot.convention,
+        "gravity": _floats(robot.gravity),
+    }
+    assert robot.coupling is not None
+    if not np.array_equal(robot.coupling, np.eye(robot.n)):
+        out["coupling"] = _floats(robot.coupling)
+    for key, pose in (("base", robot.base), ("flange", robot.flange)):
+        if not np.array_equal(pose, np.eye(4)):
+            rpy = Rotation.from_matrix(pose[:3, :3]).as_euler("xyz")
+            out[key] = {"xyz": _floats(pose[:3, 3]), "rpy": _floats(rpy)}
+    if robot.payload is not None:
+        out["payload"] = {
+            "mass": robot.payload.mass,
+            "com": _floats(robot.payload.com),
+            "inertia": _floats(robot.payload.inertia),
+        }
+    out["sources"] = {
+        cat: {"status": robot.sources[cat].status, "ref": robot.sources[cat].ref}
+        for cat in SOURCE_CATEGORIES
+    }
+    joints = []
+    for j in robot.joints:
+        drive: dict[str, Any] = {
+            "gear_ratio": j.drive.gear_ratio,
+            "motor_inertia": j.drive.motor_inertia,
+            "reducer_inertia": j.drive.reducer_inertia,
+            "torque_constant": j.drive.torque_constant,
+            "motor_constant": j.drive.motor_constant,
+            "kt_over_kb": j.drive.kt_over_kb,
+        }
+        if j.drive.winding_resistance is not None:
+            drive["winding_resistance"] = j.drive.winding_resistance
+        drive["friction"] = {"model": j.drive.friction.model, **j.drive.friction.params}
+        limits: dict[str, Any] = {
+            "position": _floats(j.limits.position),
+            "speed": j.limits.speed,
+            "torque": j.limits.torque,
+        }
+        if j.limits.acceleration is not None:
+            limits["acceleration"] = j.limits.acceleration
+        joints.append(
+            {
+                "name": j.name,
+                "d": j.d,
+                "a": j.a,
+                "alpha": j.alpha,
+                "offset": j.offset,
+                "mass": j.link.mass,
+                "com": _floats(j.link.com),
+                "inertia": _floats(j.link.inertia),
+                "drive": drive,
+                "limits": limits,
+            }
+        )
+    out["joints"] = joints
+    return out
+
+
+def read_robot_file(path: str | os.PathLike[str]) -> Robot:
+    """Read a robot file (TOML, or URDF by its ``.urdf`` suffix).
+
+    Raises
+    ------
+    KinergyError
+        ``FILE: problem`` for unreadable files, TOML syntax errors (with line and column) and any
+        invalid field.
+    """
+    path = Path(path)
+    if path.suffix.lower() == ".urdf":
+        from kinergy.model.urdf import robot_from_urdf
+
+        return robot_from_urdf(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise KinergyError(f"{path}: cannot read robot file ({exc.strerror})") from None
+    except UnicodeDecodeError:
+        raise KinergyError(f"{path}: not a text (UTF-8) file") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise KinergyError(f"{path}: not valid TOML: {exc}") from None
+    try:
+        return robot_from_dict(data)
+    except KinergyError as exc:
+        raise exc.prefixed(str(path)) from None
+
+
+def save_robot(robot: Robot, path: str | os.PathLike[str], *, header: str = "") -> None:
+    """Write ``robot`` as a TOML robot file, atomically (no half-written file on failure).
+
+    ``header`` lines are written as TOML comments at the top.
+    """
+    path = Path(path)
+    body = tomli_w.dumps(robot_to_dict(robot))
+    comment = "".join(f"# {line}\n" for line in header.splitlines())
+    directory = path.parent if str(path.parent) else Path(".")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=directory)
+    except OSError as exc:
+        raise KinergyError(f"{path}: cannot write ({exc.strerror})") from None
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(comment + body)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _library_dir() -> Any:
+    return resources.files("kinergy.model") / "library"
+
+
+def library_names() -> list[str]:
+    """Names of the built-in robot files, sorted."""
+    return sorted(
+        p.name.removesuffix(".toml") for p in _library_dir().iterdir() if p.name.endswith(".toml")
+    )
+
+
+def load_robot(name_or_path: str | os.PathLike[str], *, payload: Payload | None = None) -> Robot:
+    """Load a built-in robot by name (``"ur5e"``) or a robot file by path (TOML or URDF).
+
+    Parameters
+    ----------
+    name_or_path : str or path
+        A name from :func:`library_names` or a path to a ``.toml`` / ``.urdf`` file.
+    payload : Payload, optional
+        Replaces the file's payload.
+
+    Raises
+    ------
+    KinergyError
+        Unknown name (listing the built-in ones), unreadable or invalid file.
+    """
+    key = os.fspath(name_or_path)
+    if key in library_names():
+        ref = _library_dir() / f"{key}.toml"
+        with resources.as_file(ref) as path:
+            robot = read_robot_file(path)
+    elif Path(key).exists():
+        robot = read_robot_file(key)
+    else:
+        raise KinergyError(
+            f"unknown robot {key!r}: not a built-in robot ({', '.join(library_names())}) "
+            "and no such file"
+        )
+    return robot if payload is None else robot.with_payload(payload)
+
+
+def parse_payload(text: str) -> Payload:
+    """Parse a CLI payload: ``MASS``, ``MASS,CX,CY,CZ`` or ``MASS,CX,CY,CZ,IXX,IYY,IZZ,IXY,IYZ,IXZ``.
+
+    kg, m (flange frame), kg m^2 (about the centre of mass).
+    """
+    try:
+        values = [float(v) for v in text.replace(" ", "").split(",") if v != ""]
+    except ValueError:
+        raise KinergyError(f"--payload: expected comma-separated numbers, got {text!r}") from None
+    if len(values) not in (1, 4, 10):
+        raise KinergyError(
+            f"--payload: expected MASS, MASS,CX,CY,CZ or 10 numbers with the inertia; got {len(values)}"
+        )
+    com = values[1:4] if len(values) >= 4 else [0.0, 0.0, 0.0]
+    inertia = values[4:10] if len(values) == 10 else [0.0] * 6
+    return _at(
+        "--payload",
+        lambda: Payload(mass=values[0], com=np.asarray(com), inertia=np.asarray(inertia)),
+    )

@@ -1,0 +1,424 @@
+"""The robot model: plain, frozen data, validated on construction.
+
+A :class:`Robot` is a serial chain of revolute :class:`Joint` s. Each joint carries its kinematic
+parameters (standard or modified Denavit–Hartenberg, see :data:`CONVENTIONS`), the :class:`Link`
+it moves (mass, centre of mass, inertia about the centre of mass in the link frame), its
+:class:`Drive` (gear, motor, friction; motor side) and its :class:`Limits`. An optional
+:class:`Payload` sits at the flange. Nothing here computes dynamics: algorithms are functions in
+:mod:`kinergy.dynamics` that take a robot.
+
+Units are SI throughout (m, rad, kg, kg m^2, N m, A). Inertia 6-vectors are
+``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]`` about the centre of mass, in the link frame.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kinergy.drives.friction import check_friction
+from kinergy.errors import KinergyError
+
+__all__ = [
+    "CONVENTIONS",
+    "SOURCE_CATEGORIES",
+    "SOURCE_STATUSES",
+    "Drive",
+    "Friction",
+    "Limits",
+    "Link",
+    "Payload",
+    "Robot",
+    "Source",
+    "inertia_matrix",
+]
+
+Array = NDArray[np.float64]
+
+#: ``dh``: frame i = frame i-1 · Rz(q_i + offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i).
+#: ``mdh`` (Craig): frame i = frame i-1 · Rx(alpha_{i-1}) · Tx(a_{i-1}) · Rz(q_i + offset_i) · Tz(d_i),
+#: with joint i storing ``a`` = a_{i-1} and ``alpha`` = alpha_{i-1}.
+CONVENTIONS = ("dh", "mdh")
+
+#: Groups of parameters whose provenance a robot file records.
+SOURCE_CATEGORIES = (
+    "kinematics",
+    "mass",
+    "com",
+    "inertia",
+    "drive_inertia",
+    "torque_constant",
+    "friction",
+    "motor_constant",
+    "limits",
+)
+#: ``published`` by the maker, from a ``seed`` paper's tables, ``identified`` from logs by kinergy,
+#: ``nominal`` (an estimate: identify before trusting), or ``user`` (a file that does not say).
+SOURCE_STATUSES = ("published", "seed", "identified", "nominal", "user")
+
+
+def _vector(value: Any, length: int, what: str) -> Array:
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise KinergyError(f"{what} must be {length} numbers, got {value!r}") from None
+    if arr.shape != (length,):
+        raise KinergyError(f"{what} must be {length} numbers, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise KinergyError(f"{what} must be finite, got {arr.tolist()}")
+    arr.setflags(write=False)
+    return arr
+
+
+def _number(value: Any, what: str, *, low: float | None = None, strict: bool = True) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
+        raise KinergyError(f"{what} must be a number, got {value!r}")
+    x = float(value)
+    if not np.isfinite(x):
+        raise KinergyError(f"{what} must be finite, got {value!r}")
+    if low is not None and ((strict and x <= low) or (not strict and x < low)):
+        raise KinergyError(f"{what} must be {'>' if strict else '>='} {low:g}, got {x:g}")
+    return x
+
+
+def inertia_matrix(inertia: Array) -> Array:
+    """Symmetric 3x3 tensor from ``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]``, shape (..., 6) -> (..., 3, 3)."""
+    ixx, iyy, izz, ixy, iyz, ixz = np.moveaxis(np.asarray(inertia, dtype=float), -1, 0)
+    return np.stack(
+        [
+            np.stack([ixx, ixy, ixz], axis=-1),
+            np.stack([ixy, iyy, iyz], axis=-1),
+            np.stack([ixz, iyz, izz], axis=-1),
+        ],
+        axis=-2,
+    )
+
+
+def _check_inertia(inertia: Array, what: str, *, allow_zero: bool) -> None:
+    """Positive (semi-)definite and satisfying the triangle inequality of principal moments."""
+    eig = np.linalg.eigvalsh(inertia_matrix(inertia))
+    scale = max(float(np.max(np.abs(eig))), 1e-12)
+    if allow_zero and scale <= 1e-12:
+        return
+    if eig[0] <= (-1e-12 * scale if allow_zero else 0.0):
+        raise KinergyError(
+            f"{what} is not positive definite (principal moments {np.round(eig, 9).tolist()})"
+        )
+    if eig[0] + eig[1] < eig[2] * (1.0 - 1e-9):
+        raise KinergyError(
+            f"{what} violates the triangle inequality: principal moments "
+            f"{np.round(eig, 9).tolist()} (the two smaller must add up to at least the largest)"
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Link:
+    """Rigid-body data of one link, in its own frame (DH or MDH frame i).
+
+    Attributes
+    ----------
+    mass : float
+        kg, > 0.
+    com : ndarray, shape (3,)
+        Centre of mass, m, in the link frame.
+    inertia : ndarray, shape (6,)
+        ``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]`` about the centre of mass, kg m^2, in the link frame;
+        positive definite and satisfying the triangle inequality.
+    """
+
+    mass: float
+    com: Array
+    inertia: Array
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "mass", _number(self.mass, "mass", low=0.0))
+        object.__setattr__(self, "com", _vector(self.com, 3, "com"))
+        object.__setattr__(self, "inertia", _vector(self.inertia, 6, "inertia"))
+        _check_inertia(self.inertia, "inertia", allow_zero=False)
+
+
+@dataclass(frozen=True, eq=False)
+class Payload:
+    """A load rigidly fixed to the flange (what a UR program sets with ``set_payload``).
+
+    Attributes
+    ----------
+    mass : float
+        kg, >= 0.
+    com : ndarray, shape (3,)
+        Centre of mass in the flange frame, m.
+    inertia : ndarray, shape (6,)
+        About the centre of mass, flange-frame axes, kg m^2; zeros for a point mass.
+    """
+
+    mass: float
+    com: Array = field(default_factory=lambda: np.zeros(3))
+    inertia: Array = field(default_factory=lambda: np.zeros(6))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "mass", _number(self.mass, "payload mass", low=0.0, strict=False))
+        object.__setattr__(self, "com", _vector(self.com, 3, "payload com"))
+        object.__setattr__(self, "inertia", _vector(self.inertia, 6, "payload inertia"))
+        _check_inertia(self.inertia, "payload inertia", allow_zero=True)
+
+
+@dataclass(frozen=True, eq=False)
+class Friction:
+    """A friction model (see :mod:`kinergy.drives.friction`) and its motor-side parameters."""
+
+    model: str
+    params: Mapping[str, float]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "params", check_friction(self.model, dict(self.params)))
+
+
+@dataclass(frozen=True, eq=False)
+class Drive:
+    """A joint drive: motor, reducer and their friction, described on the motor side.
+
+    Attributes
+    ----------
+    gear_ratio : float
+        Motor speed / joint speed (UR5e eq 2's ``i``), non-zero; its sign sets the direction.
+    motor_inertia, reducer_inertia : float
+        J_m and J_r, kg m^2, motor side, >= 0 (UR5e Table IV).
+    torque_constant : float
+        k_t, N m/A, > 0 (UR5e eq 10).
+    motor_constant : float
+        k_m = k_t / sqrt(R), N m/sqrt(W), > 0 (UR5e eq 23).
+    kt_over_kb : float
+        Ratio of torque constant to back-EMF constant, > 0 (0.89 for the UR5e motors).
+    friction : Friction
+        Motor-side friction model.
+    winding_resistance : float or None
+        R, ohm, > 0, when known; overrides ``motor_constant`` in the electrical model.
+    """
+
+    gear_ratio: float
+    motor_inertia: float
+    reducer_inertia: float
+    torque_constant: float
+    motor_constant: float
+    kt_over_kb: float
+    friction: Friction
+    winding_resistance: float | None = None
+
+    def __post_init__(self) -> None:
+        ratio = _number(self.gear_ratio, "gear_ratio")
+        if ratio == 0.0:
+            raise KinergyError("gear_ratio must be non-zero")
+        object.__setattr__(self, "gear_ratio", ratio)
+        for name in ("motor_inertia", "reducer_inertia"):
+            object.__setattr__(
+                self, name, _number(getattr(self, name), name, low=0.0, strict=False)
+            )
+        for name in ("torque_constant", "motor_constant", "kt_over_kb"):
+            object.__setattr__(self, name, _number(getattr(self, name), name, low=0.0))
+        if self.winding_resistance is not None:
+            object.__setattr__(
+                self,
+                "winding_resistance",
+                _number(self.winding_resistance, "winding_resistance", low=0.0),
+            )
+        if not isinstance(self.friction, Friction):
+            raise KinergyError("friction must be a Friction")
+
+    @property
+    def rotor_inertia(self) -> float:
+        """J_m + J_r, kg m^2, motor side (UR5e eq 9)."""
+        return self.motor_inertia + self.reducer_inertia
+
+
+@dataclass(frozen=True, eq=False)
+class Limits:
+    """Joint limits, joint side.
+
+    Attributes
+    ----------
+    position : ndarray, shape (2,)
+        Lower and upper joint angle, rad.
+    speed : float
+        Maximum |qd|, rad/s.
+    torque : float
+        Maximum |tau|, N m.
+    acceleration : float or None
+        Maximum |qdd|, rad/s^2, where published.
+    """
+
+    position: Array
+    speed: float
+    torque: float
+    acceleration: float | None = None
+
+    def __post_init__(self) -> None:
+        pos = _vector(self.position, 2, "limits.position")
+        if not pos[0] < pos[1]:
+            raise KinergyError(
+                f"limits.position must be [lower, upper] with lower < upper, got {pos.tolist()}"
+            )
+        object.__setattr__(self, "position", pos)
+        object.__setattr__(self, "speed", _number(self.speed, "limits.speed", low=0.0))
+        object.__setattr__(self, "torque", _number(self.torque, "limits.torque", low=0.0))
+        if self.acceleration is not None:
+            object.__setattr__(
+                self, "acceleration", _number(self.acceleration, "limits.acceleration", low=0.0)
+            )
+
+
+@dataclass(frozen=True, eq=False)
+class Joint:
+    """One revolute joint, the link it moves, its drive and limits.
+
+    ``d``, ``a``, ``alpha``, ``offset`` follow the robot's convention (:data:`CONVENTIONS`); for
+    ``mdh`` ``a`` and ``alpha`` are a_{i-1} and alpha_{i-1}. m and rad.
+    """
+
+    name: str
+    d: float
+    a: float
+    alpha: float
+    offset: float
+    link: Link
+    drive: Drive
+    limits: Limits
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise KinergyError(f"joint name must be a non-empty string, got {self.name!r}")
+        for name in ("d", "a", "alpha", "offset"):
+            object.__setattr__(self, name, _number(getattr(self, name), name))
+
+
+@dataclass(frozen=True)
+class Source:
+    """Where a group of parameters comes from: a status (:data:`SOURCE_STATUSES`) and a reference."""
+
+    status: str
+    ref: str = ""
+
+    def __post_init__(self) -> None:
+        if self.status not in SOURCE_STATUSES:
+            raise KinergyError(
+                f"source status must be one of {', '.join(SOURCE_STATUSES)}, got {self.status!r}"
+            )
+
+
+def _transform(value: Any, what: str) -> Array:
+    arr = np.array(value, dtype=float)
+    if arr.shape != (4, 4) or not np.all(np.isfinite(arr)):
+        raise KinergyError(f"{what} must be a finite 4x4 homogeneous transform")
+    rot = arr[:3, :3]
+    if not np.allclose(rot @ rot.T, np.eye(3), atol=1e-9) or np.linalg.det(rot) < 0:
+        raise KinergyError(f"{what} rotation must be a proper rotation matrix")
+    if not np.allclose(arr[3], [0.0, 0.0, 0.0, 1.0]):
+        raise KinergyError(f"{what} last row must be [0, 0, 0, 1]")
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class Robot:
+    """A serial arm of revolute joints, as data.
+
+    Attributes
+    ----------
+    name : str
+    convention : {'dh', 'mdh'}
+    joints : tuple of Joint, length n
+    gravity : ndarray, shape (3,)
+        Gravitational acceleration in the base frame, m/s^2 (default ``[0, 0, -9.81]``).
+    payload : Payload or None
+        Load at the flange.
+    flange : ndarray, shape (4, 4)
+        Pose of the flange in the last link frame (identity for UR arms, whose DH frame 6 is the
+        flange).
+    base : ndarray, shape (4, 4)
+        Pose of the kinematic frame 0 in the robot's base frame (identity unless a file, e.g. an
+        imported URDF, needs it). Gravity, forward kinematics and Jacobians are in the base frame.
+    coupling : ndarray, shape (n, n)
+        Transmission coupling: the motor-side input angles before the gears are
+        ``coupling @ q`` (identity for independent joints; nursing eq 3 for differential joints).
+    sources : mapping of str to Source
+        Provenance of each parameter group (:data:`SOURCE_CATEGORIES`).
+    description : str
+    """
+
+    name: str
+    convention: str
+    joints: tuple[Joint, ...]
+    gravity: Array = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
+    payload: Payload | None = None
+    flange: Array = field(default_factory=lambda: np.eye(4))
+    base: Array = field(default_factory=lambda: np.eye(4))
+    coupling: Array | None = None
+    sources: Mapping[str, Source] = field(default_factory=dict)
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise KinergyError(f"robot name must be a non-empty string, got {self.name!r}")
+        if self.convention not in CONVENTIONS:
+            raise KinergyError(
+                f"convention must be one of {', '.join(CONVENTIONS)}, got {self.convention!r}"
+            )
+        joints = tuple(self.joints)
+        if not joints:
+            raise KinergyError("a robot needs at least one joint")
+        for j in joints:
+            if not isinstance(j, Joint):
+                raise KinergyError(f"joints must be Joint objects, got {type(j).__name__}")
+        names = [j.name for j in joints]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise KinergyError(f"joint names must be unique; repeated: {', '.join(dup)}")
+        object.__setattr__(self, "joints", joints)
+        object.__setattr__(self, "gravity", _vector(self.gravity, 3, "gravity"))
+        if self.payload is not None and not isinstance(self.payload, Payload):
+            raise KinergyError("payload must be a Payload")
+        object.__setattr__(self, "flange", _transform(self.flange, "flange"))
+        object.__setattr__(self, "base", _transform(self.base, "base"))
+        n = len(joints)
+        coupling = np.eye(n) if self.coupling is None else np.array(self.coupling, dtype=float)
+        if coupling.shape != (n, n) or not np.all(np.isfinite(coupling)):
+            raise KinergyError(
+                f"coupling must be a finite {n}x{n} matrix, got shape {coupling.shape}"
+            )
+        if abs(np.linalg.det(coupling)) < 1e-12:
+            raise KinergyError("coupling matrix must be invertible")
+        coupling.setflags(write=False)
+        object.__setattr__(self, "coupling", coupling)
+        sources = dict(self.sources)
+        unknown = sorted(set(sources) - set(SOURCE_CATEGORIES))
+        if unknown:
+            raise KinergyError(
+                f"unknown source categories: {', '.join(unknown)} "
+                f"(known: {', '.join(SOURCE_CATEGORIES)})"
+            )
+        for cat in SOURCE_CATEGORIES:
+            sources.setdefault(cat, Source("user"))
+        object.__setattr__(self, "sources", sources)
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return len(self.joints)
+
+    @property
+    def joint_names(self) -> list[str]:
+        return [j.name for j in self.joints]
+
+    def with_payload(self, payload: Payload | None) -> Robot:
+        """A copy of this robot with ``payload`` at the flange (``None`` removes it)."""
+        return dataclasses.replace(self, payload=payload)
+
+    def with_joints(self, joints: Sequence[Joint]) -> Robot:
+        """A copy of this robot with other joints (same count)."""
+        if len(joints) != self.n:
+            raise KinergyError(f"expected {self.n} joints, got {len(joints)}")
+        return dataclasses.replace(self, joints=tuple(joints))
