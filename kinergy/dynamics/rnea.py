@@ -96,7 +96,7 @@ def rnea(
         np.ascontiguousarray(s["q"]),
         np.ascontiguousarray(s["qd"]),
         np.ascontiguousarray(s["qdd"]),
-        np.zeros((rows, 6)) if w is None else np.ascontiguousarray(w),
+        np.empty((0, 6)) if w is None else np.ascontiguousarray(w),
         w is not None,
         tau,
     )
