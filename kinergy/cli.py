@@ -223,11 +223,205 @@ def _show_text(r: Robot) -> str:
 )
 def robot_show(robot_name: str, as_json: bool, payload: str | None) -> None:
     """Show a robot model: a built-in name (ur5e) or a robot file (.toml, .urdf)."""
-    r = load_robot(robot_name, payload=None if payload is None else parse_payload(payload))
+    r = _load(robot_name, payload)
     if as_json:
         click.echo(json.dumps(robot_to_dict(r), indent=2))
     else:
         click.echo(_show_text(r))
+
+
+def _load(robot_name: str, payload: str | None) -> Robot:
+    return load_robot(robot_name, payload=None if payload is None else parse_payload(payload))
+
+
+_payload_option = click.option(
+    "--payload",
+    metavar="MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]",
+    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2.",
+)
+_columns_option = click.option(
+    "--columns",
+    metavar="SPEC",
+    help='Layout of a headerless log, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6".',
+)
+
+
+@cli.command()
+@click.argument("robot_name", metavar="ROBOT")
+@click.option(
+    "--trajectory",
+    required=True,
+    metavar="test-a|test-b|FILE",
+    help="The UR5e doc's test programs, or a motion file (record.py layout with target_q).",
+)
+@click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Log to write.")
+@click.option("--exact", is_flag=True, help="No lag and no noise: the model's equations exactly.")
+@click.option("--lag", type=float, default=None, help="Real motion behind the target, s [0.004].")
+@click.option(
+    "--speed-noise", type=float, default=None, help="Measured speed noise std, rad/s [0.01]."
+)
+@click.option(
+    "--current-noise", type=float, default=None, help="Measured current noise std, A [0.04]."
+)
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the noise.")
+@_payload_option
+@_columns_option
+def simulate(
+    robot_name: str,
+    trajectory: str,
+    out: str,
+    exact: bool,
+    lag: float | None,
+    speed_noise: float | None,
+    current_noise: float | None,
+    seed: int,
+    payload: str | None,
+    columns: str | None,
+) -> None:
+    """Run the digital twin: write the log a UR controller would record (record.py layout, 500 Hz).
+
+    ROBOT is a built-in name or a model file; it is the twin's "true" model.
+    """
+    from kinergy.io.motion import motion_from_log
+    from kinergy.io.rtde import read_log, write_log
+    from kinergy.simulate import TEST_TRAJECTORIES, TwinSettings, paper_trajectory
+    from kinergy.simulate import simulate as run_twin
+
+    r = _load(robot_name, payload)
+    if trajectory in TEST_TRAJECTORIES:
+        motion = paper_trajectory(r, trajectory)
+    else:
+        motion = motion_from_log(
+            read_log(trajectory, columns=columns), n_joints=r.n, source="target"
+        )
+    base = TwinSettings.exact() if exact else TwinSettings()
+    settings = TwinSettings(
+        lag=base.lag if lag is None else lag,
+        speed_noise=base.speed_noise if speed_noise is None else speed_noise,
+        position_noise=base.position_noise,
+        current_noise=base.current_noise if current_noise is None else current_noise,
+        seed=seed,
+    )
+    signals = run_twin(r, motion, settings)
+    t = signals.pop("timestamp")
+    write_log(out, t, signals)
+    click.echo(
+        f"wrote {out}: {len(t)} samples, {t[-1] - t[0]:.3f} s, {r.name}, trajectory {trajectory}, "
+        f"lag {settings.lag * 1e3:g} ms, speed noise {settings.speed_noise:g} rad/s, "
+        f"current noise {settings.current_noise:g} A"
+    )
+
+
+def _energy_text(report: dict[str, Any]) -> str:
+    rows = []
+    for j in report["joints"]:
+        b = j["breakdown"]
+        eff = "-" if j["efficiency"] is None else f"{100 * j['efficiency']:.1f}"
+        rows.append(
+            [
+                j["name"],
+                f"{j['e_mech']:.1f}",
+                f"{j['e_elec']:.1f}",
+                eff,
+                f"{j['mean_power']:.1f}",
+                f"{j['peak_power']:.1f}",
+                f"{b['inertial']:.1f}",
+                f"{b['gravity']:.1f}",
+                f"{b['friction']:.1f}",
+                f"{b['copper']:.1f}",
+            ]
+        )
+    tot = report["total"]
+    b = tot["breakdown"]
+    rows.append(
+        [
+            "total",
+            f"{tot['e_mech']:.1f}",
+            f"{tot['e_elec']:.1f}",
+            f"{100 * tot['efficiency']:.1f}",
+            f"{tot['e_elec'] / report['duration']:.1f}",
+            f"{tot['peak_power']:.1f}",
+            f"{b['inertial']:.1f}",
+            f"{b['gravity']:.1f}",
+            f"{b['friction']:.1f}",
+            f"{b['copper']:.1f}",
+        ]
+    )
+    head = f"{report['robot']}: {report['duration']:.3f} s, {report['samples']} samples; " + (
+        "signed integrals (braking energy returns to the bus)"
+        if report["recovery"]
+        else "no recovery (negative power clipped)"
+    )
+    lines = [
+        head,
+        "",
+        _table(
+            [
+                "joint",
+                "E_mech [J]",
+                "E_elec [J]",
+                "eta [%]",
+                "mean P [W]",
+                "peak P [W]",
+                "inertial [J]",
+                "gravity [J]",
+                "friction [J]",
+                "copper [J]",
+            ],
+            rows,
+        ),
+        "",
+        "E_mech = int tau_m wm dt, E_elec = int W_elec dt (UR5e eqs 23, 25, 26); eta = E_mech / E_elec.",
+        "E_elec = inertial + gravity + friction + copper (each motion part includes its k_b/k_t share).",
+    ]
+    if tot["standby"]:
+        lines.append(
+            f"standby: {tot['standby']:.1f} J; total drawn {tot['e_elec_with_standby']:.1f} J"
+        )
+    return "\n".join(lines)
+
+
+@cli.command()
+@click.argument("model", metavar="MODEL")
+@click.argument("motion_path", metavar="LOG_OR_MOTION", type=click.Path(dir_okay=False))
+@_columns_option
+@click.option("--json", "as_json", is_flag=True, help="Print JSON (DESIGN.md shape).")
+@click.option(
+    "--no-recovery", is_flag=True, help="Clip negative power: the supply takes no energy back."
+)
+@click.option(
+    "--source",
+    type=click.Choice(["auto", "target", "actual"]),
+    default="auto",
+    show_default=True,
+    help="Which motion of a log: commanded (target_*) or measured (actual_*).",
+)
+@_payload_option
+def energy(
+    model: str,
+    motion_path: str,
+    columns: str | None,
+    as_json: bool,
+    no_recovery: bool,
+    source: str,
+    payload: str | None,
+) -> None:
+    """Per-joint mechanical and electrical energy of a logged or planned motion.
+
+    MODEL is a built-in name or a model file; LOG_OR_MOTION a log (record.py layout, or headerless
+    with --columns) or a motion file.
+    """
+    from kinergy.energy.accounting import energy as account
+    from kinergy.io.motion import motion_from_log
+    from kinergy.io.rtde import read_log
+
+    r = _load(model, payload)
+    motion = motion_from_log(read_log(motion_path, columns=columns), n_joints=r.n, source=source)
+    report = account(r, motion, recovery=not no_recovery).to_dict()
+    if as_json:
+        click.echo(json.dumps(report, indent=2))
+    else:
+        click.echo(_energy_text(report))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -6,6 +6,8 @@ A robot file is TOML with the same structure as :func:`robot_to_dict` (which is 
     name = "ur5e"
     convention = "dh"                 # or "mdh"
     gravity = [0.0, 0.0, -9.81]       # optional
+    standby_power = 0.0               # optional, W: controller and brakes, drawn whatever the motion
+    bus_voltage = 48.0                # optional, V: DC bus of the joints
     description = "..."               # optional
     coupling = [[...], ...]           # optional, n x n (differential joints)
     [flange]                          # optional: pose of the flange in the last link frame
@@ -95,6 +97,8 @@ _ROBOT_KEYS = {
     "payload",
     "sources",
     "joints",
+    "standby_power",
+    "bus_voltage",
 }
 _JOINT_KEYS = {"name", "d", "a", "alpha", "offset", "mass", "com", "inertia", "drive", "limits"}
 _DRIVE_KEYS = {
@@ -264,6 +268,8 @@ def robot_from_dict(data: Mapping[str, Any]) -> Robot:
         coupling=data.get("coupling"),
         sources=sources,
         description=str(data.get("description", "")),
+        standby_power=data.get("standby_power", 0.0),
+        bus_voltage=data.get("bus_voltage", 48.0),
     )
 
 
@@ -282,6 +288,8 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         "description": robot.description,
         "convention": robot.convention,
         "gravity": _floats(robot.gravity),
+        "standby_power": robot.standby_power,
+        "bus_voltage": robot.bus_voltage,
     }
     assert robot.coupling is not None
     if not np.array_equal(robot.coupling, np.eye(robot.n)):

@@ -347,6 +347,11 @@ class Robot:
     sources : mapping of str to Source
         Provenance of each parameter group (:data:`SOURCE_CATEGORIES`).
     description : str
+    standby_power : float
+        Constant power the controller and the brakes draw whatever the motion, W (default 0:
+        the seed's energy figures are the motors' alone).
+    bus_voltage : float
+        DC bus voltage the joints are supplied from, V (48 V on UR e-Series).
     """
 
     name: str
@@ -359,6 +364,8 @@ class Robot:
     coupling: Array | None = None
     sources: Mapping[str, Source] = field(default_factory=dict)
     description: str = ""
+    standby_power: float = 0.0
+    bus_voltage: float = 48.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -378,6 +385,12 @@ class Robot:
         if dup:
             raise KinergyError(f"joint names must be unique; repeated: {', '.join(dup)}")
         object.__setattr__(self, "joints", joints)
+        object.__setattr__(
+            self,
+            "standby_power",
+            _number(self.standby_power, "standby_power", low=0.0, strict=False),
+        )
+        object.__setattr__(self, "bus_voltage", _number(self.bus_voltage, "bus_voltage", low=0.0))
         object.__setattr__(self, "gravity", _vector(self.gravity, 3, "gravity"))
         if self.payload is not None and not isinstance(self.payload, Payload):
             raise KinergyError("payload must be a Payload")

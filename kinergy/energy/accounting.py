@@ -1,0 +1,198 @@
+"""Energy accounting of a motion: where each joule drawn by the motors goes.
+
+Per joint j (UR5e section 5):
+
+- mechanical power ``P_mech = tau_m wm`` and energy ``E_mech = int P_mech dt`` (eq 25),
+- electrical power ``W_elec = tau_m^2 / k_m^2 + (k_b / k_t) wm tau_m`` and ``E_elec = int W_elec dt``
+  (eqs 23, 26),
+- efficiency ``eta = E_mech / E_elec`` (eq 24), mean and peak electrical power.
+
+The electrical energy splits exactly into four parts (framework Fig. 4): the motor torque is
+``tau_m = tau_inertial + tau_gravity + tau_friction`` (motor side; inertial includes the
+Coriolis/centrifugal terms and the rotor inertia), and ``W_elec`` is the copper loss
+``tau_m^2 / k_m^2`` plus ``(k_b / k_t) wm tau_m``, linear in the torque, so::
+
+    E_elec = E_inertial + E_gravity + E_friction + E_copper
+
+where each motion part includes its share of the non-copper motor losses (the ``k_b / k_t`` factor).
+Integrals are signed by default, as in the seed: braking energy returns to the DC bus and is
+counted negative. ``recovery=False`` clips negative power: per joint for the joint figures, and on
+the summed bus power for the total (joints braking can still feed joints driving; the supply takes
+nothing back).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.integrate import trapezoid
+
+from kinergy.drives.electrics import DriveState, drive_state
+from kinergy.drives.transmission import transmission_matrix
+from kinergy.model.robot import Robot
+from kinergy.trajectory.motion import Motion
+
+__all__ = ["EnergyReport", "energy"]
+
+Array = NDArray[np.float64]
+
+BREAKDOWN = ("inertial", "gravity", "friction", "copper")
+
+
+@dataclass(frozen=True, eq=False)
+class EnergyReport:
+    """Energy figures of one motion on one robot.
+
+    Attributes
+    ----------
+    robot : str
+    joints : list of str
+    t : ndarray, shape (N,)
+        s.
+    p_mech, p_elec : ndarray, shape (N, n)
+        Mechanical and electrical power per motor, W (clipped at 0 when ``recovery`` is False).
+    e_mech, e_elec : ndarray, shape (n,)
+        J, per joint.
+    breakdown : dict of str to ndarray, shape (n,)
+        ``inertial``, ``gravity``, ``friction``, ``copper`` parts of ``e_elec`` (signed integrals;
+        with ``recovery`` False they no longer add up to the clipped ``e_elec``).
+    standby : float
+        Energy of the robot's constant standby power over the motion, J.
+    recovery : bool
+        Whether braking energy was counted as returned to the bus.
+    drive : DriveState
+        The drive model's torques, currents, voltages over the motion.
+    """
+
+    robot: str
+    joints: list[str]
+    t: Array
+    p_mech: Array
+    p_elec: Array
+    e_mech: Array
+    e_elec: Array
+    breakdown: dict[str, Array]
+    standby: float
+    total_e_mech: float
+    total_e_elec: float
+    recovery: bool
+    drive: DriveState = field(repr=False)
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def efficiency(self) -> Array:
+        """Per joint ``E_mech / E_elec`` (UR5e eq 24); NaN where ``E_elec`` is 0."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(self.e_elec != 0.0, self.e_mech / self.e_elec, np.nan)
+
+    @property
+    def total_efficiency(self) -> float:
+        """``sum E_mech / sum E_elec`` over the joints (standby excluded), the seed's eta."""
+        return float(self.total_e_mech / self.total_e_elec) if self.total_e_elec else float("nan")
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``energy --json`` shape of DESIGN.md (extra keys included)."""
+        joints = []
+        for i, name in enumerate(self.joints):
+            eff = self.efficiency[i]
+            joints.append(
+                {
+                    "name": name,
+                    "e_mech": float(self.e_mech[i]),
+                    "e_elec": float(self.e_elec[i]),
+                    "efficiency": None if np.isnan(eff) else float(eff),
+                    "mean_power": float(self.e_elec[i] / self.duration) if self.duration else None,
+                    "peak_power": float(np.max(self.p_elec[:, i])),
+                    "breakdown": {k: float(v[i]) for k, v in self.breakdown.items()},
+                    "rms_current": float(np.sqrt(np.mean(self.drive.current[:, i] ** 2))),
+                    "peak_current": float(np.max(np.abs(self.drive.current[:, i]))),
+                }
+            )
+        bus = self.p_elec.sum(axis=1)
+        total_elec = self.total_e_elec + self.standby
+        return {
+            "robot": self.robot,
+            "duration": self.duration,
+            "samples": int(self.t.size),
+            "recovery": self.recovery,
+            "joints": joints,
+            "total": {
+                "e_mech": self.total_e_mech,
+                "e_elec": self.total_e_elec,
+                "efficiency": self.total_efficiency,
+                "standby": self.standby,
+                "e_elec_with_standby": total_elec,
+                "mean_power": total_elec / self.duration if self.duration else None,
+                "peak_power": float(np.max(bus)),
+                "breakdown": {k: float(v.sum()) for k, v in self.breakdown.items()},
+            },
+        }
+
+
+def energy(robot: Robot, motion: Motion, *, recovery: bool = True) -> EnergyReport:
+    """Per-joint and total mechanical and electrical energy of ``motion`` (UR5e eqs 23-26).
+
+    Parameters
+    ----------
+    robot : Robot
+        The model (link data, payload, drives, friction, motor constants, standby power).
+    motion : Motion
+        Joint angles, speeds and accelerations over time.
+    recovery : bool
+        True (default, as the seed): signed integrals, braking energy returns to the bus.
+        False: negative power is clipped (see the module docstring).
+
+    Returns
+    -------
+    EnergyReport
+    """
+    state = drive_state(robot, motion.q, motion.qd, motion.qdd)
+    t = motion.t
+    p_mech = state.p_mech
+    p_elec = state.power
+    # split the motor torque into its sources (motor side)
+    n_mat = transmission_matrix(robot)
+    tau_gravity_m = np.linalg.solve(n_mat.T, state.tau_gravity.T).T
+    tau_inertial_m = state.tau_load - tau_gravity_m
+    kt_over_kb = np.array([j.drive.kt_over_kb for j in robot.joints])
+    copper = p_elec - state.wm * state.tau_m / kt_over_kb
+
+    def integral(power: Array) -> Array:
+        return np.asarray(trapezoid(power, t, axis=0), dtype=float)
+
+    breakdown = {
+        "inertial": integral(state.wm * tau_inertial_m / kt_over_kb),
+        "gravity": integral(state.wm * tau_gravity_m / kt_over_kb),
+        "friction": integral(state.wm * state.tau_friction / kt_over_kb),
+        "copper": integral(copper),
+    }
+    if recovery:
+        total_mech = float(integral(p_mech.sum(axis=1)[:, None])[0])
+        total_elec = float(integral(p_elec.sum(axis=1)[:, None])[0])
+    else:
+        total_mech = float(integral(np.maximum(p_mech.sum(axis=1), 0.0)[:, None])[0])
+        total_elec = float(integral(np.maximum(p_elec.sum(axis=1), 0.0)[:, None])[0])
+        p_mech = np.maximum(p_mech, 0.0)
+        p_elec = np.maximum(p_elec, 0.0)
+    duration = float(t[-1] - t[0])
+    return EnergyReport(
+        robot=robot.name,
+        joints=robot.joint_names,
+        t=t,
+        p_mech=p_mech,
+        p_elec=p_elec,
+        e_mech=integral(p_mech),
+        e_elec=integral(p_elec),
+        breakdown=breakdown,
+        standby=robot.standby_power * duration,
+        total_e_mech=total_mech,
+        total_e_elec=total_elec,
+        recovery=recovery,
+        drive=state,
+    )

@@ -1,0 +1,85 @@
+"""Finite Fourier-series joint trajectories (nursing eq 22), the usual excitation for identification.
+
+    q_i(t) = q_i0 + sum_{l=1..L} ( a_il / (w_f l) sin(w_f l t) - b_il / (w_f l) cos(w_f l t) )
+
+with base frequency ``w_f`` (rad/s; the period is ``2 pi / w_f``). Speeds and accelerations are the
+exact derivatives. The series is periodic, so a run can repeat it for cycle averaging (nursing eq 24).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from kinergy.errors import KinergyError
+from kinergy.trajectory.motion import Motion
+
+__all__ = ["fourier_motion", "fourier_series"]
+
+Array = NDArray[np.float64]
+
+
+def fourier_series(
+    t: ArrayLike, q0: ArrayLike, a: ArrayLike, b: ArrayLike, base_frequency: float
+) -> tuple[Array, Array, Array]:
+    """Evaluate nursing eq 22 and its derivatives.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Time, s.
+    q0 : array_like, shape (n,)
+        Offsets, rad.
+    a, b : array_like, shape (n, L)
+        Coefficients of harmonic l = 1..L, rad/s.
+    base_frequency : float
+        ``w_f``, rad/s.
+
+    Returns
+    -------
+    q, qd, qdd : ndarray, shape (N, n)
+        rad, rad/s, rad/s^2.
+    """
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    q0 = np.asarray(q0, dtype=float)
+    a = np.atleast_2d(np.asarray(a, dtype=float))
+    b = np.atleast_2d(np.asarray(b, dtype=float))
+    if a.shape != b.shape or a.shape[0] != q0.size:
+        raise KinergyError(
+            f"Fourier coefficients: a and b must both have shape ({q0.size}, L), got {a.shape} and {b.shape}"
+        )
+    if not (np.isfinite(base_frequency) and base_frequency > 0):
+        raise KinergyError(f"base frequency must be > 0, got {base_frequency}")
+    w = base_frequency * np.arange(1, a.shape[1] + 1)  # (L,)
+    phase = t[:, None] * w[None, :]  # (N, L)
+    s, c = np.sin(phase), np.cos(phase)
+    q = q0 + (s / w) @ a.T - (c / w) @ b.T
+    qd = c @ a.T + s @ b.T
+    qdd = -(s * w) @ a.T + (c * w) @ b.T
+    return q, qd, qdd
+
+
+def fourier_motion(
+    q0: ArrayLike,
+    a: ArrayLike,
+    b: ArrayLike,
+    *,
+    base_frequency: float,
+    periods: int = 1,
+    dt: float = 0.002,
+) -> Motion:
+    """A Fourier-series motion over ``periods`` whole periods, sampled every ``dt`` s.
+
+    Examples
+    --------
+    >>> m = fourier_motion([0.0], [[0.2]], [[0.0]], base_frequency=0.2 * np.pi, dt=0.1)
+    >>> round(m.duration, 6), round(float(m.q[0, 0]), 6), round(float(m.q[-1, 0]), 6)
+    (10.0, 0.0, 0.0)
+    """
+    if periods < 1:
+        raise KinergyError(f"periods must be >= 1, got {periods}")
+    period = 2.0 * np.pi / base_frequency
+    steps = round(periods * period / dt)
+    t = np.arange(steps + 1, dtype=float) * (periods * period / steps)
+    q, qd, qdd = fourier_series(t, q0, a, b, base_frequency)
+    return Motion(t, q, qd, qdd)

@@ -1,0 +1,82 @@
+"""A joint-space motion: time stamps and joint angles, speeds and accelerations."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from kinergy.errors import KinergyError
+
+__all__ = ["Motion"]
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class Motion:
+    """A sampled joint-space motion.
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        Time, s, strictly increasing.
+    q, qd, qdd : ndarray, shape (N, n)
+        Joint angles (rad), speeds (rad/s), accelerations (rad/s^2).
+    """
+
+    t: Array
+    q: Array
+    qd: Array
+    qdd: Array
+
+    def __post_init__(self) -> None:
+        t = np.asarray(self.t, dtype=float)
+        if t.ndim != 1 or t.size < 1:
+            raise KinergyError(f"motion time must be a 1-D array, got shape {t.shape}")
+        if t.size > 1 and not np.all(np.diff(t) > 0):
+            k = int(np.argmax(np.diff(t) <= 0))
+            raise KinergyError(f"motion time must increase strictly; it does not at sample {k + 1}")
+        arrays = {}
+        for name in ("q", "qd", "qdd"):
+            arr = np.asarray(getattr(self, name), dtype=float)
+            if arr.ndim != 2 or arr.shape[0] != t.size:
+                raise KinergyError(f"motion {name} must have shape ({t.size}, n), got {arr.shape}")
+            if not np.all(np.isfinite(arr)):
+                raise KinergyError(f"motion {name} has non-finite values")
+            arrays[name] = arr
+        shapes = {a.shape for a in arrays.values()}
+        if len(shapes) != 1:
+            raise KinergyError(f"motion q, qd, qdd shapes differ: {sorted(shapes)}")
+        object.__setattr__(self, "t", t)
+        for name, arr in arrays.items():
+            object.__setattr__(self, name, arr)
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return int(self.q.shape[1])
+
+    @property
+    def duration(self) -> float:
+        """``t[-1] - t[0]``, s."""
+        return float(self.t[-1] - self.t[0])
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    def sliced(self, start: int, stop: int) -> Motion:
+        """Samples ``start:stop``."""
+        return Motion(
+            self.t[start:stop], self.q[start:stop], self.qd[start:stop], self.qdd[start:stop]
+        )
+
+    @classmethod
+    def from_arrays(cls, t: ArrayLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> Motion:
+        return cls(
+            np.asarray(t, float),
+            np.asarray(q, float),
+            np.asarray(qd, float),
+            np.asarray(qdd, float),
+        )
