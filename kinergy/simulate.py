@@ -15,8 +15,8 @@ Given a robot model and a commanded (target) motion, the twin produces, at the c
 - ``robot_mode`` 7 (running) and ``runtime_state`` 2 (playing), as a program run logs them.
 
 ``test-a`` and ``test-b`` are the UR5e doc's experiments (section 2.2): a movej program from the
-home pose through six random points and back, joint speed 3 rad/s, acceleration 6 rad/s^2, seeded
-(seeds 1 and 2) so they are reproducible, with points drawn until the flange and the elbow stay
+home pose through six random points and back, joint speed 3 rad/s, acceleration 6 rad/s^2 (capped
+by the robot's joint limits), seeded (seeds 1 and 2) so they are reproducible, with points drawn until the flange and the elbow stay
 above the table plane over the whole motion.
 """
 
@@ -93,11 +93,21 @@ def _above_table(robot: Robot, q: Array, floor: float) -> bool:
     return bool(np.all(heights > floor))
 
 
+def paper_speed(robot: Robot) -> tuple[float, float]:
+    """The test programs' movej speed and acceleration: the UR5e doc's 3 rad/s and 6 rad/s^2,
+    capped by the robot's slowest joint limits (so other arms run them within their limits)."""
+    speed = min([3.0] + [j.limits.speed for j in robot.joints])
+    acc = min(
+        [6.0] + [j.limits.acceleration for j in robot.joints if j.limits.acceleration is not None]
+    )
+    return speed, acc
+
+
 def paper_waypoints(robot: Robot, seed: int, *, points: int = 6, floor: float = 0.05) -> Array:
     """Home, ``points`` random joint targets, home: the UR5e doc's test programs (section 2.2).
 
     Targets are drawn (seeded) with the base and wrists anywhere in +-pi, the shoulder in
-    [-pi, 0] and the elbow in +-2.5 rad, and redrawn until every link frame from the elbow on stays
+    [-pi, 0] and the elbow in +-2.5 rad (within the robot's joint limits), and redrawn until every link frame from the elbow on stays
     above ``floor`` (m) over the whole movej at 3 rad/s and 6 rad/s^2.
 
     Returns
@@ -109,18 +119,31 @@ def paper_waypoints(robot: Robot, seed: int, *, points: int = 6, floor: float = 
             f"the test programs are for 6-joint arms; {robot.name} has {robot.n} joints"
         )
     rng = np.random.default_rng(seed)
-    lo = np.array([-np.pi, -np.pi, -2.5, -np.pi, -np.pi, -np.pi])
-    hi = np.array([np.pi, 0.0, 2.5, np.pi, np.pi, np.pi])
-    way = [_HOME]
-    while len(way) < points + 1:
+    limits = np.array([j.limits.position for j in robot.joints])
+    lo = np.maximum([-np.pi, -np.pi, -2.5, -np.pi, -np.pi, -np.pi], limits[:, 0])
+    hi = np.minimum([np.pi, 0.0, 2.5, np.pi, np.pi, np.pi], limits[:, 1])
+    if np.any(lo >= hi):
+        raise KinergyError(f"the test programs' joint ranges do not fit {robot.name}'s limits")
+    speed, acc = paper_speed(robot)
+    home = np.clip(_HOME, lo, hi)
+    if not _above_table(robot, home[None, :], floor):
+        floor = -np.inf  # an arm whose home pose is not above a table (a mobile or hanging arm)
+    way = [home]
+    for _ in range(2000):
+        if len(way) == points + 1:
+            break
         candidate = rng.uniform(lo, hi)
-        leg = movej(np.vstack([way[-1], candidate]), speed=3.0, acceleration=6.0, dt=0.02)
+        leg = movej(np.vstack([way[-1], candidate]), speed=speed, acceleration=acc, dt=0.02)
         if _above_table(robot, leg.q, floor):
             way.append(candidate)
-    home_leg = movej(np.vstack([way[-1], _HOME]), speed=3.0, acceleration=6.0, dt=0.02)
+    else:
+        raise KinergyError(
+            f"could not draw {points} test points that keep {robot.name} above the table"
+        )
+    home_leg = movej(np.vstack([way[-1], home]), speed=speed, acceleration=acc, dt=0.02)
     if not _above_table(robot, home_leg.q, floor):  # pragma: no cover - depends on the draw
         return paper_waypoints(robot, seed + 1000, points=points, floor=floor)
-    way.append(_HOME)
+    way.append(home)
     return np.vstack(way)
 
 
@@ -131,7 +154,8 @@ def paper_trajectory(robot: Robot, name: str, *, dt: float = 0.002, rest: float 
             f"unknown test trajectory {name!r} (known: {', '.join(TEST_TRAJECTORIES)})"
         )
     waypoints = paper_waypoints(robot, TEST_TRAJECTORIES[name])
-    motion = movej(waypoints, speed=3.0, acceleration=6.0, dt=dt)
+    speed, acc = paper_speed(robot)
+    motion = movej(waypoints, speed=speed, acceleration=acc, dt=dt)
     return pad_rest(motion, rest, dt)
 
 

@@ -321,3 +321,27 @@ def test_electrical_power_formula_directly(ur5e: Robot) -> None:
     np.testing.assert_allclose(
         electrical_power(ur5e, tau_m, wm), tau_m**2 / km**2 + wm * tau_m / 0.89, rtol=1e-12
     )
+
+
+@pytest.mark.parametrize("model", sorted(FRICTION_MODELS))
+def test_friction_columns_reproduce_the_model(model: str) -> None:
+    from kinergy.drives.friction import LINEAR_PARAMETERS, friction_columns, with_linear_parameters
+
+    rng = np.random.default_rng(12)
+    wm = rng.normal(0, 50, 300)
+    load = rng.normal(0, 1, 300)
+    params = PARAMS[model]
+    cols = friction_columns(model, params, wm, load)
+    assert cols.shape == (300, len(LINEAR_PARAMETERS[model]))
+    values = np.array([params.get(n, 0.0) for n in LINEAR_PARAMETERS[model]])
+    if model == "motor_reducer":
+        values[1] = params["motor_coulomb"] + params["reducer_coulomb"]
+    np.testing.assert_allclose(
+        cols @ values, friction_torque(model, params, wm, load), rtol=1e-12, atol=1e-15
+    )
+    # new linear values go back into a parameter set that evaluates to the new columns' torque
+    new = values * 1.7 + 0.01
+    updated = with_linear_parameters(model, params, new)
+    np.testing.assert_allclose(
+        friction_torque(model, updated, wm, load), cols @ new, rtol=1e-12, atol=1e-15
+    )

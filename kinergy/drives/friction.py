@@ -33,7 +33,14 @@ from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
 
-__all__ = ["FRICTION_MODELS", "check_friction", "friction_torque"]
+__all__ = [
+    "FRICTION_MODELS",
+    "LINEAR_PARAMETERS",
+    "check_friction",
+    "friction_columns",
+    "friction_torque",
+    "with_linear_parameters",
+]
 
 Array = NDArray[np.float64]
 
@@ -156,3 +163,88 @@ def friction_torque(
     wm = np.asarray(wm, dtype=float)
     load = None if tau_load is None else np.asarray(tau_load, dtype=float)
     return fn(params, wm, load)
+
+
+#: For each model, the parameters it is linear in (the others, such as ``smoothing``, stay fixed
+#: during a linear fit). ``motor_reducer``'s two Coulomb levels share one column: only their sum,
+#: ``coulomb``, can be identified.
+LINEAR_PARAMETERS: dict[str, tuple[str, ...]] = {
+    "none": (),
+    "viscous_coulomb": ("viscous", "coulomb"),
+    "motor_reducer": ("motor_viscous", "coulomb"),
+    "power_flow": ("viscous", "coulomb_direct", "coulomb_reverse"),
+    "makkar": ("gamma1", "gamma4", "gamma6"),
+    "stribeck": ("coulomb", "static", "viscous"),
+}
+
+
+def friction_columns(
+    model: str,
+    params: Mapping[str, float],
+    wm: Array,
+    tau_load: Array | None = None,
+) -> Array:
+    """Regressor columns of a friction model: ``friction_torque == columns @ linear values``.
+
+    The values are those named by :data:`LINEAR_PARAMETERS` (``motor_reducer``'s ``coulomb`` is
+    ``motor_coulomb + reducer_coulomb``); the model's other parameters are taken from ``params``.
+    For ``power_flow`` these are UR5e eq 18's columns ``[wm, tanh(wm_dir/e), tanh(wm_rev/e)]``.
+
+    Parameters
+    ----------
+    wm : array_like, shape (N,)
+        Motor speed, rad/s.
+    tau_load : array_like, shape (N,), optional
+        Load torque (motor side), needed by ``power_flow``.
+
+    Returns
+    -------
+    ndarray, shape (N, k)
+    """
+    wm = np.asarray(wm, dtype=float)
+    p = params
+    if model == "none":
+        return np.zeros((wm.size, 0))
+    if model in ("viscous_coulomb", "motor_reducer"):
+        return np.column_stack([wm, np.tanh(wm / p["smoothing"])])
+    if model == "power_flow":
+        if tau_load is None:
+            raise KinergyError("friction model 'power_flow' needs the load torque")
+        flow = wm * np.asarray(tau_load, dtype=float)
+        w_dir = np.where(flow > 0.0, wm, 0.0)  # UR5e eq 15
+        w_rev = np.where(flow < 0.0, wm, 0.0)  # UR5e eq 16
+        return np.column_stack(
+            [wm, np.tanh(w_dir / p["smoothing"]), np.tanh(w_rev / p["smoothing"])]
+        )
+    if model == "makkar":
+        return np.column_stack(
+            [np.tanh(p["gamma2"] * wm) - np.tanh(p["gamma3"] * wm), np.tanh(p["gamma5"] * wm), wm]
+        )
+    if model == "stribeck":
+        sign = np.tanh(wm / p["smoothing"])
+        bump = np.exp(-((wm / p["stribeck_speed"]) ** 2))
+        return np.column_stack([sign * (1.0 - bump), sign * bump, wm])
+    raise KinergyError(f"unknown friction model {model!r}")
+
+
+def with_linear_parameters(
+    model: str, params: Mapping[str, float], values: Array
+) -> dict[str, float]:
+    """The model's parameters with the linear ones replaced by ``values`` (see
+    :func:`friction_columns`). ``motor_reducer``'s fitted ``coulomb`` is shared between motor and
+    reducer in the ratio of the old values (equally when both were zero)."""
+    names = LINEAR_PARAMETERS[model]
+    if len(values) != len(names):
+        raise KinergyError(
+            f"friction model {model!r} has {len(names)} linear parameters, got {len(values)}"
+        )
+    out = dict(params)
+    for name, value in zip(names, values, strict=True):
+        if model == "motor_reducer" and name == "coulomb":
+            old = params["motor_coulomb"] + params["reducer_coulomb"]
+            share = params["motor_coulomb"] / old if old > 0 else 0.5
+            out["motor_coulomb"] = float(value) * share
+            out["reducer_coulomb"] = float(value) * (1.0 - share)
+        else:
+            out[name] = float(value)
+    return out
