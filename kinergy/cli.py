@@ -424,6 +424,297 @@ def energy(
         click.echo(_energy_text(report))
 
 
+_repair_option = click.option(
+    "--repair",
+    is_flag=True,
+    help="Drop malformed rows (cut short, non-numeric, time out of order) instead of rejecting.",
+)
+
+
+def _read_logs(
+    paths: Sequence[str], columns: str | None, repair: bool, n_joints: int, cutoff: float | None
+) -> list[Any]:
+    from kinergy.identify.preprocess import prepare
+    from kinergy.io.rtde import read_log
+
+    datas = []
+    for path in paths:
+        log = read_log(path, columns=columns, repair=repair)
+        for note in log.notes:
+            click.echo(f"kinergy: note: {note}", err=True)
+        datas.append(prepare(log, n_joints, cutoff=cutoff))
+    return datas
+
+
+def _metrics_table(metrics: list[dict[str, float]], names: Sequence[str], unit: str) -> str:
+    return _table(
+        ["joint", f"mean [{unit}]", f"max [{unit}]", f"RMS [{unit}]", "R^2"],
+        [
+            [name, f"{m['mean']:.4f}", f"{m['max']:.4f}", f"{m['rms']:.4f}", f"{m['r2']:.4f}"]
+            for name, m in zip(names, metrics, strict=True)
+        ],
+    )
+
+
+def _validation_text(report: dict[str, Any], names: Sequence[str]) -> str:
+    parts = []
+    for key, title, unit in (
+        ("torque", "Torque against target_moment (UR5e Table V)", "N m"),
+        ("current", "Current against actual_current (UR5e Table VII)", "A"),
+        ("joint_torque", "Joint torque against measured torque", "N m"),
+    ):
+        if report.get(key):
+            parts += [title, _metrics_table(report[key], names, unit), ""]
+    return "\n".join(parts).rstrip()
+
+
+@cli.command()
+@click.argument("logs", metavar="LOG...", nargs=-1, required=True)
+@click.option(
+    "--robot",
+    "robot_name",
+    required=True,
+    metavar="ROBOT",
+    help="Starting model: a built-in name or a model file.",
+)
+@click.option(
+    "--method",
+    type=click.Choice(["sequential", "full"]),
+    default="sequential",
+    show_default=True,
+    help="sequential: the UR5e doc's procedure; full: base-parameter regression.",
+)
+@click.option(
+    "--out",
+    "out",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="Model file to write (TOML).",
+)
+@_columns_option
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (DESIGN.md shape).")
+@click.option(
+    "--friction",
+    "friction",
+    default=None,
+    metavar="MODEL",
+    help="Friction model for every joint (default: the model's own).",
+)
+@click.option(
+    "--target",
+    type=click.Choice(["auto", "moment", "current", "torque"]),
+    default="auto",
+    show_default=True,
+    help="Full method: regress against target_moment, currents or measured torques.",
+)
+@click.option(
+    "--solver",
+    type=click.Choice(["ols", "wls", "ridge"]),
+    default="ols",
+    show_default=True,
+    help="Full method: ordinary, weighted or ridge least squares.",
+)
+@click.option(
+    "--ridge",
+    "ridge",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="Full method: ridge weight.",
+)
+@click.option(
+    "--payload-only",
+    is_flag=True,
+    help="Identify only the payload from logs taken with it; ROBOT is the model identified without it.",
+)
+@click.option(
+    "--cutoff",
+    type=float,
+    default=None,
+    help="Low-pass cutoff for measured speeds, Hz [min(10, fs/5)].",
+)
+@_repair_option
+def identify(
+    logs: tuple[str, ...],
+    robot_name: str,
+    method: str,
+    out: str,
+    columns: str | None,
+    as_json: bool,
+    friction: str | None,
+    target: str,
+    solver: str,
+    ridge: float,
+    payload_only: bool,
+    cutoff: float | None,
+    repair: bool,
+) -> None:
+    """Identify a model from controller logs and write it as a robot file.
+
+    The sequential method (default, UR5e doc sections 3-4) keeps the model's link data and
+    identifies rotor inertias from target_moment and torque constants with friction from
+    actual_current; the full method regresses the base inertial parameters too.
+    """
+    import datetime
+
+    from kinergy import __version__
+    from kinergy.model import save_robot
+
+    r = load_robot(robot_name)
+    datas = _read_logs(logs, columns, repair, r.n, cutoff)
+    stamp = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
+    if payload_only:
+        from kinergy.identify.payload import identify_payload
+
+        payload, report = identify_payload(r, datas)
+        save_robot(
+            r.with_payload(payload),
+            out,
+            header=f"kinergy {__version__}: {r.name} with the payload identified from {', '.join(logs)} ({stamp})",
+        )
+        if as_json:
+            click.echo(
+                json.dumps({"robot": r.name, "method": "payload", "payload": report}, indent=2)
+            )
+        else:
+            click.echo(
+                f"payload: {report['mass']:.4f} +- {report['mass_std']:.4f} kg at {_vec(report['com'])} m "
+                f"(flange frame), from {report['signal']}; wrote {out}"
+            )
+            for note in report["notes"]:
+                click.echo(f"note: {note}")
+        return
+    if method == "sequential":
+        from kinergy.identify.sequential import identify_sequential
+
+        result = identify_sequential(r, datas, friction=friction)
+    else:
+        from kinergy.identify.full import identify_full
+
+        result = identify_full(
+            r, datas, target=target, solver=solver, ridge=ridge, friction=friction
+        )
+    header = (
+        f"kinergy {__version__}: {r.name} identified ({result.method} method) from "
+        f"{', '.join(logs)} on {stamp}"
+    )
+    save_robot(result.robot, out, header=header)
+    if as_json:
+        click.echo(json.dumps(result.to_dict(), indent=2, default=float))
+        return
+    names = result.robot.joint_names
+    rows = []
+    for j in result.joints:
+        fr = {k: v for k, v in j["friction"].items() if k != "model"}
+        rows.append(
+            [
+                j["name"],
+                f"{j['rotor_inertia']:.4e}",
+                f"{j['motor_inertia']:.4e}",
+                f"{j['torque_constant']:.4f}",
+                j["friction"]["model"] + " " + " ".join(f"{k}={_g(v)}" for k, v in fr.items()),
+            ]
+        )
+    click.echo(
+        f"{r.name}: {result.method} identification from {len(logs)} log(s), {result.fit.get('samples', 0)} samples"
+    )
+    click.echo(
+        _table(
+            ["joint", "J_m+J_r [kg m^2]", "J_m [kg m^2]", "k_t [N m/A]", "friction (motor side)"],
+            rows,
+        )
+    )
+    text = _validation_text(result.fit, names)
+    if text:
+        click.echo("\nFit on the identification logs\n" + text)
+    for warning in result.warnings:
+        click.echo(f"warning: {warning}")
+    click.echo(f"wrote {out}")
+
+
+@cli.command()
+@click.argument("model", metavar="MODEL")
+@click.argument("logs", metavar="LOG...", nargs=-1, required=True)
+@_columns_option
+@click.option("--json", "as_json", is_flag=True, help="Print JSON (DESIGN.md shape).")
+@click.option(
+    "--plots",
+    "plots",
+    type=click.Path(file_okay=False),
+    default=None,
+    help="Write plots (measured vs predicted, error box plots) to this folder.",
+)
+@click.option("--cutoff", type=float, default=None, help="Low-pass cutoff for measured speeds, Hz.")
+@_payload_option
+@_repair_option
+def validate(
+    model: str,
+    logs: tuple[str, ...],
+    columns: str | None,
+    as_json: bool,
+    plots: str | None,
+    cutoff: float | None,
+    payload: str | None,
+    repair: bool,
+) -> None:
+    """How well a model predicts logs: torque (UR5e Table V) and current (Table VII) errors and R^2."""
+    from kinergy.identify.result import validation_metrics
+
+    r = _load(model, payload)
+    datas = _read_logs(logs, columns, repair, r.n, cutoff)
+    report = validation_metrics(r, datas)
+    if plots:
+        _validation_plots(r, datas, plots)
+    if as_json:
+        click.echo(json.dumps(report, indent=2))
+        return
+    click.echo(f"{r.name} on {', '.join(logs)}\n")
+    text = _validation_text(report, r.joint_names)
+    click.echo(
+        text or "the logs have neither target_moment nor actual_current nor measured torques"
+    )
+    if plots:
+        click.echo(f"\nplots in {plots}")
+
+
+def _validation_plots(r: Robot, datas: list[Any], folder: str) -> None:
+    from pathlib import Path
+
+    from kinergy.identify.result import predict
+    from kinergy.report.plots import error_boxplot, save, time_series
+
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    errors: dict[str, dict[str, Any]] = {"torque": {}, "current": {}}
+    for k, data in enumerate(datas):
+        pred = predict(r, data)
+        stem = Path(data.path).stem or f"log{k}"
+        for key, measured, predicted, unit, label in (
+            ("torque", data.tau_ref, pred.torque, "N m", "target_moment"),
+            ("current", data.current, pred.current, "A", "actual_current"),
+        ):
+            if measured is None or predicted is None:
+                continue
+            fig = time_series(
+                data.t - data.t[0],
+                measured,
+                predicted,
+                joint_names=r.joint_names,
+                quantity=key,
+                unit=unit,
+                measured_label=label,
+                predicted_label="model",
+            )
+            save(fig, out / f"{stem}_{key}.png")
+            errors[key][stem] = measured - predicted
+    for key, unit in (("torque", "N m"), ("current", "A")):
+        if errors[key]:
+            save(
+                error_boxplot(errors[key], joint_names=r.joint_names, quantity=key, unit=unit),
+                out / f"{key}_errors.png",
+            )
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point: run the CLI, turning user errors into one line and a non-zero exit."""
     try:

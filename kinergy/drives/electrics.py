@@ -119,12 +119,14 @@ def electrical_power(robot: Robot, tau_m: ArrayLike, wm: ArrayLike) -> Array:
     return tau_m**2 / motor_constants(robot) ** 2 + np.asarray(wm, dtype=float) * tau_m / kt_over_kb
 
 
-def friction_torques(robot: Robot, wm: Array, tau_load: Array) -> Array:
-    """Motor-side friction of every joint, (N, n), N m."""
+def friction_torques(robot: Robot, wm: Array, tau_load: Array, dwm: Array | None = None) -> Array:
+    """Motor-side friction of every joint, (N, n), N m (``dwm``: motor accelerations, for
+    friction held through standstill)."""
     out = np.empty_like(wm)
     for i, joint in enumerate(robot.joints):
         fr = joint.drive.friction
-        out[:, i] = friction_torque(fr.model, fr.params, wm[:, i], tau_load[:, i])
+        acc = None if dwm is None else dwm[:, i]
+        out[:, i] = friction_torque(fr.model, fr.params, wm[:, i], tau_load[:, i], acc)
     return out
 
 
@@ -160,7 +162,7 @@ def drive_state(
     wm = qd_ @ n_mat.T
     dwm = qdd_ @ n_mat.T
     tau_load = np.asarray(np.linalg.solve(n_mat.T, tau_sim.T).T, dtype=float)
-    tau_friction = friction_torques(robot, wm, tau_load)
+    tau_friction = friction_torques(robot, wm, tau_load, dwm)
     tau_m = tau_load + tau_friction
     current = tau_m / torque_constants(robot)
     voltage = winding_resistances(robot) * current + back_emf_constants(robot) * wm

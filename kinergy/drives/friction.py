@@ -22,6 +22,13 @@ Models
     Nursing eq 13: ``gamma1 (tanh(gamma2 wm) - tanh(gamma3 wm)) + gamma4 tanh(gamma5 wm) + gamma6 wm``.
 ``stribeck``
     ``(coulomb + (static - coulomb) exp(-(wm / stribeck_speed)^2)) tanh(wm / smoothing) + viscous wm``.
+
+Every model also takes an optional ``standstill`` (motor side, rad/s; default 0, off): while the
+motor turns slower than that and accelerates less than ``STILL_RATE`` times that per second (it has
+stopped, not passing through zero speed on a reversal), the friction keeps the value it had when
+the joint last moved, scaled by ``holding`` (default 1; a stopped joint stays in stiction with
+the direction it stopped in, and the position loop lets part of the torque relax, as real UR
+joints do) instead of following the speed's noise through zero. It needs samples in time order.
 """
 
 from __future__ import annotations
@@ -36,9 +43,12 @@ from kinergy.errors import KinergyError
 __all__ = [
     "FRICTION_MODELS",
     "LINEAR_PARAMETERS",
+    "OPTIONAL_PARAMETERS",
     "check_friction",
     "friction_columns",
     "friction_torque",
+    "hold_standstill",
+    "linear_values",
     "with_linear_parameters",
 ]
 
@@ -96,6 +106,11 @@ FRICTION_MODELS: dict[str, tuple[tuple[str, ...], _Eval]] = {
 #: parameters that must be strictly positive (they divide)
 _POSITIVE = {"smoothing", "stribeck_speed"}
 
+#: optional parameters of every model and their defaults
+OPTIONAL_PARAMETERS = {"standstill": 0.0, "holding": 1.0}
+#: a motor is stopped when |wm| < standstill and |dwm| < STILL_RATE * standstill (1/s)
+STILL_RATE = 100.0
+
 
 def check_friction(model: str, params: Mapping[str, float]) -> dict[str, float]:
     """Validate a friction model name and its parameters; return them as plain floats.
@@ -109,8 +124,9 @@ def check_friction(model: str, params: Mapping[str, float]) -> dict[str, float]:
     if model not in FRICTION_MODELS:
         known = ", ".join(sorted(FRICTION_MODELS))
         raise KinergyError(f"unknown friction model {model!r} (known: {known})")
-    names = FRICTION_MODELS[model][0]
-    missing = [n for n in names if n not in params]
+    required = FRICTION_MODELS[model][0]
+    names = required + tuple(n for n in OPTIONAL_PARAMETERS if n in params)
+    missing = [n for n in required if n not in params]
     if missing:
         raise KinergyError(
             f"friction model {model!r} is missing parameter(s): {', '.join(missing)}"
@@ -130,6 +146,10 @@ def check_friction(model: str, params: Mapping[str, float]) -> dict[str, float]:
             raise KinergyError(f"friction parameter {name!r} must be finite, got {value!r}")
         if name in _POSITIVE and value <= 0.0:
             raise KinergyError(f"friction parameter {name!r} must be > 0, got {value!r}")
+        if name in OPTIONAL_PARAMETERS and value < 0.0:
+            raise KinergyError(f"friction parameter {name!r} must be >= 0, got {value!r}")
+        if name == "holding" and value > 1.0:
+            raise KinergyError(f"friction parameter 'holding' must be <= 1, got {value!r}")
         out[name] = float(value)
     return out
 
@@ -139,6 +159,7 @@ def friction_torque(
     params: Mapping[str, float],
     wm: Array,
     tau_load: Array | None = None,
+    dwm: Array | None = None,
 ) -> Array:
     """Friction torque on the motor side.
 
@@ -153,6 +174,8 @@ def friction_torque(
     tau_load : array_like, shape like ``wm``, optional
         Torque the motor delivers to the load without friction, N m, motor side. Needed by
         ``power_flow`` only (UR5e eqs 12-13).
+    dwm : array_like, shape like ``wm``, optional
+        Motor acceleration, rad/s^2; with ``standstill`` it tells a stop from a reversal.
 
     Returns
     -------
@@ -162,6 +185,8 @@ def friction_torque(
     fn = FRICTION_MODELS[model][1]
     wm = np.asarray(wm, dtype=float)
     load = None if tau_load is None else np.asarray(tau_load, dtype=float)
+    if params.get("standstill", 0.0) > 0.0 and wm.ndim == 1:
+        return friction_columns(model, params, wm, load, dwm) @ linear_values(model, params)
     return fn(params, wm, load)
 
 
@@ -183,6 +208,7 @@ def friction_columns(
     params: Mapping[str, float],
     wm: Array,
     tau_load: Array | None = None,
+    dwm: Array | None = None,
 ) -> Array:
     """Regressor columns of a friction model: ``friction_torque == columns @ linear values``.
 
@@ -196,12 +222,47 @@ def friction_columns(
         Motor speed, rad/s.
     tau_load : array_like, shape (N,), optional
         Load torque (motor side), needed by ``power_flow``.
+    dwm : array_like, shape (N,), optional
+        Motor acceleration, rad/s^2 (for ``standstill``).
 
     Returns
     -------
     ndarray, shape (N, k)
     """
     wm = np.asarray(wm, dtype=float)
+    cols = _columns(model, params, wm, tau_load)
+    threshold = params.get("standstill", 0.0)
+    if threshold <= 0.0:
+        return cols
+    moving = np.abs(wm) >= threshold
+    if dwm is not None:
+        moving |= np.abs(np.asarray(dwm, dtype=float)) >= STILL_RATE * threshold
+    held = params.get("holding", 1.0) * hold_standstill(cols, moving)
+    return np.where(moving[:, None], cols, held)
+
+
+def hold_standstill(columns: Array, moving: NDArray[np.bool_]) -> Array:
+    """Rows where ``moving`` is False take the last moving row's values (zeros before the first).
+
+    columns : (N, k); moving : (N,) bool, in time order.
+    """
+    index = np.where(moving, np.arange(moving.size), -1)
+    np.maximum.accumulate(index, out=index)
+    padded = np.vstack([np.zeros((1, columns.shape[1])), columns])
+    return padded[index + 1]
+
+
+def linear_values(model: str, params: Mapping[str, float]) -> Array:
+    """The values of the model's :data:`LINEAR_PARAMETERS` (``motor_reducer``'s ``coulomb`` is the
+    sum of its motor and reducer levels)."""
+    if model == "motor_reducer":
+        return np.array(
+            [params["motor_viscous"], params["motor_coulomb"] + params["reducer_coulomb"]]
+        )
+    return np.array([params[name] for name in LINEAR_PARAMETERS[model]])
+
+
+def _columns(model: str, params: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
     p = params
     if model == "none":
         return np.zeros((wm.size, 0))

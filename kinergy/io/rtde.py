@@ -47,11 +47,14 @@ class Log:
         ``timestamp``, s.
     signals : dict of str to ndarray
         Vectors as (N, n) arrays under their RTDE name (``actual_q``), scalars as (N,) arrays.
+    notes : list of str
+        What reading changed (rows dropped by ``repair``), for the user to see.
     """
 
     path: str
     t: Array
     signals: dict[str, Array] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
 
     def __contains__(self, name: str) -> bool:
         return name in self.signals
@@ -136,7 +139,44 @@ def _first_line(path: Path) -> str:
         raise KinergyError(f"{path}: cannot read log ({exc.strerror})") from None
 
 
-def read_log(path: str | os.PathLike[str], *, columns: str | None = None) -> Log:
+def _good_rows(t: Array, finite: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Rows to keep when repairing: finite, and on one chain of increasing time stamps whose
+    steps stay under 50 median periods (garbage rows a recorder wrote fall off it)."""
+    idx = np.flatnonzero(finite)
+    keep = np.zeros(t.size, dtype=bool)
+    if idx.size < 2:
+        return keep
+    steps = np.diff(t[idx])
+    positive = steps[steps > 0]
+    if positive.size == 0:
+        return keep
+    limit = 50.0 * float(np.median(positive))
+    ok = (steps > 0) & (steps <= limit)
+    # start from the longest clean run, then walk forward and backward from it
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
+    starts, stops = edges[::2], edges[1::2]
+    if starts.size == 0:
+        keep[idx[0]] = True
+        return keep
+    k = int(np.argmax(stops - starts))
+    first, last = int(starts[k]), int(stops[k])  # rows idx[first..last] are one clean run
+    keep[idx[first : last + 1]] = True
+    t_last = t[idx[last]]
+    for i in idx[last + 1 :]:
+        if 0 < t[i] - t_last <= limit:
+            keep[i] = True
+            t_last = t[i]
+    t_first = t[idx[first]]
+    for i in idx[:first][::-1]:
+        if 0 < t_first - t[i] <= limit:
+            keep[i] = True
+            t_first = t[i]
+    return keep
+
+
+def read_log(
+    path: str | os.PathLike[str], *, columns: str | None = None, repair: bool = False
+) -> Log:
     """Read a controller log (record.py layout, or headerless with a column spec).
 
     Parameters
@@ -144,6 +184,9 @@ def read_log(path: str | os.PathLike[str], *, columns: str | None = None) -> Log
     path : path
     columns : str, optional
         Column spec of a headerless file (see the module docstring).
+    repair : bool
+        Drop malformed rows (cut short, non-numeric, time stamps out of order or far off) instead
+        of rejecting the file; the log's ``notes`` say how many and which lines.
 
     Returns
     -------
@@ -199,12 +242,21 @@ def read_log(path: str | os.PathLike[str], *, columns: str | None = None) -> Log
     frame.columns = names
     values = frame.apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
     bad = ~np.isfinite(values)
+    notes: list[str] = []
+    if repair:
+        keep = _good_rows(values[:, names.index("timestamp")], ~bad.any(axis=1))
+        if not keep.all():
+            lines = np.flatnonzero(~keep) + skip + 1
+            shown = ", ".join(str(x) for x in lines[:8]) + (" ..." if lines.size > 8 else "")
+            notes.append(f"{path}: dropped {lines.size} malformed row(s) at line(s) {shown}")
+        frame, values, bad = frame.iloc[keep], values[keep], bad[keep]
     if bad.any():
         row, col = np.argwhere(bad)[0]
         line = int(row) + skip + 1
         raw = frame.iat[int(row), int(col)]
         what = "missing value (truncated line?)" if raw == "" else f"not a finite number: {raw!r}"
-        raise KinergyError(f"{path}: line {line}, column {col + 1} ({names[col]}): {what}")
+        hint = "; the last line is cut short (--repair drops it)" if row == len(frame) - 1 else ""
+        raise KinergyError(f"{path}: line {line}, column {col + 1} ({names[col]}): {what}{hint}")
     t = values[:, names.index("timestamp")]
     if t.size < 2:
         raise KinergyError(f"{path}: needs at least 2 samples, has {t.size}")
@@ -222,7 +274,7 @@ def read_log(path: str | os.PathLike[str], *, columns: str | None = None) -> Log
         idx = [names.index(c) for c in cols]
         is_vector = not (len(cols) == 1 and cols[0] == name)
         signals[name] = values[:, idx] if is_vector else values[:, idx[0]]
-    return Log(str(path), t, signals)
+    return Log(str(path), t, signals, notes)
 
 
 def write_log(

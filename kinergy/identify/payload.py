@@ -1,0 +1,162 @@
+"""A payload's mass, centre of mass and (where the motion excites it) inertia, from a log taken
+with it and a model identified without it.
+
+The payload adds, at every joint, torques linear in its 10 inertial parameters expressed in the
+last link's frame (the last link's columns of the regressor, nursing eq 15). With the joint torque
+the motors deliver measured through the currents (``N^T k_t I``, UR5e eqs 10, 17), or taken from
+measured joint torques, the part the unloaded model does not explain is regressed on those
+columns by least squares in N m, all joints stacked:
+
+    N^T (k_t I) - tau_model(q, qd, qdd) = Y_n(q, qd, qdd) [m, m c, I_o]
+
+Mass and first moment are always estimated; the six inertia terms only when the log excites them
+well enough (relative standard deviation below :data:`MAX_INERTIA_SPREAD`); otherwise the payload
+is a point mass, as UR's own ``set_payload`` takes it.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kinergy.drives.electrics import drive_state, torque_constants
+from kinergy.drives.transmission import joint_torque
+from kinergy.dynamics.regressor import regressor
+from kinergy.errors import KinergyError
+from kinergy.identify.preprocess import IdentData
+from kinergy.model.robot import Payload, Robot
+
+__all__ = ["identify_payload"]
+
+Array = NDArray[np.float64]
+
+#: inertia terms are reported only when their relative standard deviation is below this
+MAX_INERTIA_SPREAD = 0.2
+
+
+def _solve(a: Array, b: Array) -> tuple[Array, Array, float]:
+    scale = np.linalg.norm(a, axis=0)
+    scale[scale == 0] = 1.0
+    x, _, _, sv = np.linalg.lstsq(a / scale, b, rcond=None)
+    x = x / scale
+    dof = max(a.shape[0] - a.shape[1], 1)
+    sigma2 = float(np.sum((b - a @ x) ** 2) / dof)
+    cov = sigma2 * np.linalg.pinv((a / scale).T @ (a / scale)) / np.outer(scale, scale)
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    return x, np.sqrt(np.clip(np.diag(cov), 0, None)), cond
+
+
+def identify_payload(
+    robot: Robot, datas: list[IdentData], *, signal: str = "auto"
+) -> tuple[Payload, dict[str, Any]]:
+    """Identify the payload at the flange.
+
+    Parameters
+    ----------
+    robot : Robot
+        The model identified without the payload (its own payload, if any, is ignored).
+    datas : list of IdentData
+        Logs taken with the payload.
+    signal : {"auto", "current", "torque", "moment"}
+        What measures the joint torques: motor currents (default when present), measured joint
+        torques, or ``target_moment`` (only if the controller was told about the payload).
+
+    Returns
+    -------
+    payload : Payload
+        Mass (kg), centre of mass in the flange frame (m) and inertia about it (kg m^2, zeros
+        when not excited).
+    report : dict
+        Values with standard deviations, the condition number, and notes.
+
+    Raises
+    ------
+    KinergyError
+        No usable signal, a negative mass, or a motion that does not excite the payload.
+    """
+    bare = robot.with_payload(None)
+    if signal == "auto":
+        if all(d.current is not None for d in datas):
+            signal = "current"
+        elif all(d.torque is not None for d in datas):
+            signal = "torque"
+        elif all(d.tau_ref is not None for d in datas):
+            signal = "moment"
+        else:
+            raise KinergyError(
+                "payload identification needs actual_current, measured torques or target_moment"
+            )
+    rows_a, rows_b = [], []
+    for d in datas:
+        if signal == "moment":
+            if d.tau_ref is None:
+                raise KinergyError(f"{d.path}: no target_moment")
+            predicted = drive_state(bare, d.q_cmd, d.qd_cmd, d.qdd_cmd).tau_sim
+            measured = d.tau_ref
+            y = regressor(bare, d.q_cmd, d.qd_cmd, d.qdd_cmd)
+        else:
+            state = drive_state(bare, d.q, d.qd, d.qdd)
+            predicted = joint_torque(bare, state.tau_m)
+            if signal == "current":
+                if d.current is None:
+                    raise KinergyError(f"{d.path}: no actual_current")
+                measured = joint_torque(bare, d.current * torque_constants(bare))
+            else:
+                if d.torque is None:
+                    raise KinergyError(f"{d.path}: no measured joint torques")
+                measured = d.torque
+            y = regressor(bare, d.q, d.qd, d.qdd)
+        n = robot.n
+        rows_a.append(y[:, :, 10 * (n - 1) :].reshape(-1, 10))
+        rows_b.append((measured - predicted).reshape(-1))
+    a, b = np.vstack(rows_a), np.concatenate(rows_b)
+    full, full_std, cond_full = _solve(a, b)
+    inertia_ok = bool(
+        np.all(full_std[4:] < MAX_INERTIA_SPREAD * np.maximum(np.abs(full[4:]), 1e-3))
+    )
+    if inertia_ok:
+        x, std, cond = full, full_std, cond_full
+    else:
+        x4, std4, cond = _solve(a[:, :4], b)
+        x, std = np.concatenate([x4, np.zeros(6)]), np.concatenate([std4, np.zeros(6)])
+    mass = float(x[0])
+    if mass <= 0 or std[0] > 0.5 * abs(mass):
+        raise KinergyError(
+            f"the logs do not show a payload: identified mass {mass:.3g} +- {std[0]:.2g} kg"
+        )
+    com_link = x[1:4] / mass
+    rot, pos = robot.flange[:3, :3], robot.flange[:3, 3]
+    com = rot.T @ (com_link - pos)
+    inertia6 = np.zeros(6)
+    notes = []
+    if inertia_ok:
+        # x[4:] = [Ixx, Ixy, Iyy, Ixz, Iyz, Izz] about the last link's origin; move to the CoM
+        io = np.array([[x[4], x[5], x[7]], [x[5], x[6], x[8]], [x[7], x[8], x[9]]])
+        ic = io - mass * (float(com_link @ com_link) * np.eye(3) - np.outer(com_link, com_link))
+        ic = rot.T @ ic @ rot
+        inertia6 = np.array([ic[0, 0], ic[1, 1], ic[2, 2], ic[0, 1], ic[1, 2], ic[0, 2]])
+        try:
+            payload = Payload(mass=mass, com=com, inertia=inertia6)
+        except KinergyError as exc:
+            notes.append(
+                f"identified inertia is not physical ({exc}); payload taken as a point mass"
+            )
+            inertia6 = np.zeros(6)
+            inertia_ok = False
+    else:
+        notes.append("the motion does not excite the payload's inertia enough: point mass")
+    payload = Payload(mass=mass, com=com, inertia=inertia6)
+    report = {
+        "signal": signal,
+        "mass": mass,
+        "mass_std": float(std[0]),
+        "com": com.tolist(),
+        "com_std": (std[1:4] / mass).tolist(),
+        "inertia": inertia6.tolist() if inertia_ok else None,
+        "condition": cond,
+        "samples": int(sum(len(d) for d in datas)),
+        "notes": notes,
+    }
+    return payload, report

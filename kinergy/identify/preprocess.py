@@ -1,0 +1,276 @@
+"""From a controller log to the signals identification uses.
+
+Real logs are not the model's equations: the measured motion trails the commanded one by a few
+milliseconds, encoder speeds and motor currents are noisy, logs sample irregularly and include
+samples where no program runs, and UR's logs carry no measured acceleration. This module decides
+which signal feeds which regression (UR5e doc sections 3-4):
+
+- ``target_moment`` is the controller's feed-forward on the *commanded* motion (UR5e eq 7), so the
+  rotor-inertia and link regressions against it use ``target_q/qd/qdd`` when the log has them;
+- ``actual_current`` is drawn by the *real* motion (eq 17). When the log has the commanded motion,
+  the real one is taken as the commanded motion delayed by the lag estimated from
+  ``target_qd`` against ``actual_qd`` (noise-free, and exact for a controller that tracks well);
+  otherwise the measured ``actual_q/qd`` with the speed low-pass filtered (zero phase, Butterworth)
+  and differentiated for the acceleration (nursing eq 24's filtering);
+- samples where the program does not run (``runtime_state`` != 2 or ``robot_mode`` != 7, when the
+  log has them) are dropped, and irregular time stamps are resampled to a uniform grid.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.interpolate import CubicSpline
+from scipy.signal import butter, sosfiltfilt
+
+from kinergy.errors import KinergyError
+from kinergy.io.rtde import Log
+
+__all__ = [
+    "IdentData",
+    "estimate_lag",
+    "lowpass",
+    "prepare",
+    "running",
+    "uniform",
+]
+
+Array = NDArray[np.float64]
+
+#: runtime_state PLAYING and robot_mode RUNNING in RTDE
+_PLAYING = 2
+_RUNNING = 7
+
+
+@dataclass(frozen=True, eq=False)
+class IdentData:
+    """One log, ready for identification. Arrays are (N, n) unless noted.
+
+    Attributes
+    ----------
+    path : str
+    t : ndarray, shape (N,)
+        Uniform time stamps, s.
+    q_cmd, qd_cmd, qdd_cmd :
+        The motion ``target_moment`` refers to (commanded; measured when the log has no target).
+    q, qd, qdd :
+        The real motion (commanded delayed by ``lag``, or the filtered measured motion).
+    tau_ref : ndarray or None
+        ``target_moment``, N m.
+    current : ndarray or None
+        ``actual_current``, A.
+    torque : ndarray or None
+        Measured joint torques, N m (arms with torque sensors).
+    lag : float
+        Estimated lag of the real motion behind the commanded one, s.
+    source : str
+        How the real motion was obtained: ``"delayed target"`` or ``"filtered actual"``.
+    """
+
+    path: str
+    t: Array
+    q_cmd: Array
+    qd_cmd: Array
+    qdd_cmd: Array
+    q: Array
+    qd: Array
+    qdd: Array
+    tau_ref: Array | None
+    current: Array | None
+    torque: Array | None
+    lag: float
+    source: str
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def dt(self) -> float:
+        return float(self.t[1] - self.t[0])
+
+    def sliced(self, start: int, stop: int) -> IdentData:
+        """Samples ``start:stop`` (for hold-out splits)."""
+
+        def cut(x: Array | None) -> Array | None:
+            return None if x is None else x[start:stop]
+
+        return IdentData(
+            self.path,
+            self.t[start:stop],
+            self.q_cmd[start:stop],
+            self.qd_cmd[start:stop],
+            self.qdd_cmd[start:stop],
+            self.q[start:stop],
+            self.qd[start:stop],
+            self.qdd[start:stop],
+            cut(self.tau_ref),
+            cut(self.current),
+            cut(self.torque),
+            self.lag,
+            self.source,
+        )
+
+
+def running(log: Log) -> Log:
+    """Keep the samples where a program runs (``runtime_state`` 2, ``robot_mode`` 7) when the
+    log has those columns; the log unchanged otherwise.
+
+    Raises
+    ------
+    KinergyError
+        No sample is left.
+    """
+    keep = np.ones(len(log), dtype=bool)
+    if "runtime_state" in log:
+        keep &= log["runtime_state"] == _PLAYING
+    if "robot_mode" in log:
+        keep &= log["robot_mode"] == _RUNNING
+    if keep.all():
+        return log
+    if not keep.any():
+        raise KinergyError(
+            f"{log.path}: no sample where the program runs (runtime_state 2, robot_mode 7)"
+        )
+    # keep the longest run of consecutive running samples: gaps would join unrelated motions
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], keep.astype(int), [0]])))
+    starts, stops = edges[::2], edges[1::2]
+    k = int(np.argmax(stops - starts))
+    sl = slice(starts[k], stops[k])
+    return Log(log.path, log.t[sl], {name: x[sl] for name, x in log.signals.items()})
+
+
+def uniform(log: Log, *, tolerance: float = 0.01) -> Log:
+    """Resample an irregularly sampled log to a uniform grid at its median period (linear
+    interpolation); a log whose periods are within ``tolerance`` of the median is returned as is."""
+    step = np.diff(log.t)
+    dt = float(np.median(step))
+    if np.max(np.abs(step - dt)) <= tolerance * dt:
+        return log
+    grid = log.t[0] + dt * np.arange(int(np.floor((log.t[-1] - log.t[0]) / dt + 1e-9)) + 1)
+    signals = {}
+    for name, x in log.signals.items():
+        if x.ndim == 1:
+            signals[name] = np.interp(grid, log.t, x)
+        else:
+            signals[name] = np.column_stack(
+                [np.interp(grid, log.t, x[:, k]) for k in range(x.shape[1])]
+            )
+    return Log(log.path, grid, signals)
+
+
+def lowpass(x: Array, fs: float, cutoff: float, order: int = 4) -> Array:
+    """Zero-phase Butterworth low-pass of ``x`` (N, ...) along time; ``cutoff`` Hz, ``fs`` Hz."""
+    if not 0.0 < cutoff < fs / 2.0:
+        raise KinergyError(
+            f"filter cutoff must be between 0 and {fs / 2:g} Hz (half of {fs:g} Hz), got {cutoff:g}"
+        )
+    sos = butter(order, cutoff / (fs / 2.0), output="sos")
+    padlen = min(3 * (2 * len(sos) + 1), x.shape[0] - 1)
+    return np.asarray(sosfiltfilt(sos, x, axis=0, padlen=padlen), dtype=float)
+
+
+def estimate_lag(t: Array, commanded: Array, measured: Array, *, max_lag: float = 0.05) -> float:
+    """Delay of ``measured`` behind ``commanded`` (both (N, n) speeds), s, by least squares over
+    sub-sample shifts up to ``max_lag`` (a coarse grid then a golden-section refinement)."""
+    dt = float(t[1] - t[0])
+    spline = CubicSpline(t, commanded, axis=0)
+    inner = (t > t[0] + max_lag) & (t < t[-1] - max_lag)
+    if inner.sum() < 10:
+        return 0.0
+
+    def cost(lag: float) -> float:
+        return float(np.sum((spline(t[inner] - lag) - measured[inner]) ** 2))
+
+    grid = np.arange(-2, int(np.ceil(max_lag / dt)) + 1) * dt
+    best = grid[int(np.argmin([cost(g) for g in grid]))]
+    lo, hi = best - dt, best + dt
+    ratio = (np.sqrt(5.0) - 1.0) / 2.0
+    for _ in range(40):
+        a, b = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
+        if cost(a) < cost(b):
+            hi = b
+        else:
+            lo = a
+    return float(0.5 * (lo + hi))
+
+
+def _delay(t: Array, x: Array, lag: float) -> Array:
+    """``x(t - lag)`` by cubic spline, held at ``x(t0)`` before the start."""
+    spline = CubicSpline(t, x, axis=0)
+    return np.asarray(spline(np.clip(t - lag, t[0], t[-1])), dtype=float)
+
+
+def prepare(
+    log: Log,
+    n_joints: int,
+    *,
+    cutoff: float | None = None,
+    torque: Array | None = None,
+) -> IdentData:
+    """Turn a log into :class:`IdentData` (see the module docstring).
+
+    Parameters
+    ----------
+    log : Log
+    n_joints : int
+        The robot's joint count, checked against the log.
+    cutoff : float, optional
+        Low-pass cutoff for measured speeds, Hz; default min(10 Hz, a fifth of the sample rate).
+    torque : ndarray, optional
+        Measured joint torques aligned with the log's samples (arms with torque sensors).
+
+    Raises
+    ------
+    KinergyError
+        No joint motion in the log; a joint count that does not match.
+    """
+    log = uniform(running(log))
+    t = log.t
+    fs = 1.0 / float(t[1] - t[0])
+    cutoff = min(10.0, fs / 5.0) if cutoff is None else cutoff
+    for name in ("target_q", "actual_q", "target_moment", "actual_current"):
+        if name in log and (log[name].ndim != 2 or log[name].shape[1] != n_joints):
+            width = 1 if log[name].ndim == 1 else log[name].shape[1]
+            raise KinergyError(
+                f"{log.path}: {name} has {width} joints but the robot has {n_joints}"
+            )
+    has_target = "target_q" in log and "target_qd" in log
+    has_actual = "actual_q" in log and "actual_qd" in log
+    if not (has_target or has_actual):
+        log.require("actual_q", "actual_qd", purpose="identification")
+    measured_q = log["actual_q"] if has_actual else None
+    if has_actual:
+        qd_f = lowpass(log["actual_qd"], fs, cutoff)
+        qdd_f = np.gradient(qd_f, t, axis=0)
+    if has_target:
+        q_cmd, qd_cmd = log["target_q"], log["target_qd"]
+        qdd_cmd = log["target_qdd"] if "target_qdd" in log else np.gradient(qd_cmd, t, axis=0)
+        lag = estimate_lag(t, qd_cmd, log["actual_qd"]) if has_actual else 0.0
+        q, qd, qdd = (_delay(t, x, lag) for x in (q_cmd, qd_cmd, qdd_cmd))
+        source = "delayed target"
+    else:
+        assert measured_q is not None
+        q_cmd, qd_cmd, qdd_cmd = measured_q, qd_f, qdd_f
+        q, qd, qdd, lag = measured_q, qd_f, qdd_f, 0.0
+        source = "filtered actual"
+    if torque is not None and torque.shape != q.shape:
+        raise KinergyError(
+            f"{log.path}: measured torques have shape {torque.shape}, expected {q.shape}"
+        )
+    return IdentData(
+        path=log.path,
+        t=t,
+        q_cmd=np.asarray(q_cmd, dtype=float),
+        qd_cmd=np.asarray(qd_cmd, dtype=float),
+        qdd_cmd=np.asarray(qdd_cmd, dtype=float),
+        q=np.asarray(q, dtype=float),
+        qd=np.asarray(qd, dtype=float),
+        qdd=np.asarray(qdd, dtype=float),
+        tau_ref=log["target_moment"] if "target_moment" in log else None,
+        current=log["actual_current"] if "actual_current" in log else None,
+        torque=torque,
+        lag=lag,
+        source=source,
+    )

@@ -1,0 +1,369 @@
+"""The UR5e doc's sequential identification (sections 3-4).
+
+1. Link data are taken from the robot model (UR's published masses and centres of mass; the
+   inertia tensors barely matter behind a 100:1 gear, UR5e section 3.1).
+2. Rotor inertia ``J_m + J_r`` of every drive from the controller's reference torque: the part of
+   ``target_moment`` the links do not explain is the reflected rotor inertia times the
+   acceleration (eqs 7-9), solved by least squares. (For coupled joints the reflection goes
+   through the coupling matrix; the same least squares holds.)
+3. Torque constant and friction of every motor together from the measured current (eqs 17-18):
+   the current is linear in ``1/k_t`` (times the load torque from step 2's model) and in the
+   friction parameters over ``k_t``. Any friction model linear in its parameters can be used
+   (:data:`kinergy.drives.friction.LINEAR_PARAMETERS`); the UR5e doc's is ``power_flow``.
+4. Motor inertia = rotor inertia - the model's reducer inertia (Table IV).
+
+Real controllers add one thing the seed does not model: a joint that stops stays in stiction,
+and its current keeps part of the friction of the direction it stopped in. With ``hold="auto"``
+each joint's fit is made holding 0, 25, 50, 75 and 100 % of its friction through standstill (the
+``standstill`` and ``holding`` friction parameters) and keeps the best.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kinergy.drives.friction import (
+    LINEAR_PARAMETERS,
+    friction_columns,
+    with_linear_parameters,
+)
+from kinergy.drives.transmission import transmission_matrix
+from kinergy.dynamics.rnea import rnea
+from kinergy.errors import KinergyError
+from kinergy.identify.preprocess import IdentData
+from kinergy.identify.result import IdentificationResult, validation_metrics
+from kinergy.model.robot import Friction, Robot, Source
+
+__all__ = ["identify_sequential", "rotor_inertias"]
+
+Array = NDArray[np.float64]
+
+#: joint speed below which a joint counts as still, rad/s
+STILL_SPEED = 0.005
+#: a regression whose column-scaled condition number exceeds this cannot be trusted
+MAX_CONDITION = 1e8
+#: fractions of the friction a stopped joint is tried with (0: none, the seed's model)
+HOLDINGS = (0.0, 0.25, 0.5, 0.75, 1.0)
+#: a holding fraction is kept only if it cuts the squared current error by this share
+MIN_GAIN = 0.005
+#: relative standard deviation of 1/k_t above which the torque constant counts as unidentified
+MAX_KT_SPREAD = 0.1
+
+
+def _stack(datas: Sequence[IdentData], name: str) -> Array:
+    return np.vstack([getattr(d, name) for d in datas])
+
+
+def _lstsq(a: Array, y: Array) -> tuple[Array, Array, float]:
+    """Least squares with column scaling: solution, standard deviations, condition number."""
+    scale = np.linalg.norm(a, axis=0)
+    scale[scale == 0.0] = 1.0
+    sol, _, _, sv = np.linalg.lstsq(a / scale, y, rcond=None)
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    x = sol / scale
+    dof = max(a.shape[0] - a.shape[1], 1)
+    sigma2 = float(np.sum((y - a @ x) ** 2) / dof)
+    try:
+        cov = sigma2 * np.linalg.inv((a / scale).T @ (a / scale)) / np.outer(scale, scale)
+        std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    except np.linalg.LinAlgError:
+        std = np.full(a.shape[1], np.inf)
+    return x, std, cond
+
+
+def rotor_inertias(robot: Robot, datas: Sequence[IdentData]) -> tuple[Array, Array, float]:
+    """Step 2: ``J_m + J_r`` per motor from ``target_moment`` (UR5e eqs 7-9).
+
+    ``tau_ref - f_link = N^T diag(J) N qdd`` with ``N`` the transmission matrix, linear in J.
+
+    Returns
+    -------
+    inertia, std : ndarray, shape (n,)
+        kg m^2 (motor side) and its standard deviation.
+    condition : float
+    """
+    q, qd, qdd = _stack(datas, "q_cmd"), _stack(datas, "qd_cmd"), _stack(datas, "qdd_cmd")
+    tau_ref = _stack(datas, "tau_ref")
+    f_link = rnea(robot, q, qd, qdd)
+    n_mat = transmission_matrix(robot)
+    motor_acc = qdd @ n_mat.T  # (N, n): N qdd
+    # column m: contribution of J_m to every joint torque, n_mat[m, j] * (N qdd)_m
+    cols = n_mat[None, :, :] * motor_acc[:, :, None]  # (N, m, j)
+    a = np.transpose(cols, (0, 2, 1)).reshape(-1, robot.n)  # rows (sample, joint), columns m
+    y = (tau_ref - f_link).reshape(-1)
+    inertia, std, cond = _lstsq(a, y)
+    return inertia, std, cond
+
+
+def _diagnose_motion(robot: Robot, datas: Sequence[IdentData]) -> None:
+    """One line naming every joint the logs cannot identify, and why."""
+    qd = _stack(datas, "qd")
+    samples = qd.shape[0]
+    problems = []
+    if samples < 50:
+        problems.append(f"only {samples} samples (need at least 50)")
+    for j, joint in enumerate(robot.joints):
+        speed = np.abs(qd[:, j])
+        if speed.max() < 10 * STILL_SPEED:
+            problems.append(
+                f"joint {j + 1} ({joint.name}) never moves (max |qd| {speed.max():.3g} rad/s): "
+                "no rotor inertia, torque constant or friction can be identified"
+            )
+        elif (qd[:, j] > STILL_SPEED).sum() < 10 or (qd[:, j] < -STILL_SPEED).sum() < 10:
+            problems.append(
+                f"joint {j + 1} ({joint.name}) never reverses: Coulomb friction in one direction "
+                "and the torque constant cannot be separated"
+            )
+    if problems:
+        raise KinergyError("cannot identify from these logs: " + "; ".join(problems))
+
+
+def _current_fit(
+    model: str,
+    params: dict[str, float],
+    tau_load: Array,
+    wm: Array,
+    dwm: Array,
+    current: Array,
+    kt_prior: float,
+) -> tuple[Array, Array, float, float, bool]:
+    """Eq 18 for one motor: ``I = [tau_load, friction columns] @ [1/k_t, values/k_t]``.
+
+    When the load torque is too small against the friction and noise to pin ``1/k_t`` down
+    (relative standard deviation above :data:`MAX_KT_SPREAD`, or a non-positive estimate), ``k_t``
+    is fixed at ``kt_prior`` and only the friction is fitted; the last value returned says so.
+    """
+    cols = friction_columns(model, params, wm, tau_load, dwm)
+    a = np.column_stack([tau_load, cols])
+    x, std, cond = _lstsq(a, current)
+    fixed = not (x[0] > 0 and std[0] < MAX_KT_SPREAD * x[0])
+    if fixed:
+        rest, rest_std, cond = _lstsq(cols, current - tau_load / kt_prior)
+        x = np.concatenate([[1.0 / kt_prior], rest])
+        std = np.concatenate([[0.0], rest_std])
+        a_used = a
+    else:
+        a_used = a
+    sse = float(np.sum((current - a_used @ x) ** 2))
+    return x, std, cond, sse, fixed
+
+
+def identify_sequential(
+    robot: Robot,
+    datas: Sequence[IdentData],
+    *,
+    friction: str | None = None,
+    hold: str | bool = "auto",
+) -> IdentificationResult:
+    """Identify rotor inertias, torque constants and friction with the UR5e doc's procedure.
+
+    Parameters
+    ----------
+    robot : Robot
+        The starting model: its link data are kept.
+    datas : sequence of IdentData
+        Prepared logs (:func:`kinergy.identify.preprocess.prepare`). Rotor inertias need
+        ``target_moment``; torque constants and friction need ``actual_current``.
+    friction : str, optional
+        Friction model for every joint (default: each joint's model in ``robot``); it must be
+        linear in its parameters (all of kinergy's are, given their shape parameters).
+    hold : {"auto", True, False}
+        Hold friction through standstill (see the module docstring); ``auto`` keeps whichever
+        fits the currents better.
+
+    Returns
+    -------
+    IdentificationResult
+
+    Raises
+    ------
+    KinergyError
+        Logs that cannot identify a parameter (a joint that never moves or never reverses, too few
+        samples, a singular regression), naming the joints.
+    """
+    if not datas:
+        raise KinergyError("no log to identify from")
+    _diagnose_motion(robot, datas)
+    warnings: list[str] = []
+    n = robot.n
+    has_ref = all(d.tau_ref is not None for d in datas)
+    has_current = all(d.current is not None for d in datas)
+    if not (has_ref or has_current):
+        raise KinergyError(
+            "identification needs target_moment (rotor inertia) or actual_current (torque "
+            "constant and friction); the logs have neither"
+        )
+    fit: dict[str, Any] = {
+        "samples": int(sum(len(d) for d in datas)),
+        "logs": [d.path for d in datas],
+    }
+    fit["lag"] = [d.lag for d in datas]
+    rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
+    rotor_std = np.full(n, np.nan)
+    if has_ref:
+        rotor, rotor_std, cond = rotor_inertias(robot, datas)
+        fit["condition_rotor_inertia"] = cond
+        if cond > MAX_CONDITION:
+            raise KinergyError(
+                f"rotor inertia regression is singular (condition {cond:.3g}): too little acceleration"
+            )
+    else:
+        warnings.append("the logs have no target_moment: rotor inertias kept from the model")
+    for j, joint in enumerate(robot.joints):
+        if rotor[j] <= 0:
+            warnings.append(
+                f"joint {j + 1} ({joint.name}): identified rotor inertia {rotor[j]:.3g} kg m^2 is not positive"
+            )
+    joints = [
+        dataclasses.replace(
+            joint,
+            drive=dataclasses.replace(
+                joint.drive,
+                motor_inertia=max(float(rotor[j]) - joint.drive.reducer_inertia, 0.0),
+            ),
+        )
+        for j, joint in enumerate(robot.joints)
+    ]
+    for j, joint in enumerate(robot.joints):
+        if rotor[j] < joint.drive.reducer_inertia:
+            warnings.append(
+                f"joint {j + 1} ({joint.name}): rotor inertia {rotor[j]:.3g} is below the model's "
+                f"reducer inertia {joint.drive.reducer_inertia:.3g}; motor inertia set to 0"
+            )
+    staged = robot.with_joints(joints)
+    per_joint: list[dict[str, Any]] = []
+    if has_current:
+        q, qd, qdd = _stack(datas, "q"), _stack(datas, "qd"), _stack(datas, "qdd")
+        current = _stack(datas, "current")
+        n_mat = transmission_matrix(staged)
+        tau_sim = rnea(staged, q, qd, qdd) + qdd @ (n_mat.T @ (rotor[:, None] * n_mat)).T
+        tau_load = np.asarray(np.linalg.solve(n_mat.T, tau_sim.T).T, dtype=float)
+        wm = qd @ n_mat.T
+        dwm = qdd @ n_mat.T
+        ratios = np.abs(np.array([j.drive.gear_ratio for j in staged.joints]))
+        holdings = HOLDINGS if hold == "auto" else ((1.0,) if hold else (0.0,))
+        chosen = []
+        for m, joint in enumerate(staged.joints):
+            model = friction or joint.drive.friction.model
+            best: tuple[float, Any] | None = None
+            for holding in holdings:
+                params = _start_params(model, joint.drive.friction)
+                params.pop("standstill", None)
+                params.pop("holding", None)
+                if holding > 0.0:
+                    params["standstill"] = STILL_SPEED * ratios[m]
+                    params["holding"] = holding
+                x, std, cond, sse, fixed = _current_fit(
+                    model,
+                    params,
+                    tau_load[:, m],
+                    wm[:, m],
+                    dwm[:, m],
+                    current[:, m],
+                    joint.drive.torque_constant,
+                )
+                if best is None or sse < best[0] * (1.0 - MIN_GAIN):
+                    best = (sse, (model, params, x, std, cond, fixed))
+            assert best is not None
+            chosen.append(best[1])
+        fit["friction_holding"] = [float(c[1].get("holding", 0.0)) for c in chosen]
+        new_joints = []
+        for m, (model, params, x, std, cond, fixed) in enumerate(chosen):
+            joint = staged.joints[m]
+            if fixed:
+                warnings.append(
+                    f"joint {m + 1} ({joint.name}): the logs do not pin the torque constant down "
+                    "(too little load torque against friction and noise); kept the model's "
+                    f"{joint.drive.torque_constant:.4g} N m/A"
+                )
+            if cond > MAX_CONDITION:
+                raise KinergyError(
+                    f"joint {m + 1} ({joint.name}): the current regression is singular (condition "
+                    f"{cond:.3g}): the log does not excite every friction term of model {model!r}"
+                )
+            kt = 1.0 / x[0]
+            values = x[1:] * kt
+            kt_std = std[0] / x[0] ** 2
+            value_std = np.sqrt((std[1:] * kt) ** 2 + (x[1:] * kt_std * kt) ** 2)
+            new_params = with_linear_parameters(model, params, values)
+            for name, value in zip(LINEAR_PARAMETERS[model], values, strict=True):
+                if value < 0 and name not in ("gamma1",):
+                    warnings.append(
+                        f"joint {m + 1} ({joint.name}): friction {name} = {value:.3g} is negative"
+                    )
+            new_joints.append(
+                dataclasses.replace(
+                    joint,
+                    drive=dataclasses.replace(
+                        joint.drive, torque_constant=float(kt), friction=Friction(model, new_params)
+                    ),
+                )
+            )
+            per_joint.append(
+                {
+                    "torque_constant_std": float(kt_std),
+                    "friction_std": {
+                        name: float(s)
+                        for name, s in zip(LINEAR_PARAMETERS[model], value_std, strict=True)
+                    },
+                    "condition_current": cond,
+                }
+            )
+        staged = staged.with_joints(new_joints)
+    else:
+        warnings.append(
+            "the logs have no actual_current: torque constants and friction kept from the model"
+        )
+        per_joint = [{} for _ in range(n)]
+    sources = dict(staged.sources)
+    if has_ref:
+        sources["drive_inertia"] = Source(
+            "identified", "kinergy identify (sequential, UR5e eqs 7-9)"
+        )
+    if has_current:
+        sources["torque_constant"] = Source(
+            "identified", "kinergy identify (sequential, UR5e eqs 17-18)"
+        )
+        sources["friction"] = Source("identified", "kinergy identify (sequential, UR5e eqs 17-18)")
+    identified = dataclasses.replace(staged, sources=sources)
+    joints_out = []
+    for j, joint in enumerate(identified.joints):
+        entry = {
+            "name": joint.name,
+            "rotor_inertia": float(joint.drive.motor_inertia + joint.drive.reducer_inertia)
+            if rotor[j] >= joint.drive.reducer_inertia
+            else float(rotor[j]),
+            "rotor_inertia_std": None if np.isnan(rotor_std[j]) else float(rotor_std[j]),
+            "motor_inertia": joint.drive.motor_inertia,
+            "torque_constant": joint.drive.torque_constant,
+            "friction": {"model": joint.drive.friction.model, **joint.drive.friction.params},
+        }
+        entry.update(per_joint[j])
+        joints_out.append(entry)
+    fit.update(validation_metrics(identified, list(datas)))
+    fit["warnings"] = warnings
+    return IdentificationResult(identified, "sequential", joints_out, fit)
+
+
+def _start_params(model: str, current: Friction) -> dict[str, float]:
+    """Parameters to build the friction columns with: the joint's own when the model is the same,
+    else defaults for the shape parameters (smoothing 1e-3 rad/s, Makkar's and Stribeck's rates)."""
+    if current.model == model:
+        return dict(current.params)
+    defaults = {
+        "smoothing": 1e-3,
+        "gamma2": 50.0,
+        "gamma3": 5.0,
+        "gamma5": 100.0,
+        "stribeck_speed": 10.0,
+        "motor_coulomb": 0.5,
+        "reducer_coulomb": 0.5,
+    }
+    from kinergy.drives.friction import FRICTION_MODELS
+
+    return {name: defaults.get(name, 0.0) for name in FRICTION_MODELS[model][0]}
