@@ -88,6 +88,41 @@ def identify_payload(
             raise KinergyError(
                 "payload identification needs actual_current, measured torques or target_moment"
             )
+    guess: Robot = bare
+    x = np.zeros(10)
+    # the payload moves the friction's power-flow direction (UR5e eqs 12-13): iterate to a fixed point
+    for _ in range(30):
+        a, b = _residuals(bare, guess, datas, signal)
+        x_new, std, cond = _solve(a[:, :4], b)
+        change = float(np.max(np.abs(x_new - x[:4])))
+        x[:4] = x_new
+        guess = bare.with_payload(Payload(mass=max(float(x[0]), 1e-6), com=_com(robot, x)))
+        if change < 1e-9 * max(abs(float(x[0])), 1.0):
+            break
+    full, full_std, cond_full = _solve(a, b)
+    inertia_ok = bool(
+        np.all(full_std[4:] < MAX_INERTIA_SPREAD * np.maximum(np.abs(full[4:]), 1e-3))
+    )
+    if inertia_ok:
+        x, std, cond = full, full_std, cond_full
+    else:
+        x = np.concatenate([x[:4], np.zeros(6)])
+        std = np.concatenate([std, np.zeros(6)])
+    return _finish(robot, x, std, cond, inertia_ok, signal, datas)
+
+
+def _com(robot: Robot, x: Array) -> Array:
+    """Centre of mass in the flange frame from ``[m, m c]`` in the last link frame."""
+    rot, pos = robot.flange[:3, :3], robot.flange[:3, 3]
+    return np.asarray(rot.T @ (x[1:4] / max(float(x[0]), 1e-12) - pos), dtype=float)
+
+
+def _residuals(
+    bare: Robot, guess: Robot, datas: list[IdentData], signal: str
+) -> tuple[Array, Array]:
+    """Stacked payload regressor (rows: samples x joints, 10 columns) and the torque the bare
+    model leaves unexplained, with friction evaluated on the loaded ``guess``."""
+    n = bare.n
     rows_a, rows_b = [], []
     for d in datas:
         if signal == "moment":
@@ -98,7 +133,8 @@ def identify_payload(
             y = regressor(bare, d.q_cmd, d.qd_cmd, d.qdd_cmd)
         else:
             state = drive_state(bare, d.q, d.qd, d.qdd)
-            predicted = joint_torque(bare, state.tau_m)
+            loaded = drive_state(guess, d.q, d.qd, d.qdd)
+            predicted = joint_torque(bare, state.tau_load + loaded.tau_friction)
             if signal == "current":
                 if d.current is None:
                     raise KinergyError(f"{d.path}: no actual_current")
@@ -108,19 +144,20 @@ def identify_payload(
                     raise KinergyError(f"{d.path}: no measured joint torques")
                 measured = d.torque
             y = regressor(bare, d.q, d.qd, d.qdd)
-        n = robot.n
         rows_a.append(y[:, :, 10 * (n - 1) :].reshape(-1, 10))
         rows_b.append((measured - predicted).reshape(-1))
-    a, b = np.vstack(rows_a), np.concatenate(rows_b)
-    full, full_std, cond_full = _solve(a, b)
-    inertia_ok = bool(
-        np.all(full_std[4:] < MAX_INERTIA_SPREAD * np.maximum(np.abs(full[4:]), 1e-3))
-    )
-    if inertia_ok:
-        x, std, cond = full, full_std, cond_full
-    else:
-        x4, std4, cond = _solve(a[:, :4], b)
-        x, std = np.concatenate([x4, np.zeros(6)]), np.concatenate([std4, np.zeros(6)])
+    return np.vstack(rows_a), np.concatenate(rows_b)
+
+
+def _finish(
+    robot: Robot,
+    x: Array,
+    std: Array,
+    cond: float,
+    inertia_ok: bool,
+    signal: str,
+    datas: list[IdentData],
+) -> tuple[Payload, dict[str, Any]]:
     mass = float(x[0])
     if mass <= 0 or std[0] > 0.5 * abs(mass):
         raise KinergyError(

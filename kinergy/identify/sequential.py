@@ -76,7 +76,9 @@ def _lstsq(a: Array, y: Array) -> tuple[Array, Array, float]:
     return x, std, cond
 
 
-def rotor_inertias(robot: Robot, datas: Sequence[IdentData]) -> tuple[Array, Array, float]:
+def rotor_inertias(
+    robot: Robot, datas: Sequence[IdentData], active: Sequence[int] | None = None
+) -> tuple[Array, Array, float]:
     """Step 2: ``J_m + J_r`` per motor from ``target_moment`` (UR5e eqs 7-9).
 
     ``tau_ref - f_link = N^T diag(J) N qdd`` with ``N`` the transmission matrix, linear in J.
@@ -84,9 +86,11 @@ def rotor_inertias(robot: Robot, datas: Sequence[IdentData]) -> tuple[Array, Arr
     Returns
     -------
     inertia, std : ndarray, shape (n,)
-        kg m^2 (motor side) and its standard deviation.
+        kg m^2 (motor side) and its standard deviation; motors not in ``active`` (default all)
+        keep the model's value and a NaN deviation.
     condition : float
     """
+    active = list(range(robot.n)) if active is None else list(active)
     q, qd, qdd = _stack(datas, "q_cmd"), _stack(datas, "qd_cmd"), _stack(datas, "qdd_cmd")
     tau_ref = _stack(datas, "tau_ref")
     f_link = rnea(robot, q, qd, qdd)
@@ -95,32 +99,43 @@ def rotor_inertias(robot: Robot, datas: Sequence[IdentData]) -> tuple[Array, Arr
     # column m: contribution of J_m to every joint torque, n_mat[m, j] * (N qdd)_m
     cols = n_mat[None, :, :] * motor_acc[:, :, None]  # (N, m, j)
     a = np.transpose(cols, (0, 2, 1)).reshape(-1, robot.n)  # rows (sample, joint), columns m
-    y = (tau_ref - f_link).reshape(-1)
-    inertia, std, cond = _lstsq(a, y)
+    fixed = [m for m in range(robot.n) if m not in active]
+    known = np.array([j.drive.rotor_inertia for j in robot.joints])
+    y = (tau_ref - f_link).reshape(-1) - a[:, fixed] @ known[fixed]
+    sol, sol_std, cond = _lstsq(a[:, active], y)
+    inertia, std = known.copy(), np.full(robot.n, np.nan)
+    inertia[active], std[active] = sol, sol_std
     return inertia, std, cond
 
 
-def _diagnose_motion(robot: Robot, datas: Sequence[IdentData]) -> None:
-    """One line naming every joint the logs cannot identify, and why."""
+def _diagnose_motion(robot: Robot, datas: Sequence[IdentData]) -> dict[int, str]:
+    """What the logs cannot identify, per joint (index -> reason).
+
+    Raises
+    ------
+    KinergyError
+        Too few samples, or no joint identifiable: one line naming every joint and why.
+    """
     qd = _stack(datas, "qd")
     samples = qd.shape[0]
-    problems = []
     if samples < 50:
-        problems.append(f"only {samples} samples (need at least 50)")
+        raise KinergyError(f"cannot identify from these logs: only {samples} samples (need at least 50)")
+    problems: dict[int, str] = {}
     for j, joint in enumerate(robot.joints):
         speed = np.abs(qd[:, j])
         if speed.max() < 10 * STILL_SPEED:
-            problems.append(
+            problems[j] = (
                 f"joint {j + 1} ({joint.name}) never moves (max |qd| {speed.max():.3g} rad/s): "
-                "no rotor inertia, torque constant or friction can be identified"
+                "its rotor inertia, torque constant and friction cannot be identified"
             )
         elif (qd[:, j] > STILL_SPEED).sum() < 10 or (qd[:, j] < -STILL_SPEED).sum() < 10:
-            problems.append(
+            problems[j] = (
                 f"joint {j + 1} ({joint.name}) never reverses: Coulomb friction in one direction "
                 "and the torque constant cannot be separated"
             )
-    if problems:
-        raise KinergyError("cannot identify from these logs: " + "; ".join(problems))
+    if len(problems) == robot.n:
+        raise KinergyError("cannot identify from these logs: " + "; ".join(problems.values()))
+    return problems
 
 
 def _current_fit(
@@ -188,11 +203,13 @@ def identify_sequential(
     """
     if not datas:
         raise KinergyError("no log to identify from")
-    _diagnose_motion(robot, datas)
-    warnings: list[str] = []
+    problems = _diagnose_motion(robot, datas)
+    active = [j for j in range(robot.n) if j not in problems]
+    warnings: list[str] = [f"{text}; kept the model's values" for text in problems.values()]
     n = robot.n
-    has_ref = all(d.tau_ref is not None for d in datas)
-    has_current = all(d.current is not None for d in datas)
+    ref_logs = [d for d in datas if d.tau_ref is not None]
+    current_logs = [d for d in datas if d.current is not None]
+    has_ref, has_current = bool(ref_logs), bool(current_logs)
     if not (has_ref or has_current):
         raise KinergyError(
             "identification needs target_moment (rotor inertia) or actual_current (torque "
@@ -206,7 +223,7 @@ def identify_sequential(
     rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
     rotor_std = np.full(n, np.nan)
     if has_ref:
-        rotor, rotor_std, cond = rotor_inertias(robot, datas)
+        rotor, rotor_std, cond = rotor_inertias(robot, ref_logs, active)
         fit["condition_rotor_inertia"] = cond
         if cond > MAX_CONDITION:
             raise KinergyError(
@@ -238,8 +255,8 @@ def identify_sequential(
     staged = robot.with_joints(joints)
     per_joint: list[dict[str, Any]] = []
     if has_current:
-        q, qd, qdd = _stack(datas, "q"), _stack(datas, "qd"), _stack(datas, "qdd")
-        current = _stack(datas, "current")
+        q, qd, qdd = _stack(current_logs, "q"), _stack(current_logs, "qd"), _stack(current_logs, "qdd")
+        current = _stack(current_logs, "current")
         n_mat = transmission_matrix(staged)
         tau_sim = rnea(staged, q, qd, qdd) + qdd @ (n_mat.T @ (rotor[:, None] * n_mat)).T
         tau_load = np.asarray(np.linalg.solve(n_mat.T, tau_sim.T).T, dtype=float)
@@ -247,8 +264,11 @@ def identify_sequential(
         dwm = qdd @ n_mat.T
         ratios = np.abs(np.array([j.drive.gear_ratio for j in staged.joints]))
         holdings = HOLDINGS if hold == "auto" else ((1.0,) if hold else (0.0,))
-        chosen = []
+        chosen: list[Any] = []
         for m, joint in enumerate(staged.joints):
+            if m in problems:
+                chosen.append(None)
+                continue
             model = friction or joint.drive.friction.model
             best: tuple[float, Any] | None = None
             for holding in holdings:
@@ -271,10 +291,17 @@ def identify_sequential(
                     best = (sse, (model, params, x, std, cond, fixed))
             assert best is not None
             chosen.append(best[1])
-        fit["friction_holding"] = [float(c[1].get("holding", 0.0)) for c in chosen]
+        fit["friction_holding"] = [
+            None if c is None else float(c[1].get("holding", 0.0)) for c in chosen
+        ]
         new_joints = []
-        for m, (model, params, x, std, cond, fixed) in enumerate(chosen):
+        for m, choice in enumerate(chosen):
             joint = staged.joints[m]
+            if choice is None:
+                new_joints.append(joint)
+                per_joint.append({})
+                continue
+            model, params, x, std, cond, fixed = choice
             if fixed:
                 warnings.append(
                     f"joint {m + 1} ({joint.name}): the logs do not pin the torque constant down "
@@ -344,6 +371,9 @@ def identify_sequential(
             "friction": {"model": joint.drive.friction.model, **joint.drive.friction.params},
         }
         entry.update(per_joint[j])
+        entry["identified"] = j not in problems
+        if j in problems:
+            entry["problem"] = problems[j]
         joints_out.append(entry)
     fit.update(validation_metrics(identified, list(datas)))
     fit["warnings"] = warnings

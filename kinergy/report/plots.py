@@ -1,0 +1,598 @@
+"""Figures of a model's accuracy and of the energy a motion draws: plain functions over arrays.
+
+Each function takes numpy arrays (plus names and units) and returns a :class:`matplotlib.figure.Figure`
+drawn on the non-interactive Agg canvas; nothing touches pyplot's global state, so the figures are
+safe to build in scripts, servers and tests and are freed like any other object. :func:`save`
+writes one as a PNG atomically.
+
+==========================  ==================================================================
+:func:`time_series`         measured vs predicted per joint over time, R² in each title
+                            (UR5e Figs 8-9 for torques, Figs 11-12 for currents)
+:func:`error_boxplot`       box plots of the errors per joint, one panel per data set
+                            (UR5e Figs 10 and 13)
+:func:`power_energy`        electrical power and cumulative energy per joint (UR5e Figs 14-15)
+:func:`energy_breakdown`    cumulative energy of the inertial, gravity, friction and copper parts
+                            and their total (framework Fig. 4)
+:func:`pareto`              energy against cycle time, the Pareto front and named motions
+==========================  ==================================================================
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import tempfile
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from numpy.typing import ArrayLike, NDArray
+from scipy.integrate import cumulative_trapezoid
+
+from kinergy.errors import KinergyError
+from kinergy.identify.metrics import r_squared
+
+__all__ = [
+    "DPI",
+    "energy_breakdown",
+    "error_boxplot",
+    "pareto",
+    "power_energy",
+    "save",
+    "time_series",
+]
+
+Array = NDArray[np.float64]
+
+DPI = 110
+"""Resolution :func:`save` writes at, dots per inch: a 11 x 8 in figure is 1210 x 880 px."""
+
+# Font sizes, points. Set on every artist rather than through rcParams, which are global.
+_TITLE = 11
+_SUPTITLE = 13
+_LABEL = 10
+_TICK = 9
+_LEGEND = 9
+
+_MEASURED: dict[str, Any] = {"color": "tab:green", "linewidth": 1.6, "alpha": 0.85}
+_PREDICTED: dict[str, Any] = {"color": "tab:orange", "linewidth": 1.0, "linestyle": "--"}
+
+# Colours of the energy parts, so a part has the same colour in every figure.
+_PART_COLOURS = {
+    "inertial": "tab:blue",
+    "gravity": "tab:green",
+    "friction": "tab:red",
+    "copper": "tab:orange",
+}
+
+
+# -- validation at the boundary -----------------------------------------------------------------
+
+
+def _vector(x: ArrayLike, name: str) -> Array:
+    """``x`` as a finite float vector, shape (N,)."""
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise KinergyError(f"{name}: not an array of numbers ({exc})") from None
+    if a.ndim != 1:
+        raise KinergyError(f"{name}: expected shape (N,), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise KinergyError(f"{name}: contains NaN or infinite values")
+    return a
+
+
+def _time(t: ArrayLike) -> Array:
+    """Time stamps, s, shape (N,) with N >= 2 and strictly increasing."""
+    ts = _vector(t, "t")
+    if ts.size < 2:
+        raise KinergyError(f"t: need at least 2 samples, got {ts.size}")
+    if np.any(np.diff(ts) <= 0):
+        i = int(np.argmax(np.diff(ts) <= 0))
+        raise KinergyError(
+            f"t: time stamps must increase strictly (sample {i + 1}: {ts[i + 1]:g} s)"
+        )
+    return ts
+
+
+def _matrix(x: ArrayLike, name: str, rows: int | None, cols: int) -> Array:
+    """``x`` as a finite float array of shape (rows, cols); a vector counts as one column."""
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise KinergyError(f"{name}: not an array of numbers ({exc})") from None
+    if a.ndim == 1 and cols == 1:
+        a = a[:, None]
+    expected = f"({rows if rows is not None else 'N'}, {cols})"
+    if a.ndim != 2 or a.shape[1] != cols or (rows is not None and a.shape[0] != rows):
+        raise KinergyError(f"{name}: expected shape {expected}, got {a.shape}")
+    if a.shape[0] == 0:
+        raise KinergyError(f"{name}: no samples")
+    if not np.all(np.isfinite(a)):
+        raise KinergyError(f"{name}: contains NaN or infinite values")
+    return a
+
+
+def _names(joint_names: Sequence[str]) -> list[str]:
+    """The joint names as a non-empty list of strings."""
+    if isinstance(joint_names, str):
+        raise KinergyError("joint_names: expected a sequence of names, got one string")
+    names = [str(s) for s in joint_names]
+    if not names:
+        raise KinergyError("joint_names: empty")
+    return names
+
+
+# -- layout helpers ------------------------------------------------------------------------------
+
+
+def _figure(width: float, height: float) -> Figure:
+    """A figure on its own Agg canvas with constrained layout (nothing clipped, no overlaps)."""
+    fig = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _style(ax: Axes) -> None:
+    ax.tick_params(labelsize=_TICK)
+    ax.grid(True, linewidth=0.5, alpha=0.4)
+
+
+def _ncols(n: int) -> int:
+    """Columns of the joint grid: one for a single joint, two up to eight, then three."""
+    return 1 if n == 1 else 2 if n <= 8 else 3
+
+
+def _joint_grid(fig: Figure, n: int) -> list[Axes]:
+    """``n`` axes on a grid of two columns (one for a single joint), sharing the x axis.
+
+    The grid is filled row by row; the spare cell of an odd ``n`` is removed, and the axis above
+    it gets its x tick labels back.
+    """
+    ncols = _ncols(n)
+    nrows = math.ceil(n / ncols)
+    grid = np.atleast_2d(fig.subplots(nrows, ncols, sharex=True, squeeze=False))
+    axes = list(grid.ravel())
+    for ax in axes[n:]:
+        fig.delaxes(ax)
+    axes = axes[:n]
+    for col in range(ncols):
+        column = [axes[i] for i in range(col, n, ncols)]
+        if column:
+            bottom = column[-1]
+            bottom.xaxis.set_tick_params(labelbottom=True)
+            bottom.set_xlabel("Time [s]", fontsize=_LABEL)
+    return axes
+
+
+def _grid_size(n: int) -> tuple[float, float]:
+    """Figure size, inches, for ``n`` joint panels: 11 x 8 for six."""
+    ncols = _ncols(n)
+    nrows = math.ceil(n / ncols)
+    width = 7.0 if ncols == 1 else 11.0 if ncols == 2 else 14.0
+    return width, 2.4 * nrows + 0.8
+
+
+# -- figures ----------------------------------------------------------------------------------
+
+
+def time_series(
+    t: ArrayLike,
+    measured: ArrayLike,
+    predicted: ArrayLike,
+    *,
+    joint_names: Sequence[str],
+    quantity: str,
+    unit: str,
+    measured_label: str = "measured",
+    predicted_label: str = "model",
+) -> Figure:
+    """Measured against predicted signal per joint over time, with R² per joint.
+
+    One panel per joint (a 3 x 2 grid for six joints) sharing the time axis, the measured signal
+    solid and the prediction dashed on top of it, as in UR5e Figs 8-9 (``target_moment`` against
+    the inverse dynamic model, eq 2) and Figs 11-12 (measured against estimated motor current,
+    eq 18). Each title carries the joint name and the coefficient of determination
+    ``R² = 1 - SS_res / SS_tot`` of that joint (UR5e Tables V and VII), to four decimals.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Time stamps, s, strictly increasing.
+    measured, predicted : array_like, shape (N, n)
+        The signal per joint, in ``unit``.
+    joint_names : sequence of str, length n
+    quantity : str
+        What is plotted, e.g. ``"Joint torque"``; used in the y labels and the figure title.
+    unit : str
+        Its unit, e.g. ``"N m"`` or ``"A"``.
+    measured_label, predicted_label : str
+        Legend entries of the two signals.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        ``n`` axes, in joint order.
+
+    Raises
+    ------
+    KinergyError
+        If the shapes disagree, the number of names is not ``n``, ``t`` does not increase or a
+        value is not finite.
+    """
+    names = _names(joint_names)
+    n = len(names)
+    ts = _time(t)
+    y = _matrix(measured, "measured", ts.size, n)
+    p = _matrix(predicted, "predicted", ts.size, n)
+    r2 = r_squared(y, p)
+
+    fig = _figure(*_grid_size(n))
+    axes = _joint_grid(fig, n)
+    for j, ax in enumerate(axes):
+        ax.plot(ts, y[:, j], label=measured_label, **_MEASURED)
+        ax.plot(ts, p[:, j], label=predicted_label, **_PREDICTED)
+        score = "n/a" if np.isnan(r2[j]) else f"{r2[j]:.4f}"
+        ax.set_title(f"{names[j]}  (R² = {score})", fontsize=_TITLE)
+        if j % _ncols(n) == 0:
+            ax.set_ylabel(f"{quantity} [{unit}]", fontsize=_LABEL)
+        ax.set_xlim(ts[0], ts[-1])
+        _style(ax)
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(
+        handles, labels, loc="outside lower center", ncols=2, fontsize=_LEGEND, frameon=False
+    )
+    fig.suptitle(f"{quantity}: {measured_label} vs {predicted_label}", fontsize=_SUPTITLE)
+    return fig
+
+
+def error_boxplot(
+    errors_by_set: Mapping[str, ArrayLike],
+    *,
+    joint_names: Sequence[str],
+    quantity: str,
+    unit: str,
+) -> Figure:
+    """Box plots of the prediction errors per joint, one panel per data set.
+
+    As UR5e Figs 10 (torque errors) and 13 (current errors): the box spans the first to third
+    quartile with the median marked, the whiskers reach the most extreme sample within 1.5
+    inter-quartile ranges, and samples beyond are drawn as small dots. The panels (e.g. the
+    identification run "test A" and the unseen run "test B") sit side by side and share the
+    y axis, so the sets compare at a glance.
+
+    Parameters
+    ----------
+    errors_by_set : mapping of str to array_like, shape (N_s, n)
+        Error samples (measured - predicted) per set, in ``unit``; the sets may have different
+        numbers of samples but the same joints.
+    joint_names : sequence of str, length n
+    quantity : str
+        What the errors are of, e.g. ``"Torque"``; the y label reads ``"{quantity} error [unit]"``.
+    unit : str
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axes per set, titled with the set's name, in the mapping's order.
+
+    Raises
+    ------
+    KinergyError
+        If there is no set, a set is not (N_s, n), or holds non-finite values.
+    """
+    names = _names(joint_names)
+    n = len(names)
+    if not errors_by_set:
+        raise KinergyError("errors_by_set: no data set given")
+    sets = {str(k): _matrix(v, f"errors_by_set[{k!r}]", None, n) for k, v in errors_by_set.items()}
+
+    k = len(sets)
+    width = min(max((1.2 + 0.75 * n) * k, 7.0), 18.0)
+    fig = _figure(width, 5.0)
+    axes = fig.subplots(1, k, sharey=True, squeeze=False)[0]
+    colours = [f"C{i}" for i in range(k)]
+    for i, (ax, (name, err)) in enumerate(zip(axes, sets.items(), strict=True)):
+        ax.axhline(0.0, color="0.5", linewidth=0.8, zorder=0)
+        ax.boxplot(
+            [err[:, j] for j in range(n)],
+            tick_labels=names,
+            patch_artist=True,
+            widths=0.6,
+            boxprops={"facecolor": colours[i], "alpha": 0.45, "edgecolor": "0.2"},
+            medianprops={"color": "black", "linewidth": 1.5},
+            whiskerprops={"color": "0.2"},
+            capprops={"color": "0.2"},
+            flierprops={
+                "marker": ".",
+                "markersize": 3.0,
+                "markerfacecolor": "0.3",
+                "markeredgecolor": "none",
+                "alpha": 0.5,
+            },
+        )
+        ax.set_title(name, fontsize=_TITLE)
+        ax.set_xlabel("Joint", fontsize=_LABEL)
+        if i == 0:
+            ax.set_ylabel(f"{quantity} error [{unit}]", fontsize=_LABEL)
+        _style(ax)
+        ax.grid(False, axis="x")
+        if max(len(s) for s in names) * n > 48:
+            ax.tick_params(axis="x", labelrotation=30)
+    fig.suptitle(f"{quantity} error per joint", fontsize=_SUPTITLE)
+    return fig
+
+
+def power_energy(t: ArrayLike, power: ArrayLike, *, joint_names: Sequence[str]) -> Figure:
+    """Electrical power per joint over time and the energy it adds up to (UR5e Figs 14-15).
+
+    The energy is the signed cumulative trapezoidal integral ``E_j(t) = int_0^t W_j dt``
+    (UR5e eq 26), so braking phases, where power flows back to the bus, lower it. The legend
+    gives each joint's energy over the whole motion, the lower title the total.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Time stamps, s, strictly increasing.
+    power : array_like, shape (N, n)
+        Electrical power per motor, W, positive when drawn from the supply (UR5e eq 23).
+    joint_names : sequence of str, length n
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two axes sharing the time axis: power [W] on top, cumulative energy [J] below.
+
+    Raises
+    ------
+    KinergyError
+        If the shapes disagree, the number of names is not ``n``, ``t`` does not increase or a
+        value is not finite.
+    """
+    names = _names(joint_names)
+    n = len(names)
+    ts = _time(t)
+    w = _matrix(power, "power", ts.size, n)
+    e = cumulative_trapezoid(w, ts, axis=0, initial=0.0)
+
+    fig = _figure(11.0, 7.5)
+    ax_p, ax_e = fig.subplots(2, 1, sharex=True)
+    for j in range(n):
+        colour = f"C{j % 10}"
+        ax_p.plot(ts, w[:, j], color=colour, linewidth=1.0)
+        ax_e.plot(ts, e[:, j], color=colour, linewidth=1.5, label=f"{names[j]}: {e[-1, j]:.1f} J")
+    for ax in (ax_p, ax_e):
+        ax.axhline(0.0, color="0.5", linewidth=0.8, zorder=0)
+        ax.set_xlim(ts[0], ts[-1])
+        _style(ax)
+    ax_p.set_title("Electrical power per joint", fontsize=_TITLE)
+    ax_p.set_ylabel("Power [W]", fontsize=_LABEL)
+    ax_e.set_title(f"Cumulative electrical energy (total {e[-1].sum():.1f} J)", fontsize=_TITLE)
+    ax_e.set_ylabel("Energy [J]", fontsize=_LABEL)
+    ax_e.set_xlabel("Time [s]", fontsize=_LABEL)
+    fig.legend(
+        loc="outside right center",
+        fontsize=_LEGEND,
+        title="Joint: energy",
+        title_fontsize=_LEGEND,
+        frameon=False,
+    )
+    return fig
+
+
+def energy_breakdown(t: ArrayLike, parts: Mapping[str, ArrayLike]) -> Figure:
+    """Where the electrical energy goes over time: one line per part and their total.
+
+    Each part's power is integrated (signed, cumulative trapezoid) into its energy over time and
+    drawn as a line; the total, the sum of the parts, is the thick black line, as in framework
+    Fig. 4. Lines rather than stacked areas, because a part can be negative (gravity while the
+    arm comes down, inertia while it brakes). With the parts of
+    :func:`kinergy.energy.accounting.energy` (``inertial``, ``gravity``, ``friction``,
+    ``copper``) the total is the electrical energy of UR5e eq 26.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Time stamps, s, strictly increasing.
+    parts : mapping of str to array_like, shape (N,)
+        Power of each part summed over the joints, W.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axes: energy [J] against time [s]; the legend gives each part's final energy.
+
+    Raises
+    ------
+    KinergyError
+        If there is no part, a part is not (N,), ``t`` does not increase or a value is not finite.
+    """
+    ts = _time(t)
+    if not parts:
+        raise KinergyError("parts: no energy part given")
+    power = {str(k): _vector(v, f"parts[{k!r}]") for k, v in parts.items()}
+    for k, v in power.items():
+        if v.size != ts.size:
+            raise KinergyError(f"parts[{k!r}]: expected shape ({ts.size},), got {v.shape}")
+    energy = {k: cumulative_trapezoid(v, ts, initial=0.0) for k, v in power.items()}
+    total = np.sum(list(energy.values()), axis=0)
+
+    fig = _figure(9.0, 5.5)
+    ax = fig.subplots()
+    ax.axhline(0.0, color="0.5", linewidth=0.8, zorder=0)
+    spare = (f"C{i}" for i in range(4, 100))
+    for k, e in energy.items():
+        colour = _PART_COLOURS.get(k.lower()) or next(spare)
+        ax.plot(ts, e, color=colour, linewidth=1.5, label=f"{k}: {e[-1]:.1f} J")
+    ax.plot(ts, total, color="black", linewidth=2.4, label=f"total: {total[-1]:.1f} J")
+    ax.set_xlim(ts[0], ts[-1])
+    ax.set_xlabel("Time [s]", fontsize=_LABEL)
+    ax.set_ylabel("Energy [J]", fontsize=_LABEL)
+    ax.set_title("Electrical energy over time by contribution", fontsize=_TITLE)
+    ax.legend(loc="upper left", fontsize=_LEGEND, framealpha=0.9)
+    _style(ax)
+    return fig
+
+
+def _pareto_front(x: Array, y: Array) -> NDArray[np.intp]:
+    """Indices of the points no other point beats in both x and y, by increasing x."""
+    order = np.lexsort((y, x))
+    front: list[int] = []
+    best = np.inf
+    for i in order:
+        if y[i] < best:
+            front.append(int(i))
+            best = y[i]
+    return np.asarray(front, dtype=np.intp)
+
+
+def pareto(
+    cycle_times: ArrayLike,
+    energies: ArrayLike,
+    *,
+    marked: Mapping[str, tuple[float, float]] | None = None,
+) -> Figure:
+    """Energy against cycle time of candidate motions, with their Pareto front and named points.
+
+    The front joins the motions no other is both faster and cheaper than (a staircase, by
+    increasing cycle time); named motions (e.g. ``"as recorded"``, ``"optimised"``) are drawn as
+    stars with their names beside them.
+
+    Parameters
+    ----------
+    cycle_times : array_like, shape (M,)
+        Cycle time of each candidate, s.
+    energies : array_like, shape (M,)
+        Its energy, J.
+    marked : mapping of str to (float, float), optional
+        Named points ``name -> (cycle time [s], energy [J])``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axes: energy [J] against cycle time [s].
+
+    Raises
+    ------
+    KinergyError
+        If the two arrays differ in length, are empty, or a value is not finite.
+    """
+    x = _vector(cycle_times, "cycle_times")
+    y = _vector(energies, "energies")
+    if x.size != y.size:
+        raise KinergyError(f"energies: expected shape ({x.size},) like cycle_times, got {y.shape}")
+    if x.size == 0:
+        raise KinergyError("cycle_times: no candidate given")
+    points: dict[str, tuple[float, float]] = {}
+    for name, xy in (marked or {}).items():
+        v = _vector(xy, f"marked[{name!r}]")
+        if v.size != 2:
+            raise KinergyError(
+                f"marked[{name!r}]: expected (cycle time, energy), got {v.size} values"
+            )
+        points[str(name)] = (float(v[0]), float(v[1]))
+
+    fig = _figure(8.0, 5.5)
+    ax = fig.subplots()
+    ax.scatter(x, y, s=18, color="0.55", alpha=0.7, label="candidates", zorder=2)
+    front = _pareto_front(x, y)
+    if front.size > 1:
+        ax.step(
+            x[front],
+            y[front],
+            where="post",
+            color="tab:blue",
+            linewidth=1.4,
+            label="Pareto front",
+            zorder=3,
+        )
+    # Labels point into the plot, away from the nearest edges, so none leaves the axes.
+    xs = np.concatenate([x, [p[0] for p in points.values()]])
+    ys = np.concatenate([y, [p[1] for p in points.values()]])
+    x_mid = 0.5 * (xs.min() + xs.max())
+    y_mid = 0.5 * (ys.min() + ys.max())
+    for i, (name, (px, py)) in enumerate(points.items()):
+        colour = f"C{(i + 1) % 10}"
+        ax.scatter(
+            [px],
+            [py],
+            s=140,
+            marker="*",
+            color=colour,
+            edgecolors="black",
+            linewidths=0.6,
+            zorder=5,
+        )
+        right = px <= x_mid
+        up = py <= y_mid
+        ax.annotate(
+            f"{name}\n{px:.2f} s, {py:.1f} J",
+            (px, py),
+            xytext=(10 if right else -10, 10 if up else -10),
+            textcoords="offset points",
+            ha="left" if right else "right",
+            va="bottom" if up else "top",
+            fontsize=_LEGEND,
+            bbox={"boxstyle": "round,pad=0.25", "facecolor": "white", "alpha": 0.85, "lw": 0.5},
+            zorder=6,
+        )
+    ax.set_xlabel("Cycle time [s]", fontsize=_LABEL)
+    ax.set_ylabel("Energy [J]", fontsize=_LABEL)
+    ax.set_title("Energy against cycle time", fontsize=_TITLE)
+    ax.legend(loc="upper right", fontsize=_LEGEND, framealpha=0.9)
+    ax.margins(0.08)
+    _style(ax)
+    return fig
+
+
+# -- output -------------------------------------------------------------------------------------
+
+
+def save(fig: Figure, path: str | os.PathLike[str]) -> Path:
+    """Write ``fig`` as a PNG at :data:`DPI` dots per inch, atomically.
+
+    The image goes to a temporary file in the target's folder, which then replaces ``path`` in
+    one step (:func:`os.replace`): a reader never sees a half-written file and a failure leaves
+    none behind. The folder is created if missing. The figure stays open and usable.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    path : str or os.PathLike
+        Where to write; the image is PNG whatever the suffix.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    KinergyError
+        If the folder cannot be created or the file cannot be written.
+    """
+    target = Path(path)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    except OSError as exc:
+        raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fig.savefig(fh, format="png", dpi=DPI)
+        os.chmod(tmp, 0o644)  # mkstemp makes it private; a figure is for reading
+        os.replace(tmp, target)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    return target
