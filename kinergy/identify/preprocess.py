@@ -23,7 +23,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
-from scipy.signal import butter, sosfiltfilt
 
 from kinergy.errors import KinergyError
 from kinergy.io.rtde import Log
@@ -162,12 +161,15 @@ def uniform(log: Log, *, tolerance: float = 0.01) -> Log:
 
 def lowpass(x: Array, fs: float, cutoff: float, order: int = 4) -> Array:
     """Zero-phase Butterworth low-pass of ``x`` (N, ...) along time; ``cutoff`` Hz, ``fs`` Hz."""
+    from scipy.signal import butter, sosfiltfilt  # slow to import; only filtering needs it
+
     if not 0.0 < cutoff < fs / 2.0:
         raise KinergyError(
             f"filter cutoff must be between 0 and {fs / 2:g} Hz (half of {fs:g} Hz), got {cutoff:g}"
         )
     sos = butter(order, cutoff / (fs / 2.0), output="sos")
-    padlen = min(3 * (2 * len(sos) + 1), x.shape[0] - 1)
+    # pad by several periods of the cutoff so the ends have settled
+    padlen = min(int(np.ceil(6.0 * fs / cutoff)), x.shape[0] - 1)
     return np.asarray(sosfiltfilt(sos, x, axis=0, padlen=padlen), dtype=float)
 
 
@@ -226,11 +228,28 @@ def prepare(
     KinergyError
         No joint motion in the log; a joint count that does not match.
     """
+    if torque is not None:
+        torque = np.asarray(torque, dtype=float)
+        if torque.shape != (len(log), n_joints):
+            raise KinergyError(
+                f"{log.path}: measured torques have shape {torque.shape}, expected {(len(log), n_joints)}"
+            )
+        # carried through the same sample selection and resampling as the log's own signals
+        log = Log(log.path, log.t, {**log.signals, "_torque": torque}, log.notes)
     log = uniform(running(log))
+    torque = log.signals.pop("_torque", None) if torque is not None else None
     t = log.t
     fs = 1.0 / float(t[1] - t[0])
     cutoff = min(10.0, fs / 5.0) if cutoff is None else cutoff
-    for name in ("target_q", "actual_q", "target_moment", "actual_current"):
+    for name in (
+        "target_q",
+        "target_qd",
+        "target_qdd",
+        "actual_q",
+        "actual_qd",
+        "target_moment",
+        "actual_current",
+    ):
         if name in log and (log[name].ndim != 2 or log[name].shape[1] != n_joints):
             width = 1 if log[name].ndim == 1 else log[name].shape[1]
             raise KinergyError(
@@ -255,10 +274,6 @@ def prepare(
         q_cmd, qd_cmd, qdd_cmd = measured_q, qd_f, qdd_f
         q, qd, qdd, lag = measured_q, qd_f, qdd_f, 0.0
         source = "filtered actual"
-    if torque is not None and torque.shape != q.shape:
-        raise KinergyError(
-            f"{log.path}: measured torques have shape {torque.shape}, expected {q.shape}"
-        )
     return IdentData(
         path=log.path,
         t=t,

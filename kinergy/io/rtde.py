@@ -23,7 +23,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
@@ -199,6 +198,8 @@ def read_log(
         last line included); a non-numeric or missing value (line and column named); time stamps
         that repeat or go back.
     """
+    import pandas as pd  # imported here: it is slow to import and only reading needs it
+
     path = Path(path)
     head = _first_line(path)
     if not head.strip():

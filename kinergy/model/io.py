@@ -59,7 +59,6 @@ from typing import Any, TypeVar
 
 import numpy as np
 import tomli_w
-from scipy.spatial.transform import Rotation
 
 from kinergy.errors import KinergyError
 from kinergy.model.robot import (
@@ -207,6 +206,31 @@ def _joint_from_dict(data: Any, index: int) -> Joint:
     )
 
 
+def rpy_matrix(rpy: Any) -> np.ndarray:
+    """Rotation from fixed-axis roll, pitch, yaw (URDF's ``rpy``): ``Rz(y) Ry(p) Rx(r)``."""
+    r, p, y = (float(v) for v in rpy)
+    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def matrix_rpy(rot: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw of a rotation matrix, the inverse of :func:`rpy_matrix` (pitch in
+    [-pi/2, pi/2]; at the gimbal lock yaw is set to 0)."""
+    pitch = float(np.arcsin(np.clip(-rot[2, 0], -1.0, 1.0)))
+    if abs(rot[2, 0]) < 1.0 - 1e-12:
+        roll = float(np.arctan2(rot[2, 1], rot[2, 2]))
+        yaw = float(np.arctan2(rot[1, 0], rot[0, 0]))
+    else:
+        roll, yaw = float(np.arctan2(-rot[1, 2], rot[1, 1])), 0.0
+    return np.array([roll, pitch, yaw])
+
+
 def _pose_from_dict(data: Any, where: str) -> np.ndarray:
     data = _table(data, where)
     _no_unknown(data, {"xyz", "rpy"}, where)
@@ -218,7 +242,7 @@ def _pose_from_dict(data: Any, where: str) -> np.ndarray:
     if xyz.shape != (3,) or rpy.shape != (3,):
         raise KinergyError(f"{where}: xyz and rpy must be 3 numbers each")
     out = np.eye(4)
-    out[:3, :3] = Rotation.from_euler("xyz", rpy).as_matrix()
+    out[:3, :3] = rpy_matrix(rpy)
     out[:3, 3] = xyz
     return out
 
@@ -296,7 +320,7 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         out["coupling"] = _floats(robot.coupling)
     for key, pose in (("base", robot.base), ("flange", robot.flange)):
         if not np.array_equal(pose, np.eye(4)):
-            rpy = Rotation.from_matrix(pose[:3, :3]).as_euler("xyz")
+            rpy = matrix_rpy(pose[:3, :3])
             out[key] = {"xyz": _floats(pose[:3, 3]), "rpy": _floats(rpy)}
     if robot.payload is not None:
         out["payload"] = {
