@@ -715,6 +715,142 @@ def _validation_plots(r: Robot, datas: list[Any], folder: str) -> None:
             )
 
 
+def _progress() -> Any:
+    import time
+
+    start = time.perf_counter()
+
+    def say(message: str) -> None:
+        click.echo(f"[{time.perf_counter() - start:5.1f} s] {message}", err=True)
+
+    return say
+
+
+def _print_tables(tables: dict[str, Any], keys: Sequence[str]) -> None:
+    for key in keys:
+        for table in tables.get(key, []):
+            click.echo(f"\n{table.caption}")
+            click.echo(_table(table.headers, table.rows))
+            if table.note:
+                click.echo(table.note)
+
+
+@cli.command()
+@click.option(
+    "--out",
+    "out",
+    type=click.Path(file_okay=False),
+    default="kinergy-demo",
+    show_default=True,
+    help="Folder for the logs, figures and report.html.",
+)
+def demo(out: str) -> None:
+    """The UR5e study on the built-in twin: simulate tests A and B, identify on A, validate on A
+    and B, compute the energy, print UR5e Tables IV-VIII and write an HTML report."""
+    from pathlib import Path
+
+    from kinergy.demo import run_demo
+
+    _sections, tables, report, seconds = run_demo(Path(out), _progress())
+    _print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown"])
+    click.echo(f"\nreport: {report} ({seconds:.1f} s)")
+
+
+@cli.command()
+@click.argument("model", metavar="MODEL")
+@click.option(
+    "--identify",
+    "identify_logs",
+    multiple=True,
+    metavar="LOG",
+    help="Identify the model from this log first (sequential method; repeatable).",
+)
+@click.option(
+    "--validate",
+    "validate_logs",
+    multiple=True,
+    metavar="LOG",
+    help="Compare the model with this log (repeatable).",
+)
+@click.option(
+    "--energy",
+    "energy_logs",
+    multiple=True,
+    metavar="LOG_OR_MOTION",
+    help="Account the energy of this log's or motion file's motion (repeatable).",
+)
+@click.option(
+    "--out",
+    "out",
+    type=click.Path(file_okay=False),
+    default="kinergy-report",
+    show_default=True,
+    help="Folder for the figures and report.html.",
+)
+@_columns_option
+@_payload_option
+@_repair_option
+def report(
+    model: str,
+    identify_logs: tuple[str, ...],
+    validate_logs: tuple[str, ...],
+    energy_logs: tuple[str, ...],
+    out: str,
+    columns: str | None,
+    payload: str | None,
+    repair: bool,
+) -> None:
+    """Build the study report (tables, figures, report.html) from your own model and logs."""
+    import time
+    from pathlib import Path
+
+    from kinergy import __version__
+    from kinergy.io.motion import motion_from_log
+    from kinergy.io.rtde import read_log
+    from kinergy.report.build import StudyInputs, report_sections
+    from kinergy.report.html import write_report
+
+    if not (identify_logs or validate_logs or energy_logs):
+        raise KinergyError("report: give logs with --identify, --validate or --energy")
+    say = _progress()
+    r = _load(model, payload)
+    result = None
+    if identify_logs:
+        from kinergy.identify.sequential import identify_sequential
+
+        say("identifying")
+        result = identify_sequential(r, _read_logs(identify_logs, columns, repair, r.n, None))
+        r = result.robot
+    validation = {
+        Path(p).name: d
+        for p, d in zip(
+            validate_logs, _read_logs(validate_logs, columns, repair, r.n, None), strict=True
+        )
+    }
+    motions = {
+        Path(p).name: motion_from_log(read_log(p, columns=columns, repair=repair), n_joints=r.n)
+        for p in energy_logs
+    }
+    folder = Path(out)
+    sections, tables = report_sections(
+        StudyInputs(model=r, validation=validation, motions=motions, result=result), folder, say
+    )
+    path = write_report(
+        folder / "report.html",
+        title=f"kinergy report: {r.name}",
+        subtitle="Model parameters, accuracy on logs and energy of motions",
+        sections=sections,
+        meta={
+            "model": model,
+            "kinergy": __version__,
+            "date": time.strftime("%Y-%m-%d %H:%M"),
+            "logs": ", ".join(identify_logs + validate_logs + energy_logs),
+        },
+    )
+    _print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown"])
+    click.echo(f"\nreport: {path}")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point: run the CLI, turning user errors into one line and a non-zero exit."""
     try:

@@ -27,7 +27,12 @@ UR10E = DATASETS / "ur10e-innopolis"
 UR10E_SPEC = "timestamp,actual_q:6,actual_qd:6,actual_current:6,target_current:6,target_moment:6"
 
 
-def _twin(robot: kinergy.Robot, motion: kinergy.trajectory.motion.Motion, settings: TwinSettings, name: str) -> Log:  # type: ignore[name-defined]
+def _twin(
+    robot: kinergy.Robot,
+    motion: kinergy.trajectory.motion.Motion,
+    settings: TwinSettings,
+    name: str,
+) -> Log:  # type: ignore[name-defined]
     signals = simulate(robot, motion, settings)
     t = signals.pop("timestamp")
     return Log(name, t, signals)
@@ -84,12 +89,19 @@ def test_a_joint_that_never_moves_gets_a_message_not_numbers(ur5e: kinergy.Robot
     motion = paper_trajectory(ur5e, "test-a", dt=0.004)
     frozen = motion.q.copy()
     frozen[:, 3] = frozen[0, 3]
-    still = dataclasses.replace(motion, q=frozen, qd=np.where(np.arange(6) == 3, 0.0, motion.qd), qdd=np.where(np.arange(6) == 3, 0.0, motion.qdd))
+    still = dataclasses.replace(
+        motion,
+        q=frozen,
+        qd=np.where(np.arange(6) == 3, 0.0, motion.qd),
+        qdd=np.where(np.arange(6) == 3, 0.0, motion.qdd),
+    )
     log = _twin(ur5e, still, TwinSettings.exact(), "still")
     result = identify_sequential(ur5e, [prepare(log, 6)])
     entry = result.joints[3]
     assert entry["identified"] is False and "never moves" in entry["problem"]
-    assert entry["torque_constant"] == ur5e.joints[3].drive.torque_constant  # the model's, untouched
+    assert (
+        entry["torque_constant"] == ur5e.joints[3].drive.torque_constant
+    )  # the model's, untouched
     assert any("joint 4 (wrist_1) never moves" in w for w in result.warnings)
     assert all(j["identified"] for k, j in enumerate(result.joints) if k != 3)
 
@@ -99,10 +111,14 @@ def test_nothing_identifiable_is_one_error(ur5e: kinergy.Robot) -> None:
     q = np.tile([0.0, -1.57, 0.0, -1.57, 0.0, 0.0], (400, 1))
     still = kinergy.trajectory.motion.Motion(t, q, np.zeros_like(q), np.zeros_like(q))
     log = _twin(ur5e, still, TwinSettings.exact(), "still")
-    with pytest.raises(KinergyError, match=r"joint 1 \(shoulder_pan\) never moves.*joint 6 \(wrist_3\) never moves"):
+    with pytest.raises(
+        KinergyError, match=r"joint 1 \(shoulder_pan\) never moves.*joint 6 \(wrist_3\) never moves"
+    ):
         identify_sequential(ur5e, [prepare(log, 6)])
     with pytest.raises(KinergyError, match="only 20 samples"):
-        identify_sequential(ur5e, [prepare(Log("short", t[:20], {k: v[:20] for k, v in log.signals.items()}), 6)])
+        identify_sequential(
+            ur5e, [prepare(Log("short", t[:20], {k: v[:20] for k, v in log.signals.items()}), 6)]
+        )
 
 
 def _fourier(robot: kinergy.Robot, seed: int, duration_periods: int = 2):
@@ -110,13 +126,19 @@ def _fourier(robot: kinergy.Robot, seed: int, duration_periods: int = 2):
     q0 = np.array([0.0, -1.4, 1.2, -1.4, -1.57, 0.0])
     a = rng.normal(0.0, 0.35, (6, 4))
     b = rng.normal(0.0, 0.35, (6, 4))
-    return fourier_motion(q0, a, b, base_frequency=2 * np.pi / 8.0, periods=duration_periods, dt=0.004)
+    return fourier_motion(
+        q0, a, b, base_frequency=2 * np.pi / 8.0, periods=duration_periods, dt=0.004
+    )
 
 
 # noise-free, the payload is recovered to 1e-3: not to round-off, because it moves the power-flow
 # direction of samples with almost no load torque, a step in the friction (UR5e eqs 12-13)
-@pytest.mark.parametrize(("settings", "tolerance"), [(TwinSettings.exact(), 1e-3), (TwinSettings(seed=5), 0.02)])
-def test_payload_from_a_twin_log(ur5e: kinergy.Robot, settings: TwinSettings, tolerance: float) -> None:
+@pytest.mark.parametrize(
+    ("settings", "tolerance"), [(TwinSettings.exact(), 1e-3), (TwinSettings(seed=5), 0.02)]
+)
+def test_payload_from_a_twin_log(
+    ur5e: kinergy.Robot, settings: TwinSettings, tolerance: float
+) -> None:
     truth = kinergy.Payload(mass=2.4, com=[0.03, -0.02, 0.09])
     log = _twin(ur5e.with_payload(truth), _fourier(ur5e, 3), settings, "loaded")
     payload, report = identify_payload(ur5e, [prepare(log, 6)])
@@ -131,14 +153,16 @@ def test_payload_needs_a_payload(ur5e: kinergy.Robot) -> None:
         identify_payload(ur5e, [prepare(log, 6)])
 
 
-def test_cli_identify_validate_and_payload(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_identify_validate_and_payload(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     a, b = tmp_path / "a.csv", tmp_path / "b.csv"
     assert main(["simulate", "ur5e", "--trajectory", "test-a", "--out", str(a)]) == 0
     assert main(["simulate", "ur5e", "--trajectory", "test-b", "--out", str(b), "--seed", "3"]) == 0
     model = tmp_path / "ur5e-id.toml"
     assert main(["identify", str(a), "--robot", "ur5e", "--out", str(model), "--json"]) == 0
     out = capsys.readouterr().out
-    data = json.loads(out[out.index("{"):])
+    data = json.loads(out[out.index("{") :])
     assert data["method"] == "sequential" and len(data["joints"]) == 6
     identified = kinergy.load_robot(model)
     assert identified.sources["torque_constant"].status == "identified"
@@ -151,7 +175,9 @@ def test_cli_identify_validate_and_payload(tmp_path: Path, capsys: pytest.Captur
     assert "UR5e Table VII" in capsys.readouterr().out
 
 
-def test_cli_identify_bad_log_leaves_no_model(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_identify_bad_log_leaves_no_model(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     bad = tmp_path / "bad.csv"
     bad.write_text("timestamp actual_q_0\n0 1\n0.1 x\n")
     out = tmp_path / "m.toml"
@@ -171,12 +197,17 @@ def ur10e_model():
     if not UR10E.exists():
         pytest.skip("shared datasets not available")
     robot = kinergy.load_robot("ur10e")
-    datas = [prepare(read_log(UR10E / "identification_data" / f"{run}.csv", columns=UR10E_SPEC), 6) for run in UR10E_RUNS]
+    datas = [
+        prepare(read_log(UR10E / "identification_data" / f"{run}.csv", columns=UR10E_SPEC), 6)
+        for run in UR10E_RUNS
+    ]
     return identify_sequential(robot, datas).robot
 
 
 def test_ur10e_predicts_the_held_out_point_to_point_program(ur10e_model) -> None:
-    val = prepare(read_log(UR10E / "validation_data" / "ur-20_01_17-ptp_10_points.csv", columns=UR10E_SPEC), 6)
+    val = prepare(
+        read_log(UR10E / "validation_data" / "ur-20_01_17-ptp_10_points.csv", columns=UR10E_SPEC), 6
+    )
     metrics = validation_metrics(ur10e_model, [val])
     r2 = [m["r2"] for m in metrics["current"]]
     # measured (README): 0.963 0.995 0.997 0.977 0.958 0.808 -- wrist 3 rests 64 % of this run and
@@ -187,7 +218,11 @@ def test_ur10e_predicts_the_held_out_point_to_point_program(ur10e_model) -> None
 
 
 def test_ur10e_payload_within_five_percent(ur10e_model) -> None:
-    log = read_log(UR10E / "identification_data" / "ur-20_02_19_15harm50secLoad.csv", columns=UR10E_SPEC, repair=True)
+    log = read_log(
+        UR10E / "identification_data" / "ur-20_02_19_15harm50secLoad.csv",
+        columns=UR10E_SPEC,
+        repair=True,
+    )
     assert log.notes and "dropped" in log.notes[0]  # the recorder wrote garbage rows at the start
     payload, _ = identify_payload(ur10e_model, [prepare(log, 6)])
     assert payload.mass == pytest.approx(2.805, rel=0.05)

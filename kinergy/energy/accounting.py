@@ -59,6 +59,8 @@ class EnergyReport:
     breakdown : dict of str to ndarray, shape (n,)
         ``inertial``, ``gravity``, ``friction``, ``copper`` parts of ``e_elec`` (signed integrals;
         with ``recovery`` False they no longer add up to the clipped ``e_elec``).
+    part_power : dict of str to ndarray, shape (N, n)
+        The electrical power of each part over time, W (framework Fig. 4).
     standby : float
         Energy of the robot's constant standby power over the motion, J.
     recovery : bool
@@ -75,6 +77,7 @@ class EnergyReport:
     e_mech: Array
     e_elec: Array
     breakdown: dict[str, Array]
+    part_power: dict[str, Array]
     standby: float
     total_e_mech: float
     total_e_elec: float
@@ -166,12 +169,13 @@ def energy(robot: Robot, motion: Motion, *, recovery: bool = True) -> EnergyRepo
     def integral(power: Array) -> Array:
         return np.asarray(trapezoid(power, t, axis=0), dtype=float)
 
-    breakdown = {
-        "inertial": integral(state.wm * tau_inertial_m / kt_over_kb),
-        "gravity": integral(state.wm * tau_gravity_m / kt_over_kb),
-        "friction": integral(state.wm * state.tau_friction / kt_over_kb),
-        "copper": integral(copper),
+    part_power = {
+        "inertial": state.wm * tau_inertial_m / kt_over_kb,
+        "gravity": state.wm * tau_gravity_m / kt_over_kb,
+        "friction": state.wm * state.tau_friction / kt_over_kb,
+        "copper": copper,
     }
+    breakdown = {name: integral(power) for name, power in part_power.items()}
     if recovery:
         total_mech = float(integral(p_mech.sum(axis=1)[:, None])[0])
         total_elec = float(integral(p_elec.sum(axis=1)[:, None])[0])
@@ -190,6 +194,7 @@ def energy(robot: Robot, motion: Motion, *, recovery: bool = True) -> EnergyRepo
         e_mech=integral(p_mech),
         e_elec=integral(p_elec),
         breakdown=breakdown,
+        part_power=part_power,
         standby=robot.standby_power * duration,
         total_e_mech=total_mech,
         total_e_elec=total_elec,

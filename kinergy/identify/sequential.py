@@ -119,7 +119,9 @@ def _diagnose_motion(robot: Robot, datas: Sequence[IdentData]) -> dict[int, str]
     qd = _stack(datas, "qd")
     samples = qd.shape[0]
     if samples < 50:
-        raise KinergyError(f"cannot identify from these logs: only {samples} samples (need at least 50)")
+        raise KinergyError(
+            f"cannot identify from these logs: only {samples} samples (need at least 50)"
+        )
     problems: dict[int, str] = {}
     for j, joint in enumerate(robot.joints):
         speed = np.abs(qd[:, j])
@@ -255,7 +257,11 @@ def identify_sequential(
     staged = robot.with_joints(joints)
     per_joint: list[dict[str, Any]] = []
     if has_current:
-        q, qd, qdd = _stack(current_logs, "q"), _stack(current_logs, "qd"), _stack(current_logs, "qdd")
+        q, qd, qdd = (
+            _stack(current_logs, "q"),
+            _stack(current_logs, "qd"),
+            _stack(current_logs, "qdd"),
+        )
         current = _stack(current_logs, "current")
         n_mat = transmission_matrix(staged)
         tau_sim = rnea(staged, q, qd, qdd) + qdd @ (n_mat.T @ (rotor[:, None] * n_mat)).T

@@ -1,0 +1,116 @@
+"""`kinergy demo` and `kinergy report`: the whole study on the twin, end to end."""
+
+from __future__ import annotations
+
+import re
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pytest
+
+import kinergy
+from kinergy.cli import main
+from kinergy.demo import nominal_drives, run_demo
+
+
+class _Images(HTMLParser):
+    def __init__(self) -> None:
+        super().__init__()
+        self.sources: list[str] = []
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        if tag == "img":
+            self.sources += [v for k, v in attrs if k == "src" and v]
+
+
+@pytest.fixture(scope="module")
+def demo_run(tmp_path_factory: pytest.TempPathFactory):
+    out = tmp_path_factory.mktemp("demo")
+    return out, run_demo(out)
+
+
+def test_demo_writes_a_report_whose_images_all_exist(demo_run) -> None:
+    out, (_sections, _tables, report, _seconds) = demo_run
+    assert report == out / "report.html" and report.exists()
+    parser = _Images()
+    parser.feed(report.read_text())
+    assert len(parser.sources) >= 10  # torque and current per test, box plots, power, breakdown
+    for src in parser.sources:
+        assert (out / src).is_file() and (out / src).stat().st_size > 10_000, src
+    assert sorted(p.name for p in (out / "logs").iterdir()) == ["test-a.csv", "test-b.csv"]
+
+
+def test_demo_prints_the_five_tables_with_comparisons(demo_run) -> None:
+    _out, (_sections, tables, _report, _seconds) = demo_run
+    assert {"IV", "V", "VI", "VII", "VIII"} <= set(tables)
+    assert "twin J_m (Table IV)" in tables["IV"][0].headers
+    assert [t.caption[-6:] for t in tables["VII"]] == ["test A", "test B"]
+    assert "R² (paper)" in tables["VII"][1].headers
+    assert "E_elec (paper)" in tables["VIII"][0].headers
+
+
+def test_demo_identifies_within_the_issue_tolerances(demo_run) -> None:
+    # identification issue: rotor inertia 3 %, k_t 2 %, friction 10 % (or 0.005 N m)
+    _out, (_sections, tables, _report, _seconds) = demo_run
+    truth = kinergy.load_robot("ur5e")
+    for j, row in enumerate(tables["IV"][0].rows):
+        assert abs(float(row[-1])) < 3.0  # J_m + J_r error in %
+        assert float(row[3]) == pytest.approx(truth.joints[j].drive.rotor_inertia, rel=0.03)
+    for j, row in enumerate(tables["VI"][0].rows):
+        t = truth.joints[j].drive
+        kv, tdir, trev, kt = (float(x.split()[0]) for x in row[2:6])
+        assert kt == pytest.approx(t.torque_constant, rel=0.02)
+        assert kv == pytest.approx(t.friction.params["viscous"], rel=0.10)
+        assert abs(tdir - t.friction.params["coulomb_direct"]) <= max(
+            0.1 * t.friction.params["coulomb_direct"], 0.005
+        )
+        assert abs(trev - t.friction.params["coulomb_reverse"]) <= max(
+            0.1 * t.friction.params["coulomb_reverse"], 0.005
+        )
+    r2 = [float(row[4]) for table in tables["VII"] for row in table.rows]  # tests A and B
+    assert min(r2) >= 0.98
+
+
+def test_demo_starts_from_guessed_drives() -> None:
+    guessed = nominal_drives(kinergy.load_robot("ur5e"))
+    assert all(
+        j.drive.motor_inertia == 0.0 and j.drive.torque_constant == 0.1 for j in guessed.joints
+    )
+
+
+def test_cli_demo_and_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "demo"
+    assert main(["demo", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    for caption in (
+        "UR5e Table IV",
+        "UR5e Table V",
+        "UR5e Table VI",
+        "UR5e Table VII",
+        "UR5e Table VIII",
+    ):
+        assert caption in text
+    assert re.search(r"report: .*report\.html \(\d+\.\d s\)", text)
+    model = tmp_path / "id.toml"
+    logs = out / "logs"
+    assert main(["identify", str(logs / "test-a.csv"), "--robot", "ur5e", "--out", str(model)]) == 0
+    capsys.readouterr()
+    rep = tmp_path / "rep"
+    assert (
+        main(
+            [
+                "report",
+                str(model),
+                "--validate",
+                str(logs / "test-b.csv"),
+                "--energy",
+                str(logs / "test-b.csv"),
+                "--out",
+                str(rep),
+            ]
+        )
+        == 0
+    )
+    assert (rep / "report.html").exists()
+    assert "UR5e Table VII" in capsys.readouterr().out
+    assert main(["report", str(model), "--out", str(rep)]) == 1
