@@ -17,15 +17,16 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
+from kinergy.io.files import atomic_write
 
 __all__ = ["Log", "parse_columns", "read_log", "write_log"]
 
@@ -309,16 +310,9 @@ def write_log(
             header.extend(f"{name}_{k}" for k in range(arr.shape[1]))
             cols.append(arr)
     data = np.hstack(cols)
-    directory = path.parent if str(path.parent) else Path(".")
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=directory)
-    except OSError as exc:
-        raise KinergyError(f"{path}: cannot write ({exc.strerror})") from None
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(" ".join(header) + "\n")
-            np.savetxt(fh, data, fmt="%.10g", delimiter=" ")
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+
+    def write(fh: IO[str]) -> None:
+        fh.write(" ".join(header) + "\n")
+        np.savetxt(fh, data, fmt="%.10g", delimiter=" ")
+
+    atomic_write(path, write)

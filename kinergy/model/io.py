@@ -50,7 +50,6 @@ Every error names the file and the field, e.g.
 from __future__ import annotations
 
 import os
-import tempfile
 import tomllib
 from collections.abc import Callable, Mapping
 from importlib import resources
@@ -61,6 +60,7 @@ import numpy as np
 import tomli_w
 
 from kinergy.errors import KinergyError
+from kinergy.io.files import atomic_write
 from kinergy.model.robot import (
     SOURCE_CATEGORIES,
     Drive,
@@ -405,21 +405,9 @@ def save_robot(robot: Robot, path: str | os.PathLike[str], *, header: str = "") 
 
     ``header`` lines are written as TOML comments at the top.
     """
-    path = Path(path)
     body = tomli_w.dumps(robot_to_dict(robot))
     comment = "".join(f"# {line}\n" for line in header.splitlines())
-    directory = path.parent if str(path.parent) else Path(".")
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=directory)
-    except OSError as exc:
-        raise KinergyError(f"{path}: cannot write ({exc.strerror})") from None
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(comment + body)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    atomic_write(path, lambda fh: fh.write(comment + body))
 
 
 def _library_dir() -> Any:

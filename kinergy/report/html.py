@@ -27,12 +27,10 @@ Examples
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import os
 import re
 import struct
-import tempfile
 import unicodedata
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -41,6 +39,7 @@ from typing import Any
 from urllib.parse import quote
 
 from kinergy.errors import KinergyError
+from kinergy.io.files import atomic_write
 
 __all__ = ["Figure", "Section", "Table", "write_report"]
 
@@ -384,22 +383,4 @@ def write_report(
     context = _context(target.parent, title, subtitle, sections, meta)
     text = _template().render(**context)
 
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    except OSError as exc:
-        raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)  # mkstemp makes it private; a report is for reading
-        os.replace(tmp, target)
-    except OSError as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-    return target
+    return atomic_write(target, lambda fh: fh.write(text))

@@ -19,10 +19,8 @@ writes one as a PNG atomically.
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -36,6 +34,7 @@ from scipy.integrate import cumulative_trapezoid
 
 from kinergy.errors import KinergyError
 from kinergy.identify.metrics import r_squared
+from kinergy.io.files import atomic_write
 
 __all__ = [
     "DPI",
@@ -576,23 +575,4 @@ def save(fig: Figure, path: str | os.PathLike[str]) -> Path:
     KinergyError
         If the folder cannot be created or the file cannot be written.
     """
-    target = Path(path)
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    except OSError as exc:
-        raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fig.savefig(fh, format="png", dpi=DPI)
-        os.chmod(tmp, 0o644)  # mkstemp makes it private; a figure is for reading
-        os.replace(tmp, target)
-    except OSError as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-    return target
+    return atomic_write(path, lambda fh: fig.savefig(fh, format="png", dpi=DPI), binary=True)
