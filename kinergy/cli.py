@@ -479,7 +479,7 @@ def _validation_text(report: dict[str, Any], names: Sequence[str]) -> str:
 )
 @click.option(
     "--method",
-    type=click.Choice(["sequential", "full"]),
+    type=click.Choice(["sequential", "full", "nursing"]),
     default="sequential",
     show_default=True,
     help="sequential: the UR5e doc's procedure; full: base-parameter regression.",
@@ -588,6 +588,10 @@ def identify(
         from kinergy.identify.sequential import identify_sequential
 
         result = identify_sequential(r, datas, friction=friction)
+    elif method == "nursing":
+        from kinergy.identify.nursing import identify_nursing
+
+        result = identify_nursing(r, datas)
     else:
         from kinergy.identify.full import identify_full
 
@@ -849,6 +853,18 @@ def report(
     )
     _print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown"])
     click.echo(f"\nreport: {path}")
+
+
+def _register_commands() -> None:
+    """Commands that live in their own modules (kinergy.commands)."""
+    from kinergy.commands.nursing import nursing
+    from kinergy.commands.optimize import optimize
+
+    cli.add_command(optimize)
+    cli.add_command(nursing)
+
+
+_register_commands()
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -1,0 +1,1 @@
+"""Sub-commands of the ``kinergy`` command that live in their own modules."""

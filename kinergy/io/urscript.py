@@ -1,0 +1,287 @@
+"""URScript programs a UR controller can run, written from kinergy's motions.
+
+:func:`movej_program` writes a movej program: one ``movej(q, a=..., v=..., r=...)`` per move,
+joint angles in rad, URScript's ``a`` (rad/s^2) and ``v`` (rad/s) of the leading joint, as
+kinergy's :func:`kinergy.trajectory.movej.movej` plans them. :func:`write_script` puts any script
+on disk atomically.
+
+Blending: URScript's ``r`` is a blend radius in metres around the target's tool position, while
+kinergy plans blends as a joint-space radius (rad, on the leading joint). The two do not convert
+without the tool, so a program is written with ``r=0`` (every move stops at its target, as
+kinergy's unblended plan) unless the caller gives UR blend radii.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from kinergy.errors import KinergyError
+from kinergy.io.files import atomic_write
+
+__all__ = ["movej_program", "write_script"]
+
+
+def _num(x: float) -> str:
+    """A number URScript parses, exactly enough for 500 Hz (9 significant digits)."""
+    return f"{float(x):.9g}"
+
+
+def _decimal(x: float) -> str:
+    """A number in plain decimal notation (no exponent, which URScript may not read), to 1e-9:
+    joint angles in rad, and ``a`` and ``v`` of a movej."""
+    text = f"{float(x):.9f}".rstrip("0").rstrip(".")
+    return "0" if text in ("", "-0") else text
+
+
+def _name(name: str) -> str:
+    if (
+        not name
+        or not (name[0].isalpha() or name[0] == "_")
+        or not all(c.isalnum() or c == "_" for c in name)
+    ):
+        raise KinergyError(
+            f"program name {name!r}: must be letters, digits and underscores, not starting "
+            "with a digit"
+        )
+    return name
+
+
+def movej_program(
+    waypoints: ArrayLike,
+    speeds: ArrayLike,
+    accels: ArrayLike,
+    blends: ArrayLike | None = None,
+    *,
+    name: str = "kinergy_program",
+    cycle_time: float | None = None,
+    energy: float | None = None,
+    comments: Sequence[str] = (),
+) -> str:
+    """A URScript movej program through ``waypoints``.
+
+    Parameters
+    ----------
+    waypoints : array_like, shape (K + 1, n)
+        The start pose and the K targets, rad. The program first moves to the start pose (at
+        URScript's default ``a=1.4, v=1.05``: it is not part of the timed cycle), then runs the
+        K moves.
+    speeds, accels : float or array_like, shape (K,)
+        Each move's ``v`` (rad/s) and ``a`` (rad/s^2), > 0.
+    blends : float or array_like, shape (K,), optional
+        UR blend radii, m (tool centre point; URScript's ``r``); default 0 for every move. Not
+        kinergy's joint-space blend radii (see the module docstring).
+    name : str
+        The program's name (``def name():``).
+    cycle_time, energy : float, optional
+        Predicted cycle time (s) and electrical energy (J), written as comments.
+    comments : sequence of str
+        More comment lines for the header.
+
+    Returns
+    -------
+    str
+        ``def name():`` ... ``end``, newline-terminated.
+
+    Examples
+    --------
+    >>> text = movej_program([[0, 0, 0, 0, 0, 0], [0.5, 0, 0, 0, 0, 0]], 1.0, 2.0)
+    >>> text.splitlines()[-2].strip()
+    'movej([0.5, 0, 0, 0, 0, 0], a=2, v=1, r=0)'
+    """
+    w = np.asarray(waypoints, dtype=float)
+    if w.ndim != 2 or w.shape[0] < 2:
+        raise KinergyError(f"waypoints: expected shape (K + 1, n) with K >= 1, got {w.shape}")
+    if not np.all(np.isfinite(w)):
+        raise KinergyError("waypoints: not finite")
+    moves = w.shape[0] - 1
+    settings = {}
+    for key, value, positive in (
+        ("v", speeds, True),
+        ("a", accels, True),
+        ("r", 0.0 if blends is None else blends, False),
+    ):
+        arr = np.asarray(value, dtype=float)
+        arr = np.full(moves, float(arr)) if arr.ndim == 0 else arr
+        if arr.shape != (moves,):
+            raise KinergyError(f"{key}: expected one value or {moves}, got shape {arr.shape}")
+        bad = ~np.isfinite(arr) | ((arr <= 0.0) if positive else (arr < 0.0))
+        if np.any(bad):
+            k = int(np.argmax(bad))
+            raise KinergyError(
+                f"{key} of move {k + 1}: must be {'> 0' if positive else '>= 0'}, got {arr[k]}"
+            )
+        settings[key] = arr
+    lines = [f"def {_name(name)}():"]
+    header = ["written by kinergy: a movej program, joint angles in rad"]
+    if cycle_time is not None:
+        header.append(f"predicted cycle time: {cycle_time:.3f} s")
+    if energy is not None:
+        header.append(f"predicted electrical energy per cycle: {energy:.1f} J")
+    header.append(
+        "r is UR's blend radius at the tool (m); kinergy's joint-space blends are not written "
+        "(r=0: each move stops at its target)"
+        if blends is None
+        else "r is UR's blend radius at the tool (m), as the task gives it"
+    )
+    header.extend(str(c) for c in comments)
+    lines.extend(f"  # {line}" for text in header for line in text.splitlines())
+
+    def vec(q: Any) -> str:
+        return "[" + ", ".join(_decimal(x) for x in q) + "]"
+
+    lines.append("  # the start pose (not part of the cycle)")
+    lines.append(f"  movej({vec(w[0])}, a=1.4, v=1.05)")
+    for k in range(moves):
+        lines.append(f"  # move {k + 1}")
+        lines.append(
+            f"  movej({vec(w[k + 1])}, a={_decimal(settings['a'][k])}, "
+            f"v={_decimal(settings['v'][k])}, r={_decimal(settings['r'][k])})"
+        )
+    lines.append("end")
+    return "\n".join(lines) + "\n"
+
+
+def write_script(path: str | os.PathLike[str], text: str) -> Path:
+    """Write a URScript program to ``path`` atomically (no half-written file on failure).
+
+    Raises
+    ------
+    KinergyError
+        ``PATH: cannot write (reason)``.
+    """
+
+    def write(fh: IO[Any]) -> None:
+        fh.write(text)
+
+    return atomic_write(path, write)
+
+
+# ---------------------------------------------------------------------------------------------
+# servoj: a sampled trajectory streamed at the controller's rate
+
+__all__ += ["servoj_program"]
+
+#: the controller's cycle, s (e-Series: 500 Hz)
+SERVO_PERIOD = 0.002
+
+
+def _fixed(x: float) -> str:
+    """A joint angle (rad) in plain decimal notation, 1e-9 rad resolution (no exponent)."""
+    text = f"{float(x):.9f}".rstrip("0").rstrip(".")
+    return "0" if text in ("", "-0") else text
+
+
+def servoj_program(
+    t: ArrayLike,
+    q: ArrayLike,
+    *,
+    name: str = "kinergy_excitation",
+    start_speed: float = 0.5,
+    start_acceleration: float = 1.0,
+    lookahead_time: float = 0.1,
+    gain: float = 300.0,
+    comments: Sequence[str] = (),
+) -> str:
+    """A URScript program that runs a sampled joint trajectory with ``servoj``.
+
+    The program first moves to ``q[0]`` with ``movej`` at ``start_speed`` and
+    ``start_acceleration`` (not part of the timed motion), then commands every sample in turn with
+    ``servoj(q_k, 0, 0, dt, lookahead_time, gain)``, which blocks for ``dt`` (the samples' step,
+    normally the controller's 2 ms), so sample ``k`` is the target at time ``k * dt`` and the
+    motion runs at the controller's rate, and finally brakes with ``stopj``.
+
+    Structure: one ``servoj`` line per sample inside ``def name(): ... end``. This is valid on
+    every URScript version (CB3 3.x and e-Series 5.x) because it needs no nested lists (list
+    literals of lists and their size limits differ between versions) and does no interpreter work
+    between two samples, so no cycle is missed. The cost is size, about 90 bytes per sample (10 s
+    at 500 Hz are 5000 lines, some 450 kB), which UR controllers load and run.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Sample times, s: uniform steps of at least :data:`SERVO_PERIOD` (the controller's cycle).
+    q : array_like, shape (N, 6)
+        Joint angles, rad (URScript's joint vectors have 6 entries).
+    name : str
+        The program's name (``def name():``).
+    start_speed, start_acceleration : float
+        ``movej``'s ``v`` (rad/s) and ``a`` (rad/s^2) to the first sample, > 0; ``a`` is also
+        the ``stopj`` deceleration at the end.
+    lookahead_time : float
+        ``servoj``'s look-ahead, s, in [0.03, 0.2] (UR's range).
+    gain : float
+        ``servoj``'s proportional gain, in [100, 2000] (UR's range).
+    comments : sequence of str
+        More comment lines for the header.
+
+    Returns
+    -------
+    str
+        ``def name():`` ... ``end``, newline-terminated.
+
+    Raises
+    ------
+    KinergyError
+        Shapes, non-uniform or too short steps, settings out of range.
+
+    Examples
+    --------
+    >>> text = servoj_program([0.0, 0.002], [[0, 0, 0, 0, 0, 0], [0.001, 0, 0, 0, 0, 0]])
+    >>> text.splitlines()[-3].strip()
+    'servoj([0.001, 0, 0, 0, 0, 0], 0, 0, 0.002, 0.1, 300)'
+    """
+    times = np.asarray(t, dtype=float)
+    angles = np.asarray(q, dtype=float)
+    if times.ndim != 1 or times.size < 2:
+        raise KinergyError(f"t: expected shape (N,) with N >= 2, got {times.shape}")
+    if angles.shape != (times.size, 6):
+        raise KinergyError(
+            f"q: expected shape ({times.size}, 6) (URScript joint vectors have 6 entries), "
+            f"got {angles.shape}"
+        )
+    if not (np.all(np.isfinite(times)) and np.all(np.isfinite(angles))):
+        raise KinergyError("t and q must be finite")
+    steps = np.diff(times)
+    dt = float(np.mean(steps))
+    if np.any(np.abs(steps - dt) > 1e-6):
+        k = int(np.argmax(np.abs(steps - dt)))
+        raise KinergyError(
+            f"t: servoj needs uniform steps; step {k + 1} is {steps[k]:.6g} s, the mean {dt:.6g} s"
+        )
+    if dt < SERVO_PERIOD - 1e-9:
+        raise KinergyError(
+            f"t: steps of {dt:.6g} s are shorter than the controller's cycle ({SERVO_PERIOD} s)"
+        )
+    for label, value in (("start_speed", start_speed), ("start_acceleration", start_acceleration)):
+        if not (np.isfinite(value) and value > 0.0):
+            raise KinergyError(f"{label}: must be > 0, got {value}")
+    if not 0.03 <= lookahead_time <= 0.2:
+        raise KinergyError(f"lookahead_time: must be in [0.03, 0.2] s, got {lookahead_time}")
+    if not 100.0 <= gain <= 2000.0:
+        raise KinergyError(f"gain: must be in [100, 2000], got {gain}")
+
+    def vec(row: Any) -> str:
+        return "[" + ", ".join(_fixed(x) for x in row) + "]"
+
+    tail = f", 0, 0, {_num(dt)}, {_num(lookahead_time)}, {_num(gain)})"
+    header = [
+        "written by kinergy: a servoj program, joint angles in rad",
+        f"{times.size} samples every {_num(dt)} s ({times[-1] - times[0]:.3f} s), one servoj each",
+        "servoj(q, a, v, t, lookahead_time, gain): a and v are unused by the controller",
+        *(str(c) for c in comments),
+    ]
+    lines = [f"def {_name(name)}():"]
+    lines.extend(f"  # {line}" for text in header for line in text.splitlines())
+    lines.append("  # the start pose (not part of the timed motion)")
+    lines.append(f"  movej({vec(angles[0])}, a={_num(start_acceleration)}, v={_num(start_speed)})")
+    lines.append("  # the motion: sample k at time k * t")
+    lines.extend(f"  servoj({vec(row)}{tail}" for row in angles)
+    lines.append(f"  stopj({_num(start_acceleration)})")
+    lines.append("end")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,480 @@
+"""Energy-optimal movej timing: task files, the optimiser against brute force on a toy arm, the
+UR5e test A result against its own re-simulation and limits, the Pareto front, URScript output
+and the ``optimize`` command."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import kinergy
+from kinergy.commands.optimize import optimize
+from kinergy.drives.electrics import drive_state
+from kinergy.drives.transmission import joint_torque
+from kinergy.energy.optimal import (
+    limit_violations,
+    optimize_timing,
+    pareto_front,
+    program_energy,
+    timing_problem,
+    uniform_scaling,
+)
+from kinergy.errors import KinergyError
+from kinergy.io.task import load_task
+from kinergy.io.urscript import movej_program, write_script
+from kinergy.model import Drive, Friction, Joint, Limits, Link, Robot
+from kinergy.simulate import paper_waypoints
+from kinergy.trajectory.movej import movej, plan_movej
+
+# -- a toy arm ------------------------------------------------------------------------------------
+
+
+def _toy_robot() -> Robot:
+    """Two links in a vertical plane (gravity along -y of the base), 100:1 drives with viscous and
+    Coulomb friction: a small arm whose optimum a brute-force search can find."""
+    drive = Drive(
+        gear_ratio=100.0,
+        motor_inertia=5e-5,
+        reducer_inertia=5e-5,
+        torque_constant=0.1,
+        motor_constant=0.15,
+        kt_over_kb=0.9,
+        friction=Friction("viscous_coulomb", {"viscous": 4e-4, "coulomb": 0.03, "smoothing": 1e-3}),
+    )
+    limits = Limits(position=np.array([-np.pi, np.pi]), speed=3.0, torque=80.0)
+    joints = tuple(
+        Joint(
+            name=f"j{i + 1}",
+            d=0.0,
+            a=length,
+            alpha=0.0,
+            offset=0.0,
+            link=Link(
+                mass=mass,
+                com=np.array([-length / 2, 0.0, 0.0]),
+                inertia=np.array([0.002, 0.02, 0.02, 0.0, 0.0, 0.0]),
+            ),
+            drive=drive,
+            limits=limits,
+        )
+        for i, (length, mass) in enumerate(((0.4, 3.0), (0.3, 1.5)))
+    )
+    return Robot(name="toy", convention="dh", joints=joints, gravity=np.array([0.0, -9.81, 0.0]))
+
+
+TOY = _toy_robot()
+
+
+def _move_energy(waypoints: np.ndarray, duration: float, ramp_fraction: float) -> float:
+    """Energy of one move of the given duration and ramp fraction, re-simulated at 500 Hz."""
+    travel = float(np.max(np.abs(waypoints[1] - waypoints[0])))
+    ramp = 0.5 * ramp_fraction * duration
+    v = travel / (duration - ramp)
+    return program_energy(TOY, waypoints, v, v / ramp)
+
+
+def test_one_move_matches_a_brute_force_search() -> None:
+    # one move in a fixed time: the only freedom is the ramp (v and a tied by the duration);
+    # a fine grid over it, every point re-simulated at 500 Hz, is the oracle
+    w = np.array([[0.0, 0.0], [1.2, -0.6]])
+    budget, a_max = 2.0, 20.0
+    travel = 1.2
+    grid = np.linspace(0.02, 1.0, 150)
+    ramp = 0.5 * grid * budget
+    v = travel / (budget - ramp)
+    a = v / ramp
+    ok = (v <= 3.0) & (a <= a_max)
+    best = min(_move_energy(w, budget, f) for f in grid[ok])
+    result = optimize_timing(TOY, w, cycle_time=budget, accels=a_max, a_max=a_max)
+    assert result.optimized.ok
+    assert result.optimized.cycle_time == pytest.approx(budget, abs=1e-6)
+    assert result.optimized.e_elec == pytest.approx(best, rel=0.01)
+    assert result.optimized.e_elec <= best * 1.002  # a grid cannot beat the optimiser by much
+
+
+def test_two_moves_match_a_brute_force_search_over_the_budget_share() -> None:
+    # unblended moves are independent: E = E1(t1) + E2(T - t1), each minimised over its ramp
+    w = np.array([[0.0, 0.0], [1.0, -0.5], [0.2, 0.4]])
+    budget, a_max = 3.0, 15.0
+    travel = np.max(np.abs(np.diff(w, axis=0)), axis=1)
+    ramps = np.linspace(0.03, 1.0, 24)
+
+    def best_move(k: int, t: float) -> float:
+        out = np.inf
+        for f in ramps:
+            ramp = 0.5 * f * t
+            v = travel[k] / (t - ramp)
+            if v <= 3.0 and v / ramp <= a_max:
+                out = min(out, _move_energy(w[k : k + 2], t, f))
+        return out
+
+    shares = np.linspace(0.3, 0.7, 21) * budget
+    brute = min(best_move(0, t1) + best_move(1, budget - t1) for t1 in shares)
+    result = optimize_timing(TOY, w, cycle_time=budget, accels=a_max, a_max=a_max)
+    assert np.isfinite(brute)
+    assert result.optimized.ok
+    assert result.optimized.e_elec == pytest.approx(brute, rel=0.01)
+    assert result.optimized.e_elec <= brute * 1.002  # a grid cannot beat the optimiser by much
+
+
+def test_fixed_shares_keep_each_moves_share_of_the_time() -> None:
+    w = np.array([[0.0, 0.0], [1.0, -0.5], [0.2, 0.4]])
+    result = optimize_timing(TOY, w, cycle_time=3.0, speeds=1.0, accels=4.0, share_budget=False)
+    program = result.program
+    share = program.durations / program.durations.sum()
+    assert result.optimized.durations / result.optimized.durations.sum() == pytest.approx(
+        share, rel=1e-4
+    )
+    assert result.optimized.e_elec <= result.uniform.e_elec * (1 + 1e-9)
+
+
+# -- the UR5e twin, test A --------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def test_a(ur5e: Robot) -> tuple[np.ndarray, object]:
+    w = paper_waypoints(ur5e, 1)
+    return w, optimize_timing(ur5e, w, speeds=3.0, accels=6.0)
+
+
+def test_test_a_at_its_own_cycle_time_saves_energy(ur5e: Robot, test_a: tuple) -> None:
+    w, result = test_a
+    own = plan_movej(w, speed=3.0, acceleration=6.0).total_time
+    assert result.cycle_time == pytest.approx(own)
+    assert result.optimized.cycle_time == pytest.approx(own, abs=1e-6)
+    assert result.optimized.e_elec <= result.program.e_elec
+    # ~8 % on the seed model (the Coulomb part of the friction, ~40 %, cannot be timed away)
+    assert result.saving > 0.05
+
+
+def test_test_a_optimum_keeps_every_limit_at_every_sample(ur5e: Robot, test_a: tuple) -> None:
+    w, result = test_a
+    opt = result.optimized
+    motion = movej(w, speed=opt.speeds, acceleration=opt.accels, dt=0.002)
+    state = drive_state(ur5e, motion.q, motion.qd, motion.qdd)
+    # independently of LimitCheck: the robot's limits straight from the model
+    speed = np.array([j.limits.speed for j in ur5e.joints])
+    torque = np.array([j.limits.torque for j in ur5e.joints])
+    lo = np.array([j.limits.position[0] for j in ur5e.joints])
+    hi = np.array([j.limits.position[1] for j in ur5e.joints])
+    assert np.all(np.abs(motion.qd) <= speed * (1 + 1e-9))
+    assert np.all(np.abs(joint_torque(ur5e, state.tau_m)) <= torque)
+    assert np.all((motion.q >= lo) & (motion.q <= hi))
+    assert limit_violations(ur5e, motion, state).ok
+    assert opt.ok and not opt.check.violations()
+
+
+def test_test_a_reported_energy_is_the_resimulated_energy(ur5e: Robot, test_a: tuple) -> None:
+    w, result = test_a
+    opt = result.optimized
+    assert program_energy(ur5e, w, opt.speeds, opt.accels, dt=0.002) == pytest.approx(
+        opt.e_elec, rel=1e-12
+    )
+    # the optimiser's own quadrature agrees with the 500 Hz re-simulation
+    assert opt.predicted == pytest.approx(opt.e_elec, rel=0.005)
+    assert opt.e_moves.sum() == pytest.approx(opt.e_elec, rel=1e-9)
+    assert sum(opt.breakdown.values()) == pytest.approx(opt.e_elec, rel=1e-9)
+
+
+def test_uniform_scaling_to_the_programs_own_time_is_the_program(test_a: tuple) -> None:
+    _, result = test_a
+    assert result.uniform.speeds == pytest.approx(result.program.speeds)
+    assert result.uniform.accels == pytest.approx(result.program.accels)
+    assert result.uniform.e_elec == pytest.approx(result.program.e_elec, rel=1e-12)
+
+
+def test_uniform_scaling_stretches_every_time_by_the_factor() -> None:
+    w = np.array([[0.0, 0.0], [1.0, -0.5], [0.2, 0.4]])
+    v, a = np.array([1.0, 2.0]), np.array([3.0, 5.0])
+    plan = plan_movej(w, speed=v, acceleration=a, blend=[0.05, 0.0])
+    sv, sa = uniform_scaling(v, a, 0.5)
+    slow = plan_movej(w, speed=sv, acceleration=sa, blend=[0.05, 0.0])
+    assert slow.total_time == pytest.approx(2.0 * plan.total_time)
+    assert slow.start == pytest.approx(2.0 * plan.start)
+
+
+def test_pareto_front_falls_with_cycle_time_and_beats_uniform_scaling(ur5e: Robot) -> None:
+    w = paper_waypoints(ur5e, 1)
+    problem = timing_problem(ur5e, w)
+    own = plan_movej(w, speed=3.0, acceleration=6.0).total_time
+    points = pareto_front(
+        ur5e, w, speeds=3.0, accels=6.0, cycle_times=[own, 1.3 * own, 1.8 * own], problem=problem
+    )
+    energies = np.array([p.optimized for p in points])
+    # on the UR5e viscous friction (~1/T) outweighs the gravity copper loss (~T) over this range
+    assert np.all(np.diff(energies) < 0.0)
+    for p in points:
+        assert p.optimized_ok and p.uniform_ok
+        assert p.optimized <= p.uniform
+    assert points[0].uniform == pytest.approx(program_energy(ur5e, w, 3.0, 6.0))
+
+
+def test_blended_program_keeps_its_budget_and_limits(ur5e: Robot) -> None:
+    # blends overlap the moves (not separable): the cycle time is kinergy's overlap rule
+    w = paper_waypoints(ur5e, 1)[:5]
+    blends = np.full(4, 0.1)
+    result = optimize_timing(ur5e, w, speeds=3.0, accels=6.0, blends=blends, cycle_time=10.0)
+    opt = result.optimized
+    assert opt.blends.tolist() == blends.tolist()
+    assert opt.cycle_time == pytest.approx(10.0, abs=1e-6)
+    assert opt.ok
+    assert opt.e_elec <= result.uniform.e_elec
+    assert opt.e_elec == pytest.approx(
+        program_energy(ur5e, w, opt.speeds, opt.accels, blends), rel=1e-12
+    )
+
+
+def test_a_repeated_waypoint_is_a_move_that_does_not_move(ur5e: Robot) -> None:
+    w = paper_waypoints(ur5e, 1)
+    w = np.vstack([w[:3], w[2:4]])  # move 3 stays where move 2 ended
+    result = optimize_timing(ur5e, w, speeds=3.0, accels=6.0)
+    assert result.optimized.durations[2] == 0.0
+    assert result.optimized.ok and result.optimized.e_elec <= result.program.e_elec
+
+
+def test_a_cycle_time_below_the_fastest_feasible_is_refused(ur5e: Robot) -> None:
+    w = paper_waypoints(ur5e, 1)[:3]
+    problem = timing_problem(ur5e, w)
+    with pytest.raises(KinergyError, match="shorter than the fastest feasible"):
+        optimize_timing(
+            ur5e, w, cycle_time=0.9 * problem.fastest_cycle_time, speeds=3.0, accels=6.0
+        )
+
+
+def test_an_acceleration_cap_is_kept_and_reported(ur5e: Robot) -> None:
+    w = paper_waypoints(ur5e, 1)[:4]
+    result = optimize_timing(ur5e, w, speeds=3.0, accels=6.0, a_max=6.0)
+    assert np.all(result.optimized.accels <= 6.0)
+    assert result.optimized.ok
+    assert any(line.startswith("acceleration: a_max") for line in result.active)
+    assert result.optimized.e_elec <= result.program.e_elec
+
+
+def test_limit_violations_finds_an_overspeed_and_an_overload(ur5e: Robot) -> None:
+    w = paper_waypoints(ur5e, 1)[:2]
+    motion = movej(w, speed=4.0, acceleration=6.0, dt=0.002)  # 4 rad/s > 180 deg/s
+    check = limit_violations(ur5e, motion, drive_state(ur5e, motion.q, motion.qd, motion.qdd))
+    assert not check.ok
+    assert any(line.startswith("speed of") for line in check.violations())
+    heavy = ur5e.with_payload(kinergy.Payload(mass=40.0))
+    check = limit_violations(heavy, motion, drive_state(heavy, motion.q, motion.qd, motion.qdd))
+    assert any(line.startswith("torque of") for line in check.violations())
+    capped = limit_violations(
+        ur5e, motion, drive_state(ur5e, motion.q, motion.qd, motion.qdd), acceleration_cap=5.0
+    )
+    assert any(line.startswith("acceleration of") for line in capped.violations())
+
+
+# -- task files -------------------------------------------------------------------------------------
+
+TASK = """
+robot = "ur5e"
+unit = "deg"
+speed = 2.0
+acceleration = 4.0
+start = [0, -90, 0, -90, 0, 0]
+
+[[move]]
+q = [30, -80, 20, -90, 10, 0]
+
+[[move]]
+q = [-20, -100, 40, -70, 0, 30]
+v = 1.5
+a = 3.0
+r = 0.05
+ur_r = 0.02
+"""
+
+
+def _write(tmp_path: Path, text: str, name: str = "task.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_task_file_is_read_in_si_units(tmp_path: Path) -> None:
+    task = load_task(_write(tmp_path, TASK))
+    assert task.robot == "ur5e" and task.moves == 2
+    assert task.waypoints[0] == pytest.approx(np.radians([0, -90, 0, -90, 0, 0]))
+    assert task.waypoints[2] == pytest.approx(np.radians([-20, -100, 40, -70, 0, 30]))
+    assert task.speeds.tolist() == [2.0, 1.5]
+    assert task.accels.tolist() == [4.0, 3.0]
+    assert task.blends.tolist() == [0.0, 0.05]  # rad, not degrees
+    assert task.ur_blends.tolist() == [0.0, 0.02]
+
+
+def test_task_defaults_start_at_the_last_target_and_missing_speeds_are_nan(
+    tmp_path: Path,
+) -> None:
+    task = load_task(_write(tmp_path, "[[move]]\nq = [0.1, 0.2]\n[[move]]\nq = [0.3, -0.1]\n"))
+    assert task.waypoints.tolist() == [[0.3, -0.1], [0.1, 0.2], [0.3, -0.1]]
+    assert np.all(np.isnan(task.speeds)) and np.all(np.isnan(task.accels))
+
+
+def test_builtin_tasks_are_the_papers_test_programs(ur5e: Robot) -> None:
+    task = load_task("test-a", robot=ur5e)
+    assert task.waypoints == pytest.approx(paper_waypoints(ur5e, 1))
+    assert task.speeds.tolist() == [3.0] * 7 and task.accels.tolist() == [6.0] * 7
+    with pytest.raises(KinergyError, match="needs the robot"):
+        load_task("test-b")
+
+
+@pytest.mark.parametrize(
+    ("text", "field"),
+    [
+        ('unit = "grad"\n[[move]]\nq = [0, 0]\n', "unit"),
+        ("speed = 1.0\n", r"no \[\[move\]\]"),
+        ("[[move]]\nv = 1.0\n", r"move\[1\]\.q: missing"),
+        ("[[move]]\nq = [0, 0]\n[[move]]\nq = [0, 0, 0]\n", r"move\[2\]\.q: expected 2"),
+        ("[[move]]\nq = [0, 'a']\n", r"move\[1\]\.q\[1\]"),
+        ("[[move]]\nq = [0, 0]\nv = -1\n", r"move\[1\]\.v: must be > 0"),
+        ("[[move]]\nq = [0, 0]\nr = -0.1\n", r"move\[1\]\.r: must be >= 0"),
+        ("[[move]]\nq = [0, 0]\nspeed = 1\n", r"move\[1\]: unknown field 'speed'"),
+        ("velocity = 1\n[[move]]\nq = [0, 0]\n", "unknown field 'velocity'"),
+        ("start = [0]\n[[move]]\nq = [0, 0]\n", "start: expected 2"),
+        ("[[move]\nq = [0, 0]\n", "not valid TOML"),
+    ],
+)
+def test_task_file_errors_are_one_line_naming_file_and_field(
+    tmp_path: Path, text: str, field: str
+) -> None:
+    path = _write(tmp_path, text)
+    with pytest.raises(KinergyError, match=field) as info:
+        load_task(path)
+    message = str(info.value)
+    assert message.startswith(str(path)) and "\n" not in message
+
+
+def test_task_poses_must_fit_the_robot(tmp_path: Path, ur5e: Robot) -> None:
+    with pytest.raises(KinergyError, match=r"move\[1\]\.q: expected 6 joint angles, got 2"):
+        load_task(_write(tmp_path, "[[move]]\nq = [0, 0]\n"), robot=ur5e)
+    with pytest.raises(KinergyError, match="no such task file"):
+        load_task(tmp_path / "missing.toml")
+
+
+# -- URScript -----------------------------------------------------------------------------------------
+
+_MOVEJ = re.compile(r"^\s*movej\(\[([^\]]*)\], a=([^,]+), v=([^,]+), r=([^)]+)\)$")
+
+
+def test_urscript_movej_program_structure() -> None:
+    rng = np.random.default_rng(3)
+    w = rng.uniform(-2.0, 2.0, (5, 6))
+    w[2, 3] = 1.5e-6  # plain decimals, never an exponent
+    v, a = rng.uniform(0.5, 3.0, 4), rng.uniform(1.0, 20.0, 4)
+    text = movej_program(w, v, a, name="demo", cycle_time=4.2, energy=123.4)
+    lines = text.splitlines()
+    assert lines[0] == "def demo():" and lines[-1] == "end"
+    moves = [
+        _MOVEJ.match(line) for line in lines if "movej(" in line and "a=1.4, v=1.05" not in line
+    ]
+    assert len(moves) == 4 and all(moves)
+    for k, match in enumerate(moves):
+        assert match is not None
+        q = [float(x) for x in match.group(1).split(",")]
+        assert q == pytest.approx(w[k + 1], abs=1e-8)
+        assert float(match.group(2)) == pytest.approx(a[k], rel=1e-8) and float(match.group(2)) > 0
+        assert float(match.group(3)) == pytest.approx(v[k], rel=1e-8) and float(match.group(3)) > 0
+        assert float(match.group(4)) == 0.0
+    first = next(line for line in lines if "movej(" in line)
+    assert "a=1.4, v=1.05" in first  # to the start pose first
+    assert any("4.200 s" in line for line in lines) and any("123.4 J" in line for line in lines)
+    assert all(line.startswith(("def ", "end", "  #", "  movej(")) for line in lines)
+    assert not any(re.search(r"\de", line) for line in lines if "movej(" in line)
+
+
+def test_urscript_refuses_bad_settings_and_writes_atomically(tmp_path: Path) -> None:
+    w = np.zeros((2, 6))
+    w[1, 0] = 1.0
+    with pytest.raises(KinergyError, match="a of move 1"):
+        movej_program(w, 1.0, 0.0)
+    with pytest.raises(KinergyError, match="program name"):
+        movej_program(w, 1.0, 1.0, name="1bad")
+    path = write_script(tmp_path / "out" / "p.script", movej_program(w, 1.0, 1.0))
+    assert path.read_text().startswith("def kinergy_program():")
+    assert [p.name for p in path.parent.iterdir()] == ["p.script"]
+
+
+# -- the command ------------------------------------------------------------------------------------
+
+SMALL = """
+unit = "deg"
+speed = 3.0
+acceleration = 6.0
+start = [0, -90, 0, -90, 0, 0]
+
+[[move]]
+q = [60, -60, 40, -100, 30, 20]
+
+[[move]]
+q = [-30, -110, 70, -80, -20, 90]
+
+[[move]]
+q = [0, -90, 0, -90, 0, 0]
+"""
+
+
+def test_command_json_urscript_and_plot(tmp_path: Path) -> None:
+    task = _write(tmp_path, SMALL)
+    script, plot = tmp_path / "prog.script", tmp_path / "pareto.png"
+    args = ["ur5e", str(task), "--json", "--urscript", str(script), "--plot", str(plot)]
+    result = CliRunner().invoke(optimize, [*args, "--pareto-points", "3"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.output, parse_constant=lambda c: pytest.fail(f"{c} in JSON"))
+    for key in ("cycle_time", "program", "uniform", "optimized", "saving", "pareto"):
+        assert key in out
+    assert [set(m) >= {"v", "a", "duration"} for m in out["optimized"]["moves"]] == [True] * 3
+    assert out["optimized"]["e_elec"] <= out["program"]["e_elec"]
+    assert out["saving"] == pytest.approx(1 - out["optimized"]["e_elec"] / out["program"]["e_elec"])
+    assert out["optimized"]["within_limits"] is True
+    assert len(out["pareto"]) >= 3
+    assert script.read_text().count("movej(") == 4  # the start pose and three moves
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_command_text_report(tmp_path: Path) -> None:
+    task = _write(tmp_path, SMALL)
+    result = CliRunner().invoke(
+        optimize, ["ur5e", str(task), "--cycle-time", "6", "--pareto-points", "0"]
+    )
+    assert result.exit_code == 0, result.output
+    assert "saving:" in result.output and "active limits:" in result.output
+    assert "uniform scaling" in result.output
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (["--cycle-time", "fast"], "--cycle-time"),
+        (["--cycle-time", "0.5"], "shorter than the fastest feasible"),
+        (["--a-max", "-1"], "--a-max"),
+        (["--pareto-points", "0", "--plot", "x.png"], "--plot"),
+    ],
+)
+def test_command_errors_are_one_line_and_leave_no_file(
+    tmp_path: Path, args: list[str], match: str
+) -> None:
+    task = _write(tmp_path, SMALL)
+    script = tmp_path / "prog.script"
+    result = CliRunner().invoke(optimize, ["ur5e", str(task), "--urscript", str(script), *args])
+    assert result.exit_code != 0
+    assert isinstance(result.exception, KinergyError)
+    assert re.search(match, str(result.exception)) and "\n" not in str(result.exception)
+    assert not script.exists()
+
+
+def test_command_bad_task_file(tmp_path: Path) -> None:
+    task = _write(tmp_path, "[[move]]\nq = [0, 0]\n", "bad.toml")
+    script = tmp_path / "prog.script"
+    result = CliRunner().invoke(optimize, ["ur5e", str(task), "--urscript", str(script)])
+    assert result.exit_code == 1
+    assert isinstance(result.exception, KinergyError)
+    message = str(result.exception)
+    assert "bad.toml" in message and "move[1].q" in message and "\n" not in message
+    assert not script.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
