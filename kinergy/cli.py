@@ -857,9 +857,11 @@ def report(
 
 def _register_commands() -> None:
     """Commands that live in their own modules (kinergy.commands)."""
+    from kinergy.commands.excite import excite
     from kinergy.commands.nursing import nursing
     from kinergy.commands.optimize import optimize
 
+    cli.add_command(excite)
     cli.add_command(optimize)
     cli.add_command(nursing)
 
