@@ -756,7 +756,7 @@ def demo(out: str) -> None:
     from kinergy.demo import run_demo
 
     _sections, tables, report, seconds = run_demo(Path(out), _progress())
-    _print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown"])
+    _print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown", "timing"])
     click.echo(f"\nreport: {report} ({seconds:.1f} s)")
 
 

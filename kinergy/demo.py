@@ -6,6 +6,7 @@
    model whose drives are nominal guesses, so every drive parameter has to come from the log.
 3. Validation on test A and the unseen test B (Tables V and VII), energy of both (Table VIII),
    each next to the twin's truth or the doc's values; figures and ``report.html``.
+4. The energy-optimal timing of test A at its own cycle time, with the Pareto front.
 """
 
 from __future__ import annotations
@@ -78,6 +79,8 @@ def run_demo(
         motions[label] = motion_from_log(log, n_joints=truth.n, source="target")
     say("identifying on test A (sequential method, UR5e doc sections 3-4)")
     result = identify_sequential(nominal_drives(truth), [datas["test A"]])
+    from kinergy.io.task import load_task
+
     inputs = StudyInputs(
         model=result.robot,
         validation=datas,
@@ -85,6 +88,7 @@ def run_demo(
         result=result,
         truth=truth,
         paper=True,
+        task=load_task("test-a", robot=result.robot),
     )
     sections, tables = report_sections(inputs, out, say)
     say("writing the report")

@@ -34,7 +34,8 @@ def test_demo_writes_a_report_whose_images_all_exist(demo_run) -> None:
     assert report == out / "report.html" and report.exists()
     parser = _Images()
     parser.feed(report.read_text())
-    assert len(parser.sources) >= 10  # torque and current per test, box plots, power, breakdown
+    assert len(parser.sources) >= 11  # torque, current per test, box plots, power, breakdown, Pareto
+    assert "figures/pareto.png" in parser.sources
     for src in parser.sources:
         assert (out / src).is_file() and (out / src).stat().st_size > 10_000, src
     assert sorted(p.name for p in (out / "logs").iterdir()) == ["test-a.csv", "test-b.csv"]
@@ -42,7 +43,9 @@ def test_demo_writes_a_report_whose_images_all_exist(demo_run) -> None:
 
 def test_demo_prints_the_five_tables_with_comparisons(demo_run) -> None:
     _out, (_sections, tables, _report, _seconds) = demo_run
-    assert {"IV", "V", "VI", "VII", "VIII"} <= set(tables)
+    assert {"IV", "V", "VI", "VII", "VIII", "timing"} <= set(tables)
+    program, _uniform, optimised = tables["timing"][0].rows
+    assert float(optimised[2]) < float(program[2]) and optimised[-1] == "yes"
     assert "twin J_m (Table IV)" in tables["IV"][0].headers
     assert [t.caption[-6:] for t in tables["VII"]] == ["test A", "test B"]
     assert "R² (paper)" in tables["VII"][1].headers

@@ -153,7 +153,9 @@ def _text_report(result: Any, task: Any, pareto: Sequence[Any], robot_name: str)
     return "\n".join(lines)
 
 
-def _figure(result: Any, pareto: Sequence[Any]) -> Any:
+def pareto_figure(result: Any, pareto: Sequence[Any]) -> Any:
+    """The Pareto plot: optimised energy against cycle time, uniform scaling, and the program,
+    its uniform scaling and the optimum marked."""
     from kinergy.report.plots import pareto as pareto_plot
 
     x = np.array([p.cycle_time for p in pareto])
@@ -308,7 +310,7 @@ def optimize(
                 f"the program as written ({result.program.e_elec:.1f} J) at the same cycle time"
             ],
         )
-    figure = _figure(result, front) if plot is not None else None
+    figure = pareto_figure(result, front) if plot is not None else None
 
     written: list[Path] = []
     try:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -44,6 +45,8 @@ class StudyInputs:
         The model a twin was built with, to compare identified parameters against.
     paper : bool
         Compare with the UR5e doc's tables (its tests A and B: names ``"test A"``, ``"test B"``).
+    task : kinergy.io.task.Task, optional
+        A movej program whose energy-optimal timing (and Pareto front) the report shows.
     """
 
     model: Robot
@@ -52,6 +55,7 @@ class StudyInputs:
     result: IdentificationResult | None = None
     truth: Robot | None = None
     paper: bool = False
+    task: Any = None
 
 
 def _f(x: float, digits: int = 4) -> str:
@@ -429,4 +433,61 @@ def report_sections(
                 energy_figs,
             )
         )
+    if inputs.task is not None:
+        say(f"optimising the timing of {inputs.task.name}")
+        section, table = _timing_section(model, inputs.task, figdir)
+        tables["timing"] = [table]
+        sections.append(section)
     return sections, tables
+
+
+def _timing_section(model: Robot, task: Any, figdir: Path) -> tuple[Section, Table]:
+    """Energy-optimal timing of a movej program at its own cycle time, and the Pareto front."""
+    from kinergy.commands.optimize import pareto_figure
+    from kinergy.energy.optimal import optimize_timing, pareto_front, timing_problem
+    from kinergy.report.plots import save
+
+    problem = timing_problem(model, task.waypoints, blends=task.blends)
+    common: dict[str, Any] = {
+        "speeds": task.speeds,
+        "accels": task.accels,
+        "blends": task.blends,
+        "problem": problem,
+    }
+    result = optimize_timing(model, task.waypoints, **common)
+    front = pareto_front(model, task.waypoints, points=6, **common)
+    path = figdir / "pareto.png"
+    save(pareto_figure(result, front), path)
+    rows = []
+    for label, prog in (
+        ("program as written", result.program),
+        ("uniform scaling", result.uniform),
+        ("optimised", result.optimized),
+    ):
+        b = prog.breakdown
+        rows.append(
+            [
+                label,
+                f"{prog.cycle_time:.3f}",
+                f"{prog.e_elec:.1f}",
+                f"{b.get('friction', float('nan')):.1f}",
+                f"{b.get('copper', float('nan')):.1f}",
+                "yes" if prog.ok else "no",
+            ]
+        )
+    saving = 100.0 * (1.0 - result.optimized.e_elec / result.program.e_elec)
+    table = Table(
+        f"Energy-optimal timing of {task.name} at the same cycle time",
+        ["timing", "cycle time [s]", "E_elec [J]", "friction [J]", "copper [J]", "within limits"],
+        rows,
+        f"Saving {saving:.1f} % (re-simulated at 500 Hz, every speed, acceleration, torque and position limit checked at every sample).",
+    )
+    text = (
+        f"Per-move speeds and accelerations of the movej program {task.name} that minimise the model's electrical "
+        "energy at the program's own cycle time (kinergy optimize), and the energy against cycle time."
+    )
+    figure = Figure(
+        f"figures/{path.name}",
+        "Energy against cycle time: optimised timing, uniform time scaling, the program as written.",
+    )
+    return Section("Cutting the energy: optimal timing", text, [table], [figure]), table
