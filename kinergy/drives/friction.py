@@ -49,6 +49,7 @@ __all__ = [
     "friction_torque",
     "hold_standstill",
     "linear_values",
+    "start_parameters",
     "with_linear_parameters",
 ]
 
@@ -308,4 +309,30 @@ def with_linear_parameters(
             out["reducer_coulomb"] = float(value) * (1.0 - share)
         else:
             out[name] = float(value)
+    return out
+
+
+#: shape parameters a fit starts from when a joint switches friction model
+_SHAPE_DEFAULTS = {
+    "smoothing": 1e-3,
+    "gamma2": 50.0,
+    "gamma3": 5.0,
+    "gamma5": 100.0,
+    "stribeck_speed": 10.0,
+    "motor_coulomb": 0.5,
+    "reducer_coulomb": 0.5,
+}
+
+
+def start_parameters(
+    model: str, current_model: str, current: Mapping[str, float]
+) -> dict[str, float]:
+    """Parameters to build a model's regressor columns with before a linear fit: the joint's own
+    when the model is the same, else zero levels and default shape parameters (smoothing 1e-3
+    rad/s, Makkar's and Stribeck's rates); a ``standstill`` hold is carried over."""
+    if current_model == model:
+        return dict(current)
+    out = {name: _SHAPE_DEFAULTS.get(name, 0.0) for name in FRICTION_MODELS[model][0]}
+    if "standstill" in current:
+        out["standstill"] = current["standstill"]
     return out

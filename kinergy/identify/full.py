@@ -66,10 +66,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from kinergy.drives.electrics import drive_state
 from kinergy.drives.friction import (
-    FRICTION_MODELS,
     LINEAR_PARAMETERS,
     friction_columns,
     linear_values,
+    start_parameters,
     with_linear_parameters,
 )
 from kinergy.drives.transmission import transmission_matrix
@@ -341,26 +341,6 @@ def _solve(
     sigma2 = sse / max(rows - p_eff, 1.0)
     std = np.sqrt(sigma2 * np.sum((vt.T * gain) ** 2, axis=1))
     return _Solution(z, std, cond, sse)
-
-
-def _friction_start(model: str, current: Friction) -> dict[str, float]:
-    """Parameters to build a friction model's columns with: the joint's own when the model is the
-    same, else zero levels and default shape parameters (smoothing 1e-3 rad/s, ...)."""
-    if current.model == model:
-        return dict(current.params)
-    defaults = {
-        "smoothing": 1e-3,
-        "gamma2": 50.0,
-        "gamma3": 5.0,
-        "gamma5": 100.0,
-        "stribeck_speed": 10.0,
-        "motor_coulomb": 0.5,
-        "reducer_coulomb": 0.5,
-    }
-    out = {name: defaults.get(name, 0.0) for name in FRICTION_MODELS[model][0]}
-    if "standstill" in current.params:
-        out["standstill"] = current.params["standstill"]
-    return out
 
 
 def _friction_block(
@@ -684,7 +664,10 @@ def identify_full(
     names = ("q_cmd", "qd_cmd", "qdd_cmd") if commanded else ("q", "qd", "qdd")
     q, qd, qdd = (np.vstack([getattr(d, k) for d in datas]) for k in names)
     params = [
-        _friction_start(friction or j.drive.friction.model, j.drive.friction) for j in robot.joints
+        start_parameters(
+            friction or j.drive.friction.model, j.drive.friction.model, j.drive.friction.params
+        )
+        for j in robot.joints
     ]
     models = (
         ["none"] * n if commanded else [friction or j.drive.friction.model for j in robot.joints]

@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 from kinergy.drives.friction import (
     LINEAR_PARAMETERS,
     friction_columns,
+    start_parameters,
     with_linear_parameters,
 )
 from kinergy.drives.transmission import transmission_matrix
@@ -278,7 +279,9 @@ def identify_sequential(
             model = friction or joint.drive.friction.model
             best: tuple[float, Any] | None = None
             for holding in holdings:
-                params = _start_params(model, joint.drive.friction)
+                params = start_parameters(
+                    model, joint.drive.friction.model, joint.drive.friction.params
+                )
                 params.pop("standstill", None)
                 params.pop("holding", None)
                 if holding > 0.0:
@@ -384,22 +387,3 @@ def identify_sequential(
     fit.update(validation_metrics(identified, list(datas)))
     fit["warnings"] = warnings
     return IdentificationResult(identified, "sequential", joints_out, fit)
-
-
-def _start_params(model: str, current: Friction) -> dict[str, float]:
-    """Parameters to build the friction columns with: the joint's own when the model is the same,
-    else defaults for the shape parameters (smoothing 1e-3 rad/s, Makkar's and Stribeck's rates)."""
-    if current.model == model:
-        return dict(current.params)
-    defaults = {
-        "smoothing": 1e-3,
-        "gamma2": 50.0,
-        "gamma3": 5.0,
-        "gamma5": 100.0,
-        "stribeck_speed": 10.0,
-        "motor_coulomb": 0.5,
-        "reducer_coulomb": 0.5,
-    }
-    from kinergy.drives.friction import FRICTION_MODELS
-
-    return {name: defaults.get(name, 0.0) for name in FRICTION_MODELS[model][0]}
