@@ -34,7 +34,8 @@ def test_demo_writes_a_report_whose_images_all_exist(demo_run) -> None:
     assert report == out / "report.html" and report.exists()
     parser = _Images()
     parser.feed(report.read_text())
-    assert len(parser.sources) >= 11  # torque, current per test, box plots, power, breakdown, Pareto
+    # torque and current per test, box plots, power and breakdown per test, Pareto
+    assert len(parser.sources) >= 11
     assert "figures/pareto.png" in parser.sources
     for src in parser.sources:
         assert (out / src).is_file() and (out / src).stat().st_size > 10_000, src
