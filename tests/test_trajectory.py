@@ -117,3 +117,14 @@ def test_fourier_series_derivatives_and_period() -> None:
     assert m.duration == pytest.approx(20.0)
     with pytest.raises(KinergyError, match="coefficients"):
         fourier_series(t, q0, a, b[:, :2], wf)
+
+
+def test_top_level_api_of_design_md() -> None:
+    # DESIGN.md: movej(waypoints, *, speed, acceleration, dt) returning a motion with .t .q .qd .qdd
+    import kinergy
+
+    m = kinergy.movej([[0.0, 0.0], [0.5, -0.2]], speed=1.0, acceleration=2.0, dt=0.01)
+    assert isinstance(m, kinergy.Motion)
+    assert m.q.shape == m.qd.shape == m.qdd.shape == (len(m.t), 2)
+    for name in ("load_robot", "rnea", "regressor", "inertial_parameters", "movej", "energy"):
+        assert callable(getattr(kinergy, name))
