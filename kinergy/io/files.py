@@ -5,13 +5,14 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
+import tomllib
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
 from kinergy.errors import KinergyError
 
-__all__ = ["atomic_write"]
+__all__ = ["atomic_write", "read_toml"]
 
 
 @contextlib.contextmanager
@@ -52,3 +53,25 @@ def atomic_write(
         except OSError as exc:
             raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
     return target
+
+
+def read_toml(path: str | os.PathLike[str], what: str) -> dict[str, Any]:
+    """Parse a TOML file; ``what`` names the kind of file in messages ("robot file").
+
+    Raises
+    ------
+    KinergyError
+        ``PATH: cannot read WHAT (reason)``, ``PATH: not a text (UTF-8) file`` or
+        ``PATH: not valid TOML: ... (line L column C)``.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise KinergyError(f"{path}: cannot read {what} ({exc.strerror})") from None
+    except UnicodeDecodeError:
+        raise KinergyError(f"{path}: not a text (UTF-8) file") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise KinergyError(f"{path}: not valid TOML: {exc}") from None

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 import os
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -41,6 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
+from kinergy.io.files import read_toml
 from kinergy.model.robot import Robot
 
 __all__ = ["BUILTIN_TASKS", "Task", "load_task", "task_from_dict"]
@@ -227,20 +227,11 @@ def load_task(name_or_path: str | os.PathLike[str], *, robot: Robot | None = Non
     if key in BUILTIN_TASKS:
         return _builtin(key, robot)
     path = Path(key)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
+    if not path.exists():
         raise KinergyError(
             f"{path}: no such task file (built-in tasks: {', '.join(BUILTIN_TASKS)})"
-        ) from None
-    except OSError as exc:
-        raise KinergyError(f"{path}: cannot read task file ({exc.strerror})") from None
-    except UnicodeDecodeError:
-        raise KinergyError(f"{path}: not a text (UTF-8) file") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise KinergyError(f"{path}: not valid TOML: {exc}") from None
+        )
+    data = read_toml(path, "task file")
     try:
         return task_from_dict(data, name=path.stem, n_joints=None if robot is None else robot.n)
     except KinergyError as exc:

@@ -50,7 +50,6 @@ Every error names the file and the field, e.g.
 from __future__ import annotations
 
 import os
-import tomllib
 from collections.abc import Callable, Mapping
 from importlib import resources
 from pathlib import Path
@@ -60,7 +59,7 @@ import numpy as np
 import tomli_w
 
 from kinergy.errors import KinergyError
-from kinergy.io.files import atomic_write
+from kinergy.io.files import atomic_write, read_toml
 from kinergy.model.robot import (
     SOURCE_CATEGORIES,
     Drive,
@@ -384,16 +383,7 @@ def read_robot_file(path: str | os.PathLike[str]) -> Robot:
         from kinergy.model.urdf import robot_from_urdf
 
         return robot_from_urdf(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise KinergyError(f"{path}: cannot read robot file ({exc.strerror})") from None
-    except UnicodeDecodeError:
-        raise KinergyError(f"{path}: not a text (UTF-8) file") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise KinergyError(f"{path}: not valid TOML: {exc}") from None
+    data = read_toml(path, "robot file")
     try:
         return robot_from_dict(data)
     except KinergyError as exc:
