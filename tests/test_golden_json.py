@@ -1,0 +1,217 @@
+"""Golden tests: every command's ``--json`` keeps its shape and its numbers.
+
+The files in ``tests/golden/`` were written by the commands as they stood before the package was
+re-laid out (issue 11); a refactor must not change what a command prints. Keys must match
+exactly; numbers to a relative 1e-6 (floating-point operations may be reordered), except the few
+keys that measure wall time or carry paths of the run's temporary folder.
+
+Regenerate (only when a command's output is meant to change, and say why in the commit) with::
+
+    KINERGY_UPDATE_GOLDEN=1 pytest tests/test_golden_json.py
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from kinergy.cli import main
+
+GOLDEN = Path(__file__).parent / "golden"
+UPDATE = os.environ.get("KINERGY_UPDATE_GOLDEN") == "1"
+RTOL = 1e-6
+ATOL = 1e-9
+#: keys whose values depend on the machine or the run (timings, temporary paths)
+VOLATILE = {"seconds", "time", "elapsed", "wall", "timings"}
+
+
+def _compare(got: Any, want: Any, where: str, tol: dict[str, float]) -> list[str]:
+    if isinstance(want, dict):
+        if not isinstance(got, dict):
+            return [f"{where}: expected an object, got {type(got).__name__}"]
+        problems = []
+        if set(got) != set(want):
+            problems.append(
+                f"{where}: keys differ: missing {sorted(set(want) - set(got))}, "
+                f"extra {sorted(set(got) - set(want))}"
+            )
+        for key in set(got) & set(want):
+            if key in VOLATILE:
+                continue
+            problems += _compare(got[key], want[key], f"{where}.{key}", tol)
+        return problems
+    if isinstance(want, list):
+        if not isinstance(got, list) or len(got) != len(want):
+            return [f"{where}: expected a list of {len(want)}, got {got!r:.80}"]
+        out: list[str] = []
+        for k, (g, w) in enumerate(zip(got, want, strict=True)):
+            out += _compare(g, w, f"{where}[{k}]", tol)
+        return out
+    if isinstance(want, str) and isinstance(got, str) and want.startswith("/"):
+        # a file of the run's temporary folder: the same file name
+        return [] if Path(got).name == Path(want).name else [f"{where}: {got!r} != {want!r}"]
+    if isinstance(want, bool) or want is None or isinstance(want, str):
+        return [] if got == want else [f"{where}: {got!r} != {want!r}"]
+    if isinstance(want, int | float):
+        if isinstance(got, bool) or not isinstance(got, int | float):
+            return [f"{where}: expected a number, got {got!r}"]
+        rtol = tol.get(where.rsplit(".", 1)[-1], RTOL)
+        if math.isnan(want):
+            return [] if math.isnan(got) else [f"{where}: {got!r} != nan"]
+        if math.isclose(got, want, rel_tol=rtol, abs_tol=ATOL):
+            return []
+        return [f"{where}: {got!r} != {want!r}"]
+    return [f"{where}: unexpected value {want!r}"]
+
+
+def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> Any:
+    capsys.readouterr()
+    status = main(argv)
+    out = capsys.readouterr().out
+    assert status == 0, f"kinergy {' '.join(argv)} exited {status}"
+    return json.loads(out)
+
+
+def _check(name: str, got: Any, tol: dict[str, float] | None = None) -> None:
+    path = GOLDEN / f"{name}.json"
+    if UPDATE:
+        GOLDEN.mkdir(exist_ok=True)
+        path.write_text(json.dumps(got, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+        return
+    want = json.loads(path.read_text(encoding="utf-8"))
+    problems = _compare(got, want, name, tol or {})
+    assert not problems, "\n".join(problems[:20])
+
+
+@pytest.fixture(scope="module")
+def twin_logs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    folder = tmp_path_factory.mktemp("golden")
+    logs = {"a": folder / "test-a.csv", "b": folder / "test-b.csv"}
+    assert main(["simulate", "ur5e", "--trajectory", "test-a", "--out", str(logs["a"])]) == 0
+    assert (
+        main(["simulate", "ur5e", "--trajectory", "test-b", "--out", str(logs["b"]), "--seed", "3"])
+        == 0
+    )
+    logs["folder"] = folder
+    return logs
+
+
+def test_robot_list_and_show(capsys: pytest.CaptureFixture[str]) -> None:
+    _check("robot_list", _run(["robot", "list", "--json"], capsys))
+    for name in ("ur5e", "nursing-arm", "panda"):
+        _check(f"robot_show_{name}", _run(["robot", "show", name, "--json"], capsys))
+    _check(
+        "robot_show_ur5e_payload",
+        _run(["robot", "show", "ur5e", "--json", "--payload", "2.5,0,0.01,0.05"], capsys),
+    )
+
+
+def test_energy(twin_logs: dict[str, Path], capsys: pytest.CaptureFixture[str]) -> None:
+    _check("energy_test_a", _run(["energy", "ur5e", str(twin_logs["a"]), "--json"], capsys))
+    _check(
+        "energy_test_a_no_recovery",
+        _run(["energy", "ur5e", str(twin_logs["a"]), "--json", "--no-recovery"], capsys),
+    )
+
+
+def test_identify_and_validate(
+    twin_logs: dict[str, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    folder = twin_logs["folder"]
+    model = folder / "seq.toml"
+    a, b = str(twin_logs["a"]), str(twin_logs["b"])
+    _check(
+        "identify_sequential",
+        _run(["identify", a, "--robot", "ur5e", "--out", str(model), "--json"], capsys),
+    )
+    _check("validate_sequential", _run(["validate", str(model), b, "--json"], capsys))
+    _check(
+        "identify_full",
+        _run(
+            ["identify", a, b, "--robot", "ur5e", "--method", "full", "--json"]
+            + ["--out", str(folder / "full.toml")],
+            capsys,
+        ),
+    )
+    _check(
+        "identify_full_current",
+        _run(
+            ["identify", a, b, "--robot", "ur5e", "--method", "full", "--target", "current"]
+            + ["--json", "--out", str(folder / "full-current.toml")],
+            capsys,
+        ),
+    )
+
+
+def test_payload(twin_logs: dict[str, Path], capsys: pytest.CaptureFixture[str]) -> None:
+    folder = twin_logs["folder"]
+    loaded = folder / "loaded.csv"
+    assert (
+        main(
+            ["simulate", "ur5e", "--trajectory", "test-a", "--out", str(loaded)]
+            + ["--payload", "2.0,0.01,-0.02,0.05"]
+        )
+        == 0
+    )
+    _check(
+        "identify_payload",
+        _run(
+            ["identify", str(loaded), "--robot", "ur5e", "--payload-only", "--json"]
+            + ["--out", str(folder / "with-payload.toml")],
+            capsys,
+        ),
+    )
+
+
+def test_optimize(capsys: pytest.CaptureFixture[str]) -> None:
+    _check(
+        "optimize_test_a",
+        _run(["optimize", "ur5e", "test-a", "--json", "--pareto-points", "3"], capsys),
+        # the optimum comes from an iterative solver whose last digits follow the arithmetic
+        tol={"e_elec": 1e-4, "v": 1e-3, "a": 1e-3, "t": 1e-3, "energy": 1e-4, "saving": 1e-3},
+    )
+
+
+def test_excite(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _check(
+        "excite_small",
+        _run(
+            ["excite", "ur5e", "--harmonics", "3", "--period", "6", "--starts", "1"]
+            + ["--maxiter", "20", "--samples", "80", "--quiet", "--json"]
+            + ["--out", str(tmp_path / "exc.csv")],
+            capsys,
+        ),
+        tol={"condition": 1e-4, "a": 1e-4, "b": 1e-4},
+    )
+
+
+def test_nursing(capsys: pytest.CaptureFixture[str]) -> None:
+    _check("nursing_exact", _run(["nursing", "--exact", "--json"], capsys), tol={})
+
+
+DATASETS = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "ur10e-innopolis"
+UR10E_COLUMNS = "timestamp,actual_q:6,actual_qd:6,actual_current:6,target_current:6,target_moment:6"
+
+
+@pytest.mark.skipif(not DATASETS.exists(), reason="shared datasets not available")
+def test_ur10e_real_logs(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    fourier = str(DATASETS / "identification_data" / "ur-20_02_12-50sec_12harm.csv")
+    held_out = str(DATASETS / "validation_data" / "ur-20_01_17-ptp_10_points.csv")
+    model = tmp_path / "ur10e.toml"
+    _check(
+        "ur10e_identify_sequential",
+        _run(
+            ["identify", fourier, "--robot", "ur10e", "--columns", UR10E_COLUMNS]
+            + ["--out", str(model), "--json"],
+            capsys,
+        ),
+    )
+    _check(
+        "ur10e_validate",
+        _run(["validate", str(model), held_out, "--columns", UR10E_COLUMNS, "--json"], capsys),
+    )
