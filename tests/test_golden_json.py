@@ -133,16 +133,38 @@ def test_identify_and_validate(
     _check(
         "identify_full",
         _run(
-            ["identify", a, b, "--robot", "ur5e", "--method", "full", "--json"]
-            + ["--out", str(folder / "full.toml")],
+            [
+                "identify",
+                a,
+                b,
+                "--robot",
+                "ur5e",
+                "--method",
+                "full",
+                "--json",
+                "--out",
+                str(folder / "full.toml"),
+            ],
             capsys,
         ),
     )
     _check(
         "identify_full_current",
         _run(
-            ["identify", a, b, "--robot", "ur5e", "--method", "full", "--target", "current"]
-            + ["--json", "--out", str(folder / "full-current.toml")],
+            [
+                "identify",
+                a,
+                b,
+                "--robot",
+                "ur5e",
+                "--method",
+                "full",
+                "--target",
+                "current",
+                "--json",
+                "--out",
+                str(folder / "full-current.toml"),
+            ],
             capsys,
         ),
     )
@@ -153,16 +175,32 @@ def test_payload(twin_logs: dict[str, Path], capsys: pytest.CaptureFixture[str])
     loaded = folder / "loaded.csv"
     assert (
         main(
-            ["simulate", "ur5e", "--trajectory", "test-a", "--out", str(loaded)]
-            + ["--payload", "2.0,0.01,-0.02,0.05"]
+            [
+                "simulate",
+                "ur5e",
+                "--trajectory",
+                "test-a",
+                "--out",
+                str(loaded),
+                "--payload",
+                "2.0,0.01,-0.02,0.05",
+            ]
         )
         == 0
     )
     _check(
         "identify_payload",
         _run(
-            ["identify", str(loaded), "--robot", "ur5e", "--payload-only", "--json"]
-            + ["--out", str(folder / "with-payload.toml")],
+            [
+                "identify",
+                str(loaded),
+                "--robot",
+                "ur5e",
+                "--payload-only",
+                "--json",
+                "--out",
+                str(folder / "with-payload.toml"),
+            ],
             capsys,
         ),
     )
@@ -181,9 +219,24 @@ def test_excite(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     _check(
         "excite_small",
         _run(
-            ["excite", "ur5e", "--harmonics", "3", "--period", "6", "--starts", "1"]
-            + ["--maxiter", "20", "--samples", "80", "--quiet", "--json"]
-            + ["--out", str(tmp_path / "exc.csv")],
+            [
+                "excite",
+                "ur5e",
+                "--harmonics",
+                "3",
+                "--period",
+                "6",
+                "--starts",
+                "1",
+                "--maxiter",
+                "20",
+                "--samples",
+                "80",
+                "--quiet",
+                "--json",
+                "--out",
+                str(tmp_path / "exc.csv"),
+            ],
             capsys,
         ),
         tol={"condition": 1e-4, "a": 1e-4, "b": 1e-4},
@@ -206,8 +259,17 @@ def test_ur10e_real_logs(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     _check(
         "ur10e_identify_sequential",
         _run(
-            ["identify", fourier, "--robot", "ur10e", "--columns", UR10E_COLUMNS]
-            + ["--out", str(model), "--json"],
+            [
+                "identify",
+                fourier,
+                "--robot",
+                "ur10e",
+                "--columns",
+                UR10E_COLUMNS,
+                "--out",
+                str(model),
+                "--json",
+            ],
             capsys,
         ),
     )
