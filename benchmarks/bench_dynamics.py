@@ -27,7 +27,7 @@ per-sample C++ calls is what a Python user of Pinocchio writes; the loop overhea
 nanoseconds per call) is part of that cost and is reported, not hidden. Both sides produce the same
 output array (same shape, freshly allocated for the regressor), both are warmed up first (numba JIT
 and its on-disk cache, Pinocchio's first calls), and the Pinocchio model is built by
-``kinergy.model.pinocchio.to_pinocchio`` so that both compute the same physics, which is checked on
+``kinergy.dynamics.pinocchio.to_pinocchio`` so that both compute the same physics, which is checked on
 the benchmark states before any timing is trusted. The regressor *columns* of the two libraries only
 coincide when link frames equal joint frames, so the regressor is checked through its product with
 the inertial parameters, ``Y @ inertial_parameters(robot)``, against Pinocchio's RNEA.
@@ -50,7 +50,7 @@ import numba
 import numpy as np
 
 import kinergy
-from kinergy.model.pinocchio import to_pinocchio
+from kinergy.dynamics.pinocchio import to_pinocchio
 
 try:
     import pinocchio as pin

@@ -18,7 +18,7 @@ import statistics
 import time
 
 import kinergy
-from kinergy.energy.optimal import optimize_timing, pareto_front, timing_problem
+from kinergy.optimize.timing import optimize_timing, pareto_front, timing_problem
 from kinergy.simulate import paper_waypoints
 
 

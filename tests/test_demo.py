@@ -10,7 +10,7 @@ import pytest
 
 import kinergy
 from kinergy.cli import main
-from kinergy.demo import nominal_drives, run_demo
+from kinergy.workflows.demo import nominal_drives, run_demo
 
 
 class _Images(HTMLParser):

@@ -15,7 +15,7 @@ from conftest import random_state
 
 import kinergy
 from kinergy.drives.electrics import drive_state, electrical_power
-from kinergy.drives.friction import FRICTION_MODELS, friction_torque
+from kinergy.friction.registry import FRICTION_MODELS, friction_torque
 from kinergy.drives.transmission import (
     coupled_joint_dynamics,
     joint_torque,
@@ -30,7 +30,7 @@ from kinergy.simulate import paper_trajectory
 from kinergy.trajectory.motion import Motion
 
 pin = pytest.importorskip("pinocchio")
-from kinergy.model.pinocchio import to_pinocchio  # noqa: E402
+from kinergy.dynamics.pinocchio import to_pinocchio  # noqa: E402
 
 PARAMS = {
     "none": {},
@@ -325,7 +325,7 @@ def test_electrical_power_formula_directly(ur5e: Robot) -> None:
 
 @pytest.mark.parametrize("model", sorted(FRICTION_MODELS))
 def test_friction_columns_reproduce_the_model(model: str) -> None:
-    from kinergy.drives.friction import LINEAR_PARAMETERS, friction_columns, with_linear_parameters
+    from kinergy.friction.registry import LINEAR_PARAMETERS, friction_columns, with_linear_parameters
 
     rng = np.random.default_rng(12)
     wm = rng.normal(0, 50, 300)

@@ -17,7 +17,7 @@ import kinergy
 from kinergy.dynamics.kinematics import flange_pose, jacobian, link_poses
 
 pin = pytest.importorskip("pinocchio")
-from kinergy.model.pinocchio import to_pinocchio  # noqa: E402
+from kinergy.dynamics.pinocchio import to_pinocchio  # noqa: E402
 
 ORACLE_ROBOTS = ["ur5e", "ur10e", "nursing-arm"]
 PAYLOAD = kinergy.Payload(

@@ -17,7 +17,7 @@ import kinergy
 from kinergy.model import Drive, Friction, Joint, Limits, Link, Robot
 
 pin = pytest.importorskip("pinocchio")
-from kinergy.model.pinocchio import to_pinocchio  # noqa: E402
+from kinergy.dynamics.pinocchio import to_pinocchio  # noqa: E402
 
 DRIVE = Drive(
     gear_ratio=100.0,

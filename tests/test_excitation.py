@@ -30,13 +30,13 @@ from click.testing import CliRunner
 
 import kinergy
 from kinergy.cli import main as cli_main
-from kinergy.commands.excite import excite
+from kinergy.cli.excite import excite
 from kinergy.identify.full import identify_full, parameter_scale
 from kinergy.identify.preprocess import prepare
 from kinergy.io.rtde import Log, read_log
 from kinergy.io.urscript import servoj_program
 from kinergy.simulate import TwinSettings, simulate
-from kinergy.trajectory.excitation import (
+from kinergy.experiments.excitation import (
     Excitation,
     ExcitationProblem,
     design_excitation,

@@ -13,7 +13,7 @@ import pytest
 from click.testing import CliRunner
 
 import kinergy
-from kinergy.commands import nursing as nursing_cmd
+from kinergy.cli import nursing as nursing_cmd
 from kinergy.drives.transmission import joint_torque, motor_speed, transmission_matrix
 from kinergy.dynamics.regressor import base_parameters, inertial_parameters, regressor
 from kinergy.errors import KinergyError

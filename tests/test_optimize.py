@@ -13,10 +13,10 @@ import pytest
 from click.testing import CliRunner
 
 import kinergy
-from kinergy.commands.optimize import optimize
+from kinergy.cli.optimize import optimize
 from kinergy.drives.electrics import drive_state
 from kinergy.drives.transmission import joint_torque
-from kinergy.energy.optimal import (
+from kinergy.optimize.timing import (
     limit_violations,
     optimize_timing,
     pareto_front,

@@ -15,7 +15,7 @@ from kinergy.io.rtde import read_log
 from kinergy.simulate import TwinSettings, paper_trajectory, paper_waypoints, simulate
 
 pin = pytest.importorskip("pinocchio")
-from kinergy.model.pinocchio import to_pinocchio  # noqa: E402
+from kinergy.dynamics.pinocchio import to_pinocchio  # noqa: E402
 
 
 @pytest.fixture(scope="module")

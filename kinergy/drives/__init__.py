@@ -1,5 +1,1 @@
-"""Drives: transmissions, friction models and the motor's electrical model (motor side)."""
-
-from kinergy.drives.friction import FRICTION_MODELS, check_friction, friction_torque
-
-__all__ = ["FRICTION_MODELS", "check_friction", "friction_torque"]
+"""Drives: transmissions (coupled joints too) and the motor's electrical model (motor side)."""

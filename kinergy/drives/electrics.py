@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from kinergy.drives.friction import friction_torque
+from kinergy.friction.registry import friction_torque
 from kinergy.drives.transmission import reflected_inertia, transmission_matrix
 from kinergy.dynamics.chain import check_state
 from kinergy.dynamics.rnea import gravity_torque, rnea

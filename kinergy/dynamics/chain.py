@@ -111,7 +111,7 @@ _E3 = np.diag([0.0, 0.0, 1.0])
 
 
 def kernel_geometry(chain: Chain) -> tuple[Array, Array, Array, Array, Array, Array, Array, Array]:
-    """Constants for :mod:`kinergy.dynamics.newton_euler`: ``(A, B, C, pa, pb, pc, axis, axis_v)``
+    """Constants for :mod:`kinergy.dynamics._kernels`: ``(A, B, C, pa, pb, pc, axis, axis_v)``
     with the pose of F_i in F_{i-1} ``R_i = c A_i + s B_i + C_i``, ``p_i = c pa_i + s pb_i + pc_i``
     and the motion subspace ``S_i = (axis_i, point_i x axis_i)``."""
     rp, pp = chain.pre[:, :3, :3], chain.pre[:, :3, 3]

@@ -12,7 +12,7 @@ paper's ridge regression)::
 - ``N^T diag(J) N qdd``: motor plus reducer inertias ``J = J_m + J_r`` (motor side, kg m^2)
   reflected through the transmission ``N`` (UR5e eq 2, ``i^2 (J_m + J_r) qdd`` for a UR joint);
 - ``N^T F(wm) phi``: motor-side friction, ``F`` the columns of each joint's friction model
-  (:func:`kinergy.drives.friction.friction_columns`) at the motor speeds ``wm = N qd`` and ``phi``
+  (:func:`kinergy.friction.registry.friction_columns`) at the motor speeds ``wm = N qd`` and ``phi``
   its linear parameters; shape parameters (smoothing, Stribeck speed, ...) stay the model's.
 
 ``tau`` is the signal chosen by ``target``:
@@ -65,7 +65,7 @@ import scipy.optimize
 from numpy.typing import ArrayLike, NDArray
 
 from kinergy.drives.electrics import drive_state
-from kinergy.drives.friction import (
+from kinergy.friction.registry import (
     LINEAR_PARAMETERS,
     friction_columns,
     linear_values,
@@ -403,7 +403,7 @@ def _power_flow_load(
     Parameters
     ----------
     values : list of ndarray
-        Each motor's friction levels (:data:`kinergy.drives.friction.LINEAR_PARAMETERS`).
+        Each motor's friction levels (:data:`kinergy.friction.registry.LINEAR_PARAMETERS`).
     wm, dwm, tau_m, previous : ndarray, shape (N, n)
         Motor speeds (rad/s), accelerations (rad/s^2), measured motor torques and the loads of the
         previous pass (N m, motor side).

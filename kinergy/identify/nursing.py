@@ -60,7 +60,7 @@ import scipy.optimize
 from numpy.typing import ArrayLike, NDArray
 
 from kinergy.drives.electrics import friction_torques, torque_constants
-from kinergy.drives.friction import FRICTION_MODELS
+from kinergy.friction.registry import FRICTION_MODELS
 from kinergy.drives.transmission import reflected_inertia, transmission_matrix
 from kinergy.dynamics.chain import make_chain
 from kinergy.dynamics.kinematics import joint_axes

@@ -9,7 +9,7 @@
 3. Torque constant and friction of every motor together from the measured current (eqs 17-18):
    the current is linear in ``1/k_t`` (times the load torque from step 2's model) and in the
    friction parameters over ``k_t``. Any friction model linear in its parameters can be used
-   (:data:`kinergy.drives.friction.LINEAR_PARAMETERS`); the UR5e doc's is ``power_flow``.
+   (:data:`kinergy.friction.registry.LINEAR_PARAMETERS`); the UR5e doc's is ``power_flow``.
 4. Motor inertia = rotor inertia - the model's reducer inertia (Table IV).
 
 Real controllers add one thing the seed does not model: a joint that stops stays in stiction,
@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from kinergy.drives.friction import (
+from kinergy.friction.registry import (
     LINEAR_PARAMETERS,
     friction_columns,
     start_parameters,

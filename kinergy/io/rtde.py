@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
-from kinergy.io.files import atomic_write
+from kinergy.files import atomic_write
 
 __all__ = ["Log", "parse_columns", "read_log", "write_log"]
 

@@ -40,7 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
-from kinergy.io.files import read_toml
+from kinergy.files import read_toml
 from kinergy.model.robot import Robot
 
 __all__ = ["BUILTIN_TASKS", "Task", "load_task", "task_from_dict"]

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kinergy.errors import KinergyError
-from kinergy.io.files import atomic_write
+from kinergy.files import atomic_write
 
 __all__ = ["movej_program", "write_script"]
 

@@ -1,6 +1,6 @@
 """Robot models as data: dataclasses, robot files (TOML, URDF) and the built-in library."""
 
-from kinergy.model.io import (
+from kinergy.model.toml import (
     library_names,
     load_robot,
     parse_payload,

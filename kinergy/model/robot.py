@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from kinergy.drives.friction import check_friction
+from kinergy.friction.registry import check_friction
 from kinergy.errors import KinergyError
 
 __all__ = [
@@ -169,7 +169,7 @@ class Payload:
 
 @dataclass(frozen=True, eq=False)
 class Friction:
-    """A friction model (see :mod:`kinergy.drives.friction`) and its motor-side parameters."""
+    """A friction model (see :mod:`kinergy.friction.registry`) and its motor-side parameters."""
 
     model: str
     params: Mapping[str, float]

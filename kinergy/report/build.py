@@ -443,8 +443,8 @@ def report_sections(
 
 def _timing_section(model: Robot, task: Any, figdir: Path) -> tuple[Section, Table]:
     """Energy-optimal timing of a movej program at its own cycle time, and the Pareto front."""
-    from kinergy.commands.optimize import pareto_figure
-    from kinergy.energy.optimal import optimize_timing, pareto_front, timing_problem
+    from kinergy.cli.optimize import pareto_figure
+    from kinergy.optimize.timing import optimize_timing, pareto_front, timing_problem
     from kinergy.report.plots import save
 
     problem = timing_problem(model, task.waypoints, blends=task.blends)

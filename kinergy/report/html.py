@@ -39,7 +39,7 @@ from typing import Any
 from urllib.parse import quote
 
 from kinergy.errors import KinergyError
-from kinergy.io.files import atomic_write
+from kinergy.files import atomic_write
 
 __all__ = ["Figure", "Section", "Table", "write_report"]
 

@@ -34,7 +34,7 @@ from scipy.integrate import cumulative_trapezoid
 
 from kinergy.errors import KinergyError
 from kinergy.identify.metrics import r_squared
-from kinergy.io.files import atomic_write
+from kinergy.files import atomic_write
 
 __all__ = [
     "DPI",

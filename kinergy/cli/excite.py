@@ -1,7 +1,7 @@
 """``kinergy excite``: an optimised Fourier excitation for identification, written as a motion file
 and optionally as a URScript servoj program.
 
-Designs the trajectory with :func:`kinergy.trajectory.excitation.design_excitation` (nursing eqs
+Designs the trajectory with :func:`kinergy.experiments.excitation.design_excitation` (nursing eqs
 22-23: Fourier series, zero speed and acceleration at both ends, joint, speed, acceleration and
 floor limits, minimum condition number or D-optimality of the stacked regressor), reports its
 condition number and constraint margins, and writes ``--periods`` repeats of it at 500 Hz in
@@ -11,7 +11,7 @@ feasible Fourier trajectories of the same size and prints their median condition
 
 Register it in ``kinergy/cli.py`` with::
 
-    from kinergy.commands.excite import excite
+    from kinergy.cli.excite import excite
     cli.add_command(excite)
 """
 
@@ -215,7 +215,7 @@ def excite(
     from kinergy.io.rtde import write_log
     from kinergy.io.urscript import servoj_program, write_script
     from kinergy.model import load_robot
-    from kinergy.trajectory.excitation import (
+    from kinergy.experiments.excitation import (
         design_excitation,
         excitation_problem,
         random_feasible,

@@ -60,7 +60,7 @@ parameters of robots", IJRR 11(4), 1992.
 Examples
 --------
 >>> import kinergy
->>> from kinergy.trajectory.excitation import design_excitation, excitation_problem
+>>> from kinergy.experiments.excitation import design_excitation, excitation_problem
 >>> problem = excitation_problem(kinergy.load_robot("ur5e"), harmonics=3, samples=60)
 >>> best = design_excitation(problem, starts=1, maxiter=20)
 >>> bool(best.margins["speed"] >= 0 and best.margins["floor"] >= 0)

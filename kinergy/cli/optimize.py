@@ -2,14 +2,14 @@
 
 Given a model and a task (the waypoints of a movej program, :mod:`kinergy.io.task`), finds the
 per-move ``v`` and ``a`` that minimise the model's electrical energy at a cycle time
-(:func:`kinergy.energy.optimal.optimize_timing`), compares them with the program as written and
+(:func:`kinergy.optimize.timing.optimize_timing`), compares them with the program as written and
 with uniform time scaling, verifies all three by re-simulating them at 500 Hz, and computes the
 Pareto front of energy against cycle time. Optionally writes the optimum as a URScript program
 and the Pareto plot.
 
 Register it in ``kinergy/cli.py`` with::
 
-    from kinergy.commands.optimize import optimize
+    from kinergy.cli.optimize import optimize
     cli.add_command(optimize)
 """
 
@@ -262,7 +262,7 @@ def optimize(
     written and with uniform time scaling to the same cycle time, all re-simulated at 500 Hz
     with every speed, acceleration, torque and position limit checked at every sample.
     """
-    from kinergy.energy.optimal import optimize_timing, pareto_front, timing_problem
+    from kinergy.optimize.timing import optimize_timing, pareto_front, timing_problem
     from kinergy.io.task import load_task
     from kinergy.io.urscript import movej_program, write_script
     from kinergy.model import load_robot, parse_payload

@@ -21,7 +21,7 @@ from kinergy.identify.preprocess import prepare
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.motion import motion_from_log
 from kinergy.io.rtde import read_log, write_log
-from kinergy.model.io import load_robot
+from kinergy.model.toml import load_robot
 from kinergy.model.robot import Friction, Robot
 from kinergy.report.build import StudyInputs, report_sections
 from kinergy.report.html import Section, Table, write_report

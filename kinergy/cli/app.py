@@ -753,7 +753,7 @@ def demo(out: str) -> None:
     and B, compute the energy, print UR5e Tables IV-VIII and write an HTML report."""
     from pathlib import Path
 
-    from kinergy.demo import run_demo
+    from kinergy.workflows.demo import run_demo
 
     _sections, tables, report, seconds = run_demo(Path(out), _progress())
     _print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown", "timing"])
@@ -857,9 +857,9 @@ def report(
 
 def _register_commands() -> None:
     """Commands that live in their own modules (kinergy.commands)."""
-    from kinergy.commands.excite import excite
-    from kinergy.commands.nursing import nursing
-    from kinergy.commands.optimize import optimize
+    from kinergy.cli.excite import excite
+    from kinergy.cli.nursing import nursing
+    from kinergy.cli.optimize import optimize
 
     cli.add_command(excite)
     cli.add_command(optimize)

@@ -59,7 +59,7 @@ import numpy as np
 import tomli_w
 
 from kinergy.errors import KinergyError
-from kinergy.io.files import atomic_write, read_toml
+from kinergy.files import atomic_write, read_toml
 from kinergy.model.robot import (
     SOURCE_CATEGORIES,
     Drive,

@@ -1,1 +1,0 @@
-"""Sub-commands of the ``kinergy`` command that live in their own modules."""
