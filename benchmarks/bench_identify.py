@@ -43,11 +43,11 @@ def main() -> None:
         base_frequency=2 * np.pi / 10,
         periods=3,
     )
-    signals = simulate(robot, motion, TwinSettings(seed=1))
-    t = signals.pop("timestamp")
+    twin = simulate(robot, motion, TwinSettings(seed=1))
+    t = twin.t
     folder = Path(tempfile.mkdtemp())
     path = args.keep or folder / "excitation.csv"
-    write_log(path, t, signals)
+    write_log(path, twin.t, twin.signals)
     steps: dict[str, list[float]] = {"read_log": [], "prepare": [], "sequential": [], "total": []}
     if args.full:
         steps["full"] = []

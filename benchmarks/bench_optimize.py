@@ -1,6 +1,6 @@
 """Time the energy-optimal timing of a movej program on the UR5e (issue bar: under 10 s).
 
-Test A of the UR5e doc (:func:`kinergy.simulate.paper_waypoints`, seed 1): home, six random
+Test A of the UR5e doc (:func:`kinergy.trajectory.programs.paper_waypoints`, seed 1): home, six random
 points, home, at 3 rad/s and 6 rad/s^2 -- seven moves with the return home -- and the six-move
 task without the return. Each run is what ``kinergy optimize`` does for one cycle time: build the
 problem (caps, the torque-limited accelerations), solve it at the program's own cycle time, and
@@ -19,7 +19,7 @@ import time
 
 import kinergy
 from kinergy.optimize.timing import optimize_timing, pareto_front, timing_problem
-from kinergy.simulate import paper_waypoints
+from kinergy.trajectory.programs import paper_waypoints
 
 
 def main() -> None:

@@ -14,10 +14,8 @@ Given a robot model and a commanded (target) motion, the twin produces, at the c
   voltage);
 - ``robot_mode`` 7 (running) and ``runtime_state`` 2 (playing), as a program run logs them.
 
-``test-a`` and ``test-b`` are the UR5e doc's experiments (section 2.2): a movej program from the
-home pose through six random points and back, joint speed 3 rad/s, acceleration 6 rad/s^2 (capped
-by the robot's joint limits), seeded (seeds 1 and 2) so they are reproducible, with points drawn until the flange and the elbow stay
-above the table plane over the whole motion.
+The UR5e doc's test programs A and B that the twin usually runs are in
+:mod:`kinergy.trajectory.programs`.
 """
 
 from __future__ import annotations
@@ -28,27 +26,15 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
-from kinergy.drives.electrics import drive_state
-from kinergy.dynamics.kinematics import link_poses
 from kinergy.errors import KinergyError
+from kinergy.io.log import Log
 from kinergy.model.robot import Robot
+from kinergy.predict import drive_state
 from kinergy.trajectory.motion import Motion
-from kinergy.trajectory.movej import movej
 
-__all__ = [
-    "TEST_TRAJECTORIES",
-    "TwinSettings",
-    "paper_trajectory",
-    "paper_waypoints",
-    "simulate",
-]
+__all__ = ["TwinSettings", "simulate"]
 
 Array = NDArray[np.float64]
-
-#: name -> seed of the UR5e doc's test programs
-TEST_TRAJECTORIES = {"test-a": 1, "test-b": 2}
-
-_HOME = np.array([0.0, -np.pi / 2, 0.0, -np.pi / 2, 0.0, 0.0])
 
 
 @dataclass(frozen=True)
@@ -87,94 +73,6 @@ class TwinSettings:
         return cls(lag=0.0, speed_noise=0.0, position_noise=0.0, current_noise=0.0)
 
 
-def _above_table(robot: Robot, q: Array, floor: float) -> bool:
-    frames = link_poses(robot, q)  # (N, n, 4, 4)
-    heights = frames[:, 2:, 2, 3]  # elbow onwards
-    return bool(np.all(heights > floor))
-
-
-def paper_speed(robot: Robot) -> tuple[float, float]:
-    """The test programs' movej speed and acceleration: the UR5e doc's 3 rad/s and 6 rad/s^2,
-    capped by the robot's slowest joint limits (so other arms run them within their limits)."""
-    speed = min([3.0] + [j.limits.speed for j in robot.joints])
-    acc = min(
-        [6.0] + [j.limits.acceleration for j in robot.joints if j.limits.acceleration is not None]
-    )
-    return speed, acc
-
-
-def paper_waypoints(robot: Robot, seed: int, *, points: int = 6, floor: float = 0.05) -> Array:
-    """Home, ``points`` random joint targets, home: the UR5e doc's test programs (section 2.2).
-
-    Targets are drawn (seeded) with the base and wrists anywhere in +-pi, the shoulder in
-    [-pi, 0] and the elbow in +-2.5 rad (within the robot's joint limits), and redrawn until every link frame from the elbow on stays
-    above ``floor`` (m) over the whole movej at 3 rad/s and 6 rad/s^2.
-
-    Returns
-    -------
-    ndarray, shape (points + 2, n)
-    """
-    if robot.n != 6:
-        raise KinergyError(
-            f"the test programs are for 6-joint arms; {robot.name} has {robot.n} joints"
-        )
-    rng = np.random.default_rng(seed)
-    limits = np.array([j.limits.position for j in robot.joints])
-    lo = np.maximum([-np.pi, -np.pi, -2.5, -np.pi, -np.pi, -np.pi], limits[:, 0])
-    hi = np.minimum([np.pi, 0.0, 2.5, np.pi, np.pi, np.pi], limits[:, 1])
-    if np.any(lo >= hi):
-        raise KinergyError(f"the test programs' joint ranges do not fit {robot.name}'s limits")
-    speed, acc = paper_speed(robot)
-    home = np.clip(_HOME, lo, hi)
-    if not _above_table(robot, home[None, :], floor):
-        floor = -np.inf  # an arm whose home pose is not above a table (a mobile or hanging arm)
-    way = [home]
-    for _ in range(2000):
-        if len(way) == points + 1:
-            break
-        candidate = rng.uniform(lo, hi)
-        leg = movej(np.vstack([way[-1], candidate]), speed=speed, acceleration=acc, dt=0.02)
-        if _above_table(robot, leg.q, floor):
-            way.append(candidate)
-    else:
-        raise KinergyError(
-            f"could not draw {points} test points that keep {robot.name} above the table"
-        )
-    home_leg = movej(np.vstack([way[-1], home]), speed=speed, acceleration=acc, dt=0.02)
-    if not _above_table(robot, home_leg.q, floor):  # pragma: no cover - depends on the draw
-        return paper_waypoints(robot, seed + 1000, points=points, floor=floor)
-    way.append(home)
-    return np.vstack(way)
-
-
-def paper_trajectory(robot: Robot, name: str, *, dt: float = 0.002, rest: float = 0.2) -> Motion:
-    """``test-a`` or ``test-b`` as a target motion at ``dt`` (with ``rest`` s still at each end)."""
-    if name not in TEST_TRAJECTORIES:
-        raise KinergyError(
-            f"unknown test trajectory {name!r} (known: {', '.join(TEST_TRAJECTORIES)})"
-        )
-    waypoints = paper_waypoints(robot, TEST_TRAJECTORIES[name])
-    speed, acc = paper_speed(robot)
-    motion = movej(waypoints, speed=speed, acceleration=acc, dt=dt)
-    return pad_rest(motion, rest, dt)
-
-
-def pad_rest(motion: Motion, rest: float, dt: float) -> Motion:
-    """Hold the first and last pose still for ``rest`` seconds."""
-    k = round(rest / dt)
-    if k == 0:
-        return motion
-    n = motion.n
-    head_t = motion.t[0] - dt * np.arange(k, 0, -1)
-    tail_t = motion.t[-1] + dt * np.arange(1, k + 1)
-    zeros = np.zeros((k, n))
-    t = np.concatenate([head_t, motion.t, tail_t]) - (motion.t[0] - k * dt)
-    q = np.vstack([np.tile(motion.q[0], (k, 1)), motion.q, np.tile(motion.q[-1], (k, 1))])
-    qd = np.vstack([zeros, motion.qd, zeros])
-    qdd = np.vstack([zeros, motion.qdd, zeros])
-    return Motion(t, q, qd, qdd)
-
-
 def _delayed(motion: Motion, lag: float) -> Motion:
     """The motion ``lag`` s later: ``x(t - lag)``, held at its start value before it begins.
 
@@ -194,8 +92,8 @@ def _delayed(motion: Motion, lag: float) -> Motion:
 
 
 def simulate(
-    robot: Robot, target: Motion, settings: TwinSettings | None = None
-) -> dict[str, Array]:
+    robot: Robot, target: Motion, settings: TwinSettings | None = None, *, name: str = "twin"
+) -> Log:
     """Controller-like signals for ``target`` run on ``robot``.
 
     Parameters
@@ -207,10 +105,13 @@ def simulate(
     settings : TwinSettings, optional
         Lag and noise; default :class:`TwinSettings` (realistic), :meth:`TwinSettings.exact` for none.
 
+    name : str
+        What the log is called in messages (its ``path``).
+
     Returns
     -------
-    dict of str to ndarray
-        ``timestamp`` (N,) and the signals of the module docstring, (N, n) or (N,).
+    Log
+        The signals of the module docstring, (N, n) or (N,), at ``target.t``.
     """
     settings = settings or TwinSettings()
     if target.n != robot.n:
@@ -222,8 +123,7 @@ def simulate(
     big_n, n = target.q.shape
     current = actual.current + settings.current_noise * rng.standard_normal((big_n, n))
     bus_power = actual.power.sum(axis=1) + robot.standby_power
-    return {
-        "timestamp": target.t,
+    signals = {
         "target_q": target.q,
         "actual_q": real.q + settings.position_noise * rng.standard_normal((big_n, n)),
         "target_qd": target.qd,
@@ -238,3 +138,4 @@ def simulate(
         "robot_mode": np.full(big_n, 7.0),
         "runtime_state": np.full(big_n, 2.0),
     }
+    return Log(name, np.asarray(target.t, dtype=float), signals)

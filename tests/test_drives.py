@@ -14,8 +14,7 @@ import pytest
 from conftest import random_state
 
 import kinergy
-from kinergy.drives.electrics import drive_state, electrical_power
-from kinergy.friction.registry import FRICTION_MODELS, friction_torque
+from kinergy.drives.electrics import electrical_power
 from kinergy.drives.transmission import (
     coupled_joint_dynamics,
     joint_torque,
@@ -25,9 +24,11 @@ from kinergy.drives.transmission import (
 )
 from kinergy.energy.accounting import energy
 from kinergy.errors import KinergyError
+from kinergy.friction.registry import FRICTION_MODELS, friction_torque
 from kinergy.model import Drive, Friction, Joint, Limits, Link, Robot
-from kinergy.simulate import paper_trajectory
+from kinergy.predict import drive_state
 from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.programs import paper_trajectory
 
 pin = pytest.importorskip("pinocchio")
 from kinergy.dynamics.pinocchio import to_pinocchio  # noqa: E402
@@ -325,7 +326,11 @@ def test_electrical_power_formula_directly(ur5e: Robot) -> None:
 
 @pytest.mark.parametrize("model", sorted(FRICTION_MODELS))
 def test_friction_columns_reproduce_the_model(model: str) -> None:
-    from kinergy.friction.registry import LINEAR_PARAMETERS, friction_columns, with_linear_parameters
+    from kinergy.friction.registry import (
+        LINEAR_PARAMETERS,
+        friction_columns,
+        with_linear_parameters,
+    )
 
     rng = np.random.default_rng(12)
     wm = rng.normal(0, 50, 300)

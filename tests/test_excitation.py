@@ -31,11 +31,6 @@ from click.testing import CliRunner
 import kinergy
 from kinergy.cli import main as cli_main
 from kinergy.cli.excite import excite
-from kinergy.identify.full import identify_full, parameter_scale
-from kinergy.identify.preprocess import prepare
-from kinergy.io.rtde import Log, read_log
-from kinergy.io.urscript import servoj_program
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.experiments.excitation import (
     Excitation,
     ExcitationProblem,
@@ -43,6 +38,11 @@ from kinergy.experiments.excitation import (
     excitation_problem,
     random_feasible,
 )
+from kinergy.identify.full import identify_full, parameter_scale
+from kinergy.identify.preprocess import prepare
+from kinergy.io.rtde import read_log
+from kinergy.io.urscript import servoj_program
+from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_series
 from kinergy.trajectory.motion import Motion
 
@@ -111,9 +111,7 @@ def identified_base(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Base parameters identified by the full method from the twin's log of ``motion``, starting
     from perturbed links, and their standard deviations."""
-    signals = simulate(robot, motion, settings)
-    t = signals.pop("timestamp")
-    data = prepare(Log("twin", t, signals), robot.n)
+    data = prepare(simulate(robot, motion, settings), robot.n)
     result = identify_full(links_perturbed(robot, seed=2), [data], target=target)
     values = np.array([p["value"] for p in result.fit["base_parameters"]])
     std = np.array([p["std"] for p in result.fit["base_parameters"]])

@@ -18,9 +18,11 @@ from kinergy.identify.payload import identify_payload
 from kinergy.identify.preprocess import prepare
 from kinergy.identify.result import validation_metrics
 from kinergy.identify.sequential import identify_sequential
-from kinergy.io.rtde import Log, read_log
-from kinergy.simulate import TwinSettings, paper_trajectory, simulate
+from kinergy.io.log import Log
+from kinergy.io.rtde import read_log
+from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_motion
+from kinergy.trajectory.programs import paper_trajectory
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared" / "datasets"
 UR10E = DATASETS / "ur10e-innopolis"
@@ -33,9 +35,7 @@ def _twin(
     settings: TwinSettings,
     name: str,
 ) -> Log:  # type: ignore[name-defined]
-    signals = simulate(robot, motion, settings)
-    t = signals.pop("timestamp")
-    return Log(name, t, signals)
+    return simulate(robot, motion, settings, name=name)
 
 
 @pytest.fixture(scope="module")

@@ -28,7 +28,7 @@ from kinergy.identify.full import (
 )
 from kinergy.identify.preprocess import IdentData, lowpass, prepare
 from kinergy.identify.result import IdentificationResult, validation_metrics
-from kinergy.io.rtde import Log
+from kinergy.io.log import Log
 from kinergy.model.robot import Friction
 from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_motion
@@ -71,9 +71,7 @@ def excitation(
 
 def twin_data(robot: kinergy.Robot, motion: Motion, settings: TwinSettings) -> IdentData:
     """The twin's log of ``motion`` on ``robot``, prepared for identification."""
-    signals = simulate(robot, motion, settings)
-    t = signals.pop("timestamp")
-    return prepare(Log("twin", t, signals), robot.n)
+    return prepare(simulate(robot, motion, settings), robot.n)
 
 
 def perturbed(robot: kinergy.Robot, seed: int, spread: float = 0.2) -> kinergy.Robot:

@@ -20,7 +20,7 @@ from kinergy.errors import KinergyError
 from kinergy.identify import nursing as nu
 from kinergy.identify.preprocess import prepare
 from kinergy.identify.pso import constriction, particle_swarm
-from kinergy.io.rtde import Log
+from kinergy.io.log import Log
 from kinergy.model import load_robot, save_robot
 from kinergy.model.robot import Limits
 from kinergy.simulate import TwinSettings, simulate
@@ -36,9 +36,7 @@ def arm() -> kinergy.Robot:
 
 
 def _twin_data(robot: kinergy.Robot, motion, settings: TwinSettings, name: str):
-    sig = simulate(robot, motion, settings)
-    t = sig.pop("timestamp")
-    return prepare(Log(name, t, sig), robot.n)
+    return prepare(simulate(robot, motion, settings, name=name), robot.n)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -331,8 +329,8 @@ def test_identify_nursing_on_a_noise_free_excitation(arm, tmp_path) -> None:
 
 def test_identify_nursing_rejects_logs_without_current(arm) -> None:
     motion, _, _ = nu.table6_motion(arm, periods=1, dt=0.01)
-    sig = simulate(arm, motion, TwinSettings.exact())
-    t = sig.pop("timestamp")
+    twin = simulate(arm, motion, TwinSettings.exact())
+    t, sig = twin.t, dict(twin.signals)
     sig.pop("actual_current")
     with pytest.raises(KinergyError, match="actual_current"):
         nu.identify_nursing(arm, [prepare(Log("no-current", t, sig), 6)])

@@ -14,8 +14,11 @@ from click.testing import CliRunner
 
 import kinergy
 from kinergy.cli.optimize import optimize
-from kinergy.drives.electrics import drive_state
 from kinergy.drives.transmission import joint_torque
+from kinergy.errors import KinergyError
+from kinergy.io.task import load_task
+from kinergy.io.urscript import movej_program, write_script
+from kinergy.model import Drive, Friction, Joint, Limits, Link, Robot
 from kinergy.optimize.timing import (
     limit_violations,
     optimize_timing,
@@ -24,12 +27,9 @@ from kinergy.optimize.timing import (
     timing_problem,
     uniform_scaling,
 )
-from kinergy.errors import KinergyError
-from kinergy.io.task import load_task
-from kinergy.io.urscript import movej_program, write_script
-from kinergy.model import Drive, Friction, Joint, Limits, Link, Robot
-from kinergy.simulate import paper_waypoints
+from kinergy.predict import drive_state
 from kinergy.trajectory.movej import movej, plan_movej
+from kinergy.trajectory.programs import paper_waypoints
 
 # -- a toy arm ------------------------------------------------------------------------------------
 

@@ -16,9 +16,10 @@ from scipy.signal import butter, find_peaks, sosfreqz
 import kinergy
 from kinergy.errors import KinergyError
 from kinergy.identify.preprocess import estimate_lag, lowpass, prepare, running, uniform
-from kinergy.io.rtde import Log
-from kinergy.simulate import TwinSettings, paper_trajectory, simulate
+from kinergy.io.log import Log
+from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.programs import paper_trajectory
 
 DT = 0.002  # the twin's (and a UR controller's) 500 Hz
 
@@ -210,9 +211,14 @@ def _exact(lag: float) -> TwinSettings:
 def test_estimate_lag_finds_the_twins_lag(
     ur5e: kinergy.Robot, motion_a: Motion, lag: float, seed: int
 ) -> None:
-    s = simulate(ur5e, motion_a, TwinSettings(lag=lag, speed_noise=0.01, seed=seed))
+    s = _signals(simulate(ur5e, motion_a, TwinSettings(lag=lag, speed_noise=0.01, seed=seed)))
     estimate = estimate_lag(s["timestamp"], s["target_qd"], s["actual_qd"])
     assert abs(estimate - lag) < 3e-4, (estimate, lag)
+
+
+def _signals(log: Log) -> dict[str, np.ndarray]:
+    """The twin's log as one mapping with its ``timestamp``."""
+    return {"timestamp": log.t, **log.signals}
 
 
 def _twin_log(signals: dict[str, np.ndarray], names: tuple[str, ...] | None = None) -> Log:
@@ -246,7 +252,7 @@ def _steady(qdd: np.ndarray, margin: int) -> np.ndarray:
 def test_prepare_delays_the_target_by_the_estimated_lag(
     ur5e: kinergy.Robot, motion_a: Motion, lag: float
 ) -> None:
-    s = simulate(ur5e, motion_a, TwinSettings(lag=lag, speed_noise=0.01, seed=5))
+    s = _signals(simulate(ur5e, motion_a, TwinSettings(lag=lag, speed_noise=0.01, seed=5)))
     truth = simulate(ur5e, motion_a, _exact(lag))  # the same real motion, without noise
     d = prepare(_twin_log(s), ur5e.n)
     t = s["timestamp"]
@@ -298,8 +304,8 @@ def test_prepare_filters_the_measured_motion_without_a_target(
     ur5e: kinergy.Robot, motion_a: Motion, seed: int
 ) -> None:
     lag, noise = 0.004, 0.01
-    s = simulate(ur5e, motion_a, TwinSettings(lag=lag, speed_noise=noise, seed=seed))
-    truth = simulate(ur5e, motion_a, _exact(lag))
+    s = _signals(simulate(ur5e, motion_a, TwinSettings(lag=lag, speed_noise=noise, seed=seed)))
+    truth = _signals(simulate(ur5e, motion_a, _exact(lag)))
     d = prepare(_twin_log(s, ("actual_q", "actual_qd", "actual_current")), ur5e.n)
 
     assert d.source == "filtered actual" and d.lag == 0.0

@@ -12,7 +12,8 @@ import pytest
 import kinergy
 from kinergy.cli import main
 from kinergy.io.rtde import read_log
-from kinergy.simulate import TwinSettings, paper_trajectory, paper_waypoints, simulate
+from kinergy.simulate import TwinSettings, simulate
+from kinergy.trajectory.programs import paper_trajectory, paper_waypoints
 
 pin = pytest.importorskip("pinocchio")
 from kinergy.dynamics.pinocchio import to_pinocchio  # noqa: E402
@@ -51,7 +52,7 @@ def _eq7_and_eq17(
 
 
 def test_exact_twin_is_the_seed_equations(ur5e: kinergy.Robot, test_a) -> None:
-    sig = simulate(ur5e, test_a, TwinSettings.exact())
+    sig = simulate(ur5e, test_a, TwinSettings.exact()).signals
     moment, current = _eq7_and_eq17(ur5e, test_a.q, test_a.qd, test_a.qdd)
     scale = np.max(np.abs(moment), axis=0)
     assert np.max(np.abs(sig["target_moment"] - moment) / scale) < 1e-6
@@ -64,7 +65,7 @@ def test_realistic_twin_lags_and_is_noisy(ur5e: kinergy.Robot, test_a) -> None:
     settings = TwinSettings(
         lag=0.008, speed_noise=0.02, position_noise=0.0, current_noise=0.05, seed=3
     )
-    sig = simulate(ur5e, test_a, settings)
+    sig = simulate(ur5e, test_a, settings).signals
     # actual = target two samples (8 ms at 4 ms) later
     np.testing.assert_allclose(sig["actual_q"][2:], test_a.q[:-2], atol=1e-9)
     noise = sig["actual_qd"][2:] - test_a.qd[:-2]

@@ -284,8 +284,9 @@ def simulate(
     """
     from kinergy.io.motion import motion_from_log
     from kinergy.io.rtde import read_log, write_log
-    from kinergy.simulate import TEST_TRAJECTORIES, TwinSettings, paper_trajectory
+    from kinergy.simulate import TwinSettings
     from kinergy.simulate import simulate as run_twin
+    from kinergy.trajectory.programs import TEST_TRAJECTORIES, paper_trajectory
 
     r = _load(robot_name, payload)
     if trajectory in TEST_TRAJECTORIES:
@@ -302,9 +303,9 @@ def simulate(
         current_noise=base.current_noise if current_noise is None else current_noise,
         seed=seed,
     )
-    signals = run_twin(r, motion, settings)
-    t = signals.pop("timestamp")
-    write_log(out, t, signals)
+    twin = run_twin(r, motion, settings)
+    t = twin.t
+    write_log(out, t, twin.signals)
     click.echo(
         f"wrote {out}: {len(t)} samples, {t[-1] - t[0]:.3f} s, {r.name}, trajectory {trajectory}, "
         f"lag {settings.lag * 1e3:g} ms, speed noise {settings.speed_noise:g} rad/s, "

@@ -212,14 +212,14 @@ def excite(
     condition number of the stacked base regressor within the joint, speed, acceleration and
     floor limits. Progress goes to stderr.
     """
-    from kinergy.io.rtde import write_log
-    from kinergy.io.urscript import servoj_program, write_script
-    from kinergy.model import load_robot
     from kinergy.experiments.excitation import (
         design_excitation,
         excitation_problem,
         random_feasible,
     )
+    from kinergy.io.rtde import write_log
+    from kinergy.io.urscript import servoj_program, write_script
+    from kinergy.model import load_robot
 
     if periods < 1:
         raise KinergyError(f"--periods: must be >= 1, got {periods}")

@@ -36,12 +36,9 @@ __all__ = ["nursing", "nursing_study"]
 
 def _twin_log(robot: Robot, name: str, motion: Any, settings: Any) -> Any:
     from kinergy.identify.preprocess import prepare
-    from kinergy.io.rtde import Log
     from kinergy.simulate import simulate
 
-    sig = simulate(robot, motion, settings)
-    signals = {k: v for k, v in sig.items() if k != "timestamp"}
-    return prepare(Log(name, sig["timestamp"], signals), robot.n)
+    return prepare(simulate(robot, motion, settings, name=name), robot.n)
 
 
 def nursing_study(

@@ -262,10 +262,10 @@ def optimize(
     written and with uniform time scaling to the same cycle time, all re-simulated at 500 Hz
     with every speed, acceleration, torque and position limit checked at every sample.
     """
-    from kinergy.optimize.timing import optimize_timing, pareto_front, timing_problem
     from kinergy.io.task import load_task
     from kinergy.io.urscript import movej_program, write_script
     from kinergy.model import load_robot, parse_payload
+    from kinergy.optimize.timing import optimize_timing, pareto_front, timing_problem
 
     budget = _cycle_time(cycle_time)
     _positive("--v-max", v_max)

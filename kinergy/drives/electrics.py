@@ -1,4 +1,6 @@
-"""The joint drives' electro-mechanical model: motor torques, currents, voltages and power.
+"""The motors' electrical model: torque constants, winding resistance, back-EMF, power, friction.
+
+The forward path that puts these together over a motion is :func:`kinergy.predict.drive_state`.
 
 For a motion ``q, qd, qdd`` (joint side), UR5e section 3-5:
 
@@ -16,21 +18,14 @@ For a motion ``q, qd, qdd`` (joint side), UR5e section 3-5:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kinergy.friction.registry import friction_torque
-from kinergy.drives.transmission import reflected_inertia, transmission_matrix
-from kinergy.dynamics.chain import check_state
-from kinergy.dynamics.rnea import gravity_torque, rnea
 from kinergy.model.robot import Robot
 
 __all__ = [
-    "DriveState",
     "back_emf_constants",
-    "drive_state",
     "electrical_power",
     "friction_torques",
     "motor_constants",
@@ -68,50 +63,6 @@ def back_emf_constants(robot: Robot) -> Array:
     return torque_constants(robot) / np.array([j.drive.kt_over_kb for j in robot.joints])
 
 
-@dataclass(frozen=True)
-class DriveState:
-    """Everything the drive model says about a motion; arrays of shape (N, n) unless noted.
-
-    Attributes
-    ----------
-    tau_link : joint side, N m
-        Rigid-body torques f_link (UR5e eq 1).
-    tau_sim : joint side, N m
-        ``f_link`` plus reflected motor and reducer inertia (UR5e eq 2; ``target_moment``, eq 7).
-    tau_gravity : joint side, N m
-        The gravity part of ``tau_link``.
-    wm, dwm : motor side, rad/s and rad/s^2
-        Motor speeds and accelerations.
-    tau_load : motor side, N m
-        Torque the motor delivers to the load: ``N^-T tau_sim``.
-    tau_friction : motor side, N m
-        Friction torque.
-    tau_m : motor side, N m
-        Motor torque ``tau_load + tau_friction`` (UR5e eq 17 times k_t).
-    current, voltage : A, V
-        UR5e eqs 17/20 and 19.
-    power : W
-        Electrical power per motor, eq 23; positive when drawn from the bus.
-    """
-
-    tau_link: Array
-    tau_sim: Array
-    tau_gravity: Array
-    wm: Array
-    dwm: Array
-    tau_load: Array
-    tau_friction: Array
-    tau_m: Array
-    current: Array
-    voltage: Array
-    power: Array
-
-    @property
-    def p_mech(self) -> Array:
-        """Mechanical power of each motor ``tau_m * wm`` (UR5e eq 25 integrand), W."""
-        return self.tau_m * self.wm
-
-
 def electrical_power(robot: Robot, tau_m: ArrayLike, wm: ArrayLike) -> Array:
     """Electrical power per motor, ``tau_m^2 / k_m^2 + (k_b / k_t) wm tau_m`` (UR5e eq 23), W."""
     tau_m = np.asarray(tau_m, dtype=float)
@@ -128,55 +79,3 @@ def friction_torques(robot: Robot, wm: Array, tau_load: Array, dwm: Array | None
         acc = None if dwm is None else dwm[:, i]
         out[:, i] = friction_torque(fr.model, fr.params, wm[:, i], tau_load[:, i], acc)
     return out
-
-
-def drive_state(
-    robot: Robot,
-    q: ArrayLike,
-    qd: ArrayLike,
-    qdd: ArrayLike,
-    *,
-    wrench: ArrayLike | None = None,
-) -> DriveState:
-    """Run the drive model over a motion (UR5e eqs 1-2, 10-23).
-
-    Parameters
-    ----------
-    robot : Robot
-    q, qd, qdd : array_like, shape (N, n) or (n,)
-        Joint angles (rad), speeds (rad/s), accelerations (rad/s^2).
-    wrench : array_like, shape (6,) or (N, 6), optional
-        Wrench the flange exerts on its environment (see :func:`kinergy.rnea`).
-
-    Returns
-    -------
-    DriveState
-        Arrays of shape (N, n) (a single sample gives N = 1).
-    """
-    _, s = check_state(robot, q=q, qd=qd, qdd=qdd)
-    q_, qd_, qdd_ = s["q"], s["qd"], s["qdd"]
-    tau_link = rnea(robot, q_, qd_, qdd_, wrench=wrench)
-    tau_gravity = gravity_torque(robot, q_)
-    tau_sim = tau_link + qdd_ @ reflected_inertia(robot).T
-    n_mat = transmission_matrix(robot)
-    wm = qd_ @ n_mat.T
-    dwm = qdd_ @ n_mat.T
-    tau_load = np.asarray(np.linalg.solve(n_mat.T, tau_sim.T).T, dtype=float)
-    tau_friction = friction_torques(robot, wm, tau_load, dwm)
-    tau_m = tau_load + tau_friction
-    current = tau_m / torque_constants(robot)
-    voltage = winding_resistances(robot) * current + back_emf_constants(robot) * wm
-    power = electrical_power(robot, tau_m, wm)
-    return DriveState(
-        tau_link=tau_link,
-        tau_sim=tau_sim,
-        tau_gravity=tau_gravity,
-        wm=wm,
-        dwm=dwm,
-        tau_load=tau_load,
-        tau_friction=tau_friction,
-        tau_m=tau_m,
-        current=current,
-        voltage=voltage,
-        power=power,
-    )

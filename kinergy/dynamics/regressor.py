@@ -23,8 +23,8 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
-from kinergy.dynamics.chain import check_state, kernel_geometry, link_inertials, make_chain
 from kinergy.dynamics._kernels import regressor_kernel
+from kinergy.dynamics.chain import check_state, kernel_geometry, link_inertials, make_chain
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 

@@ -17,9 +17,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.dynamics._kernels import rnea_kernel
 from kinergy.dynamics.chain import check_state, kernel_geometry, link_inertials, make_chain
 from kinergy.dynamics.kinematics import joint_axes
-from kinergy.dynamics._kernels import rnea_kernel
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 

@@ -30,9 +30,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import trapezoid
 
-from kinergy.drives.electrics import DriveState, drive_state
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.model.robot import Robot
+from kinergy.predict import DriveState, drive_state
 from kinergy.trajectory.motion import Motion
 
 __all__ = ["EnergyReport", "energy"]

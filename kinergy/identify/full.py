@@ -64,14 +64,6 @@ import scipy.linalg
 import scipy.optimize
 from numpy.typing import ArrayLike, NDArray
 
-from kinergy.drives.electrics import drive_state
-from kinergy.friction.registry import (
-    LINEAR_PARAMETERS,
-    friction_columns,
-    linear_values,
-    start_parameters,
-    with_linear_parameters,
-)
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.dynamics.regressor import (
     BaseParameters,
@@ -81,10 +73,18 @@ from kinergy.dynamics.regressor import (
     regressor,
 )
 from kinergy.errors import KinergyError
+from kinergy.friction.registry import (
+    LINEAR_PARAMETERS,
+    friction_columns,
+    linear_values,
+    start_parameters,
+    with_linear_parameters,
+)
 from kinergy.identify.metrics import fit_metrics
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult, validation_metrics
 from kinergy.model.robot import Friction, Joint, Link, Robot, Source
+from kinergy.predict import drive_state
 
 __all__ = [
     "MAX_CONDITION",

@@ -60,13 +60,13 @@ import scipy.optimize
 from numpy.typing import ArrayLike, NDArray
 
 from kinergy.drives.electrics import friction_torques, torque_constants
-from kinergy.friction.registry import FRICTION_MODELS
 from kinergy.drives.transmission import reflected_inertia, transmission_matrix
 from kinergy.dynamics.chain import make_chain
 from kinergy.dynamics.kinematics import joint_axes
 from kinergy.dynamics.regressor import BaseParameters, base_parameters, inertial_parameters
 from kinergy.dynamics.regressor import regressor as full_regressor
 from kinergy.errors import KinergyError
+from kinergy.friction.registry import FRICTION_MODELS
 from kinergy.identify.metrics import r_squared, rmse
 from kinergy.identify.preprocess import IdentData, lowpass
 from kinergy.identify.pso import particle_swarm

@@ -21,12 +21,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from kinergy.drives.electrics import drive_state, torque_constants
+from kinergy.drives.electrics import torque_constants
 from kinergy.drives.transmission import joint_torque
 from kinergy.dynamics.regressor import regressor
 from kinergy.errors import KinergyError
 from kinergy.identify.preprocess import IdentData
 from kinergy.model.robot import Payload, Robot
+from kinergy.predict import drive_state
 
 __all__ = ["identify_payload"]
 

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
 from kinergy.errors import KinergyError
-from kinergy.io.rtde import Log
+from kinergy.io.log import Log
 
 __all__ = [
     "IdentData",

@@ -8,11 +8,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from kinergy.drives.electrics import drive_state
 from kinergy.drives.transmission import joint_torque
 from kinergy.identify.metrics import fit_metrics
 from kinergy.identify.preprocess import IdentData
 from kinergy.model.robot import Robot
+from kinergy.predict import drive_state
 
 __all__ = ["IdentificationResult", "Prediction", "predict", "validation_metrics"]
 

@@ -27,15 +27,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.drives.transmission import transmission_matrix
+from kinergy.dynamics.rnea import rnea
+from kinergy.errors import KinergyError
 from kinergy.friction.registry import (
     LINEAR_PARAMETERS,
     friction_columns,
     start_parameters,
     with_linear_parameters,
 )
-from kinergy.drives.transmission import transmission_matrix
-from kinergy.dynamics.rnea import rnea
-from kinergy.errors import KinergyError
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult, validation_metrics
 from kinergy.model.robot import Friction, Robot, Source

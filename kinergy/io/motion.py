@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
 from kinergy.errors import KinergyError
-from kinergy.io.rtde import Log
+from kinergy.io.log import Log
 from kinergy.trajectory.motion import Motion
 
 __all__ = ["motion_from_log"]

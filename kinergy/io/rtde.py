@@ -18,7 +18,6 @@ from __future__ import annotations
 import os
 import re
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
@@ -27,53 +26,13 @@ from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
+from kinergy.io.log import Log
 
-__all__ = ["Log", "parse_columns", "read_log", "write_log"]
+__all__ = ["parse_columns", "read_log", "write_log"]
 
 Array = NDArray[np.float64]
 
 _VECTOR = re.compile(r"^(?P<name>.+)_(?P<index>\d+)$")
-
-
-@dataclass(frozen=True, eq=False)
-class Log:
-    """A controller log: time and named signals.
-
-    Attributes
-    ----------
-    path : str
-        Where it was read from (for messages).
-    t : ndarray, shape (N,)
-        ``timestamp``, s.
-    signals : dict of str to ndarray
-        Vectors as (N, n) arrays under their RTDE name (``actual_q``), scalars as (N,) arrays.
-    notes : list of str
-        What reading changed (rows dropped by ``repair``), for the user to see.
-    """
-
-    path: str
-    t: Array
-    signals: dict[str, Array] = field(default_factory=dict)
-    notes: list[str] = field(default_factory=list)
-
-    def __contains__(self, name: str) -> bool:
-        return name in self.signals
-
-    def __getitem__(self, name: str) -> Array:
-        return self.signals[name]
-
-    def __len__(self) -> int:
-        return int(self.t.size)
-
-    def require(self, *names: str, purpose: str) -> None:
-        """Raise one clear line if any of ``names`` is missing."""
-        missing = [n for n in names if n not in self.signals]
-        if missing:
-            have = ", ".join(sorted(self.signals)) or "none"
-            raise KinergyError(
-                f"{self.path}: {purpose} needs {', '.join(missing)} (columns "
-                f"{', '.join(m + '_0..' for m in missing)}); the log has: {have}"
-            )
 
 
 def parse_columns(spec: str) -> list[str]:

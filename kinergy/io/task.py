@@ -25,7 +25,7 @@ them. A move without ``v`` or ``a`` (and no default) runs at the fastest the rob
 (``ur_r``) and only written into a URScript.
 
 The built-in tasks ``test-a`` and ``test-b`` are the UR5e doc's test programs
-(:func:`kinergy.simulate.paper_waypoints`, 3 rad/s and 6 rad/s^2, capped by the robot's limits).
+(:func:`kinergy.trajectory.programs.paper_waypoints`, 3 rad/s and 6 rad/s^2, capped by the robot's limits).
 """
 
 from __future__ import annotations
@@ -42,12 +42,13 @@ from numpy.typing import NDArray
 from kinergy.errors import KinergyError
 from kinergy.files import read_toml
 from kinergy.model.robot import Robot
+from kinergy.trajectory.programs import paper_speed, paper_waypoints
 
 __all__ = ["BUILTIN_TASKS", "Task", "load_task", "task_from_dict"]
 
 Array = NDArray[np.float64]
 
-#: built-in task name -> seed of :func:`kinergy.simulate.paper_waypoints`
+#: built-in task name -> seed of :func:`kinergy.trajectory.programs.paper_waypoints`
 BUILTIN_TASKS = {"test-a": 1, "test-b": 2}
 
 _TOP_KEYS = {"robot", "unit", "speed", "acceleration", "start", "move", "name", "description"}
@@ -183,8 +184,6 @@ def task_from_dict(
 
 
 def _builtin(name: str, robot: Robot | None) -> Task:
-    from kinergy.simulate import paper_speed, paper_waypoints
-
     if robot is None:
         raise KinergyError(f"task {name!r}: a built-in task needs the robot it runs on")
     waypoints = paper_waypoints(robot, BUILTIN_TASKS[name])

@@ -1,14 +1,5 @@
 """Robot models as data: dataclasses, robot files (TOML, URDF) and the built-in library."""
 
-from kinergy.model.toml import (
-    library_names,
-    load_robot,
-    parse_payload,
-    read_robot_file,
-    robot_from_dict,
-    robot_to_dict,
-    save_robot,
-)
 from kinergy.model.robot import (
     CONVENTIONS,
     SOURCE_CATEGORIES,
@@ -22,6 +13,15 @@ from kinergy.model.robot import (
     Robot,
     Source,
     inertia_matrix,
+)
+from kinergy.model.toml import (
+    library_names,
+    load_robot,
+    parse_payload,
+    read_robot_file,
+    robot_from_dict,
+    robot_to_dict,
+    save_robot,
 )
 
 __all__ = [

@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from kinergy.friction.registry import check_friction
 from kinergy.errors import KinergyError
+from kinergy.friction.registry import check_friction
 
 __all__ = [
     "CONVENTIONS",

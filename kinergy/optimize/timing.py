@@ -79,11 +79,11 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import cumulative_trapezoid
 from scipy.optimize import minimize
 
-from kinergy.drives.electrics import DriveState, drive_state
 from kinergy.drives.transmission import joint_torque
 from kinergy.energy.accounting import energy
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
+from kinergy.predict import DriveState, drive_state
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.movej import movej, plan_movej
 

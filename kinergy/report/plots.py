@@ -33,8 +33,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import cumulative_trapezoid
 
 from kinergy.errors import KinergyError
-from kinergy.identify.metrics import r_squared
 from kinergy.files import atomic_write
+from kinergy.identify.metrics import r_squared
 
 __all__ = [
     "DPI",

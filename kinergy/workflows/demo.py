@@ -21,11 +21,12 @@ from kinergy.identify.preprocess import prepare
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.motion import motion_from_log
 from kinergy.io.rtde import read_log, write_log
-from kinergy.model.toml import load_robot
 from kinergy.model.robot import Friction, Robot
+from kinergy.model.toml import load_robot
 from kinergy.report.build import StudyInputs, report_sections
 from kinergy.report.html import Section, Table, write_report
-from kinergy.simulate import TwinSettings, paper_trajectory, simulate
+from kinergy.simulate import TwinSettings, simulate
+from kinergy.trajectory.programs import paper_trajectory
 
 __all__ = ["nominal_drives", "run_demo"]
 
@@ -70,10 +71,9 @@ def run_demo(
     for k, name in enumerate(("test-a", "test-b")):
         label = "test " + name[-1].upper()
         say(f"simulating {label} on the UR5e twin (500 Hz, 4 ms lag, speed and current noise)")
-        signals = simulate(truth, paper_trajectory(truth, name), TwinSettings(seed=k + 1))
-        t = signals.pop("timestamp")
+        twin = simulate(truth, paper_trajectory(truth, name), TwinSettings(seed=k + 1))
         path = logs / f"{name}.csv"
-        write_log(path, t, signals)
+        write_log(path, twin.t, twin.signals)
         log = read_log(path)
         datas[label] = prepare(log, truth.n)
         motions[label] = motion_from_log(log, n_joints=truth.n, source="target")

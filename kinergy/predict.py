@@ -1,0 +1,135 @@
+"""Model + motion -> torques, currents, voltages and powers: the one forward path.
+
+Energy accounting, validation, the twin and the optimiser all predict through
+:func:`drive_state`. For a motion ``q, qd, qdd`` (joint side), UR5e sections 3-5:
+
+1. link torques ``f_link`` by RNEA (eq 1), plus the motor and reducer inertia (eq 2):
+   ``tau_sim = f_link + N^T diag(J_m + J_r) N qdd`` -- the controller's ``target_moment`` (eq 7);
+2. motor side: ``wm = N qd`` and the torque the motor delivers to the load ``tau_load = N^-T tau_sim``
+   (``tau_sim / i`` for a UR joint);
+3. friction on the motor side (eqs 11-16, or the joint's model), whose power-flow direction is the
+   sign of ``wm * tau_load``;
+4. motor torque ``tau_m = tau_load + tau_f`` and current ``I = tau_m / k_t`` (eqs 10, 17, 20);
+5. voltage ``V = R I + k_b wm`` (eq 19) and electrical power
+   ``W = tau_m^2 / k_m^2 + (k_b / k_t) wm tau_m`` (eqs 21-23), with ``R = (k_t / k_m)^2`` and
+   ``k_b = k_t / (k_t/k_b)``; a drive's ``winding_resistance``, when given, replaces ``R``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from kinergy.drives.electrics import (
+    back_emf_constants,
+    electrical_power,
+    friction_torques,
+    torque_constants,
+    winding_resistances,
+)
+from kinergy.drives.transmission import reflected_inertia, transmission_matrix
+from kinergy.dynamics.chain import check_state
+from kinergy.dynamics.rnea import gravity_torque, rnea
+from kinergy.model.robot import Robot
+
+__all__ = ["DriveState", "drive_state"]
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class DriveState:
+    """Everything the drive model says about a motion; arrays of shape (N, n) unless noted.
+
+    Attributes
+    ----------
+    tau_link : joint side, N m
+        Rigid-body torques f_link (UR5e eq 1).
+    tau_sim : joint side, N m
+        ``f_link`` plus reflected motor and reducer inertia (UR5e eq 2; ``target_moment``, eq 7).
+    tau_gravity : joint side, N m
+        The gravity part of ``tau_link``.
+    wm, dwm : motor side, rad/s and rad/s^2
+        Motor speeds and accelerations.
+    tau_load : motor side, N m
+        Torque the motor delivers to the load: ``N^-T tau_sim``.
+    tau_friction : motor side, N m
+        Friction torque.
+    tau_m : motor side, N m
+        Motor torque ``tau_load + tau_friction`` (UR5e eq 17 times k_t).
+    current, voltage : A, V
+        UR5e eqs 17/20 and 19.
+    power : W
+        Electrical power per motor, eq 23; positive when drawn from the bus.
+    """
+
+    tau_link: Array
+    tau_sim: Array
+    tau_gravity: Array
+    wm: Array
+    dwm: Array
+    tau_load: Array
+    tau_friction: Array
+    tau_m: Array
+    current: Array
+    voltage: Array
+    power: Array
+
+    @property
+    def p_mech(self) -> Array:
+        """Mechanical power of each motor ``tau_m * wm`` (UR5e eq 25 integrand), W."""
+        return self.tau_m * self.wm
+
+
+def drive_state(
+    robot: Robot,
+    q: ArrayLike,
+    qd: ArrayLike,
+    qdd: ArrayLike,
+    *,
+    wrench: ArrayLike | None = None,
+) -> DriveState:
+    """Run the drive model over a motion (UR5e eqs 1-2, 10-23).
+
+    Parameters
+    ----------
+    robot : Robot
+    q, qd, qdd : array_like, shape (N, n) or (n,)
+        Joint angles (rad), speeds (rad/s), accelerations (rad/s^2).
+    wrench : array_like, shape (6,) or (N, 6), optional
+        Wrench the flange exerts on its environment (see :func:`kinergy.rnea`).
+
+    Returns
+    -------
+    DriveState
+        Arrays of shape (N, n) (a single sample gives N = 1).
+    """
+    _, s = check_state(robot, q=q, qd=qd, qdd=qdd)
+    q_, qd_, qdd_ = s["q"], s["qd"], s["qdd"]
+    tau_link = rnea(robot, q_, qd_, qdd_, wrench=wrench)
+    tau_gravity = gravity_torque(robot, q_)
+    tau_sim = tau_link + qdd_ @ reflected_inertia(robot).T
+    n_mat = transmission_matrix(robot)
+    wm = qd_ @ n_mat.T
+    dwm = qdd_ @ n_mat.T
+    tau_load = np.asarray(np.linalg.solve(n_mat.T, tau_sim.T).T, dtype=float)
+    tau_friction = friction_torques(robot, wm, tau_load, dwm)
+    tau_m = tau_load + tau_friction
+    current = tau_m / torque_constants(robot)
+    voltage = winding_resistances(robot) * current + back_emf_constants(robot) * wm
+    power = electrical_power(robot, tau_m, wm)
+    return DriveState(
+        tau_link=tau_link,
+        tau_sim=tau_sim,
+        tau_gravity=tau_gravity,
+        wm=wm,
+        dwm=dwm,
+        tau_load=tau_load,
+        tau_friction=tau_friction,
+        tau_m=tau_m,
+        current=current,
+        voltage=voltage,
+        power=power,
+    )
