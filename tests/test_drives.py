@@ -24,7 +24,7 @@ from kinergy.drives.transmission import (
 )
 from kinergy.energy.accounting import energy
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import FRICTION_MODELS, friction_torque
+from kinergy.friction.registry import MODELS, friction_torque
 from kinergy.model import Drive, Friction, Joint, Limits, Link, Robot
 from kinergy.predict import drive_state
 from kinergy.trajectory.motion import Motion
@@ -67,10 +67,10 @@ PARAMS = {
 
 
 def test_every_model_has_test_parameters() -> None:
-    assert set(PARAMS) == set(FRICTION_MODELS)
+    assert set(PARAMS) == set(MODELS)
 
 
-@pytest.mark.parametrize("model", sorted(FRICTION_MODELS))
+@pytest.mark.parametrize("model", sorted(MODELS))
 def test_friction_opposes_motion(model: str) -> None:
     wm = np.random.default_rng(0).normal(0, 100, 500)
     load = np.random.default_rng(1).normal(0, 1, 500)
@@ -324,11 +324,11 @@ def test_electrical_power_formula_directly(ur5e: Robot) -> None:
     )
 
 
-@pytest.mark.parametrize("model", sorted(FRICTION_MODELS))
+@pytest.mark.parametrize("model", sorted(MODELS))
 def test_friction_columns_reproduce_the_model(model: str) -> None:
     from kinergy.friction.registry import (
-        LINEAR_PARAMETERS,
         friction_columns,
+        get_model,
         with_linear_parameters,
     )
 
@@ -337,8 +337,8 @@ def test_friction_columns_reproduce_the_model(model: str) -> None:
     load = rng.normal(0, 1, 300)
     params = PARAMS[model]
     cols = friction_columns(model, params, wm, load)
-    assert cols.shape == (300, len(LINEAR_PARAMETERS[model]))
-    values = np.array([params.get(n, 0.0) for n in LINEAR_PARAMETERS[model]])
+    assert cols.shape == (300, len(get_model(model).linear))
+    values = np.array([params.get(n, 0.0) for n in get_model(model).linear])
     if model == "motor_reducer":
         values[1] = params["motor_coulomb"] + params["reducer_coulomb"]
     np.testing.assert_allclose(

@@ -8,11 +8,6 @@ condition number and constraint margins, and writes ``--periods`` repeats of it 
 UR's record.py layout (``timestamp target_q_* target_qd_* target_qdd_*``), the motion file
 ``kinergy simulate ROBOT --trajectory FILE`` runs on the twin. ``--compare N`` also draws N random
 feasible Fourier trajectories of the same size and prints their median condition number.
-
-Register it in ``kinergy/cli.py`` with::
-
-    from kinergy.cli.excite import excite
-    cli.add_command(excite)
 """
 
 from __future__ import annotations

@@ -14,8 +14,6 @@ The nursing doc's procedure (sections 4.1-4.2; :mod:`kinergy.identify.nursing`) 
    and averaged over the periods (eq 24), joint torques less the identified friction and drive
    inertia (eq 25), ridge regression of the minimal parameter set on a 70/30 split in time, and
    the per-joint RMSE on the 30 % (eq 26) next to the doc's Table 8.
-
-Register it in ``kinergy/cli.py`` with ``cli.add_command(nursing)``.
 """
 
 from __future__ import annotations
@@ -28,6 +26,7 @@ from typing import Any
 import click
 import numpy as np
 
+from kinergy.cli.common import table
 from kinergy.errors import KinergyError
 from kinergy.model import Robot, load_robot
 
@@ -177,15 +176,6 @@ def nursing_study(
     return out
 
 
-def _row(cells: list[str], widths: list[int]) -> str:
-    return "  ".join(c.ljust(w) for c, w in zip(cells, widths, strict=True)).rstrip()
-
-
-def _table(headers: list[str], rows: list[list[str]]) -> str:
-    widths = [max(len(x) for x in col) for col in zip(headers, *rows, strict=True)]
-    return "\n".join([_row(headers, widths)] + [_row(r, widths) for r in rows])
-
-
 def _gamma(g: list[float] | None) -> list[str]:
     return ["-"] * 6 if g is None else [f"{x:.4g}" if abs(x) > 1e-9 else "0" for x in g]
 
@@ -224,7 +214,7 @@ def study_text(study: dict[str, Any]) -> str:
                 ["doc Table 4", kind, "PSO", *_gamma(doc["gamma"]), "-", "-", f"{doc['r2']:.3f}"]
             )
     lines.append(
-        _table(
+        table(
             [
                 "joint",
                 "kind",
@@ -280,7 +270,7 @@ def study_text(study: dict[str, Any]) -> str:
     lines += [
         f"Joint torque RMSE on the last {100 - round(100 * r['split'])} % (nursing eq 26, Table 8): ridge "
         f"regression of the {r['parameters']} minimal parameters",
-        _table(["joint", "RMSE [N m]", "std [N m]", "R2", "Table 8 [N m]"], rows),
+        table(["joint", "RMSE [N m]", "std [N m]", "R2", "Table 8 [N m]"], rows),
         f"Table 6 excitation, {r['period']:.4g} s period x 10, currents low-pass {r['cutoff']} Hz, averaged "
         f"over the periods (eq 24); ridge alpha {r['alpha']:.3g} by GCV, intercept {r['intercept']:.3g} N m. "
         "std: the regressed torques' spread on the test part.",

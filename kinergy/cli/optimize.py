@@ -6,11 +6,6 @@ per-move ``v`` and ``a`` that minimise the model's electrical energy at a cycle 
 with uniform time scaling, verifies all three by re-simulating them at 500 Hz, and computes the
 Pareto front of energy against cycle time. Optionally writes the optimum as a URScript program
 and the Pareto plot.
-
-Register it in ``kinergy/cli.py`` with::
-
-    from kinergy.cli.optimize import optimize
-    cli.add_command(optimize)
 """
 
 from __future__ import annotations
@@ -24,18 +19,11 @@ from typing import Any
 import click
 import numpy as np
 
+from kinergy.cli.common import table
 from kinergy.errors import KinergyError
+from kinergy.report.plots import timing_pareto
 
 __all__ = ["optimize"]
-
-
-def _table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
-    """Left-aligned text columns, two spaces apart."""
-    widths = [max(len(str(x)) for x in col) for col in zip(headers, *rows, strict=False)]
-    lines = ["  ".join(str(h).ljust(w) for h, w in zip(headers, widths, strict=True)).rstrip()]
-    for row in rows:
-        lines.append("  ".join(str(x).ljust(w) for x, w in zip(row, widths, strict=True)).rstrip())
-    return "\n".join(lines)
 
 
 def _cycle_time(text: str) -> float | None:
@@ -81,7 +69,7 @@ def _text_report(result: Any, task: Any, pareto: Sequence[Any], robot_name: str)
             ]
         )
     lines.append(
-        _table(
+        table(
             [
                 "move",
                 "v [rad/s]",
@@ -110,7 +98,7 @@ def _text_report(result: Any, task: Any, pareto: Sequence[Any], robot_name: str)
             ]
         )
     lines.append(
-        _table(
+        table(
             ["", "cycle [s]", "E_elec [J]", *(f"{k} [J]" for k in parts), "within limits"],
             totals,
         )
@@ -138,7 +126,7 @@ def _text_report(result: Any, task: Any, pareto: Sequence[Any], robot_name: str)
     if pareto:
         lines += ["", "Pareto front: energy against cycle time (re-simulated at 500 Hz)"]
         lines.append(
-            _table(
+            table(
                 ["cycle [s]", "optimized [J]", "uniform [J]"],
                 [
                     [
@@ -151,39 +139,6 @@ def _text_report(result: Any, task: Any, pareto: Sequence[Any], robot_name: str)
             )
         )
     return "\n".join(lines)
-
-
-def pareto_figure(result: Any, pareto: Sequence[Any]) -> Any:
-    """The Pareto plot: optimised energy against cycle time, uniform scaling, and the program,
-    its uniform scaling and the optimum marked."""
-    from kinergy.report.plots import pareto as pareto_plot
-
-    x = np.array([p.cycle_time for p in pareto])
-    marked = {"program as written": (result.program.cycle_time, result.program.e_elec)}
-    if abs(result.cycle_time - result.program.cycle_time) > 1e-6:
-        marked["uniform scaling"] = (result.uniform.cycle_time, result.uniform.e_elec)
-    marked["optimized"] = (result.optimized.cycle_time, result.optimized.e_elec)
-    fig = pareto_plot(x, np.array([p.optimized for p in pareto]), marked=marked)
-    ax = fig.axes[0]
-    for points in ax.collections:
-        if points.get_label() == "candidates":
-            points.set_label("optimised timing")
-    ok = np.array([p.uniform_ok for p in pareto])
-    if np.any(ok):
-        ax.plot(
-            x[ok],
-            np.array([p.uniform for p in pareto])[ok],
-            color="0.4",
-            linestyle="--",
-            linewidth=1.2,
-            marker="o",
-            markersize=3,
-            label="uniform time scaling",
-            zorder=2,
-        )
-    ax.legend(loc="upper right", fontsize=9, framealpha=0.9)
-    ax.set_title("Energy against cycle time: optimised timing and uniform scaling")
-    return fig
 
 
 @click.command()
@@ -310,7 +265,7 @@ def optimize(
                 f"the program as written ({result.program.e_elec:.1f} J) at the same cycle time"
             ],
         )
-    figure = pareto_figure(result, front) if plot is not None else None
+    figure = timing_pareto(result, front) if plot is not None else None
 
     written: list[Path] = []
     try:

@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from kinergy.dynamics._kernels import regressor_kernel
 from kinergy.dynamics.chain import check_state, kernel_geometry, link_inertials, make_chain
 from kinergy.errors import KinergyError
+from kinergy.linalg import pivoted_rank
 from kinergy.model.robot import Robot
 
 __all__ = [
@@ -192,9 +193,8 @@ def base_parameters(
     scale = np.linalg.norm(w, axis=0)
     nonzero = scale > 1e-9 * scale.max()  # columns that are zero up to round-off
     ws = np.where(nonzero, w / np.where(nonzero, scale, 1.0), 0.0)
-    _, r, piv = scipy.linalg.qr(ws, mode="economic", pivoting=True)
-    diag = np.abs(np.diag(r))
-    rank = int(np.sum(diag > rtol * diag[0]))
+    found = pivoted_rank(ws, rtol=rtol)
+    rank, r, piv = found.rank, found.r, found.pivots
     ind, dep = piv[:rank], piv[rank:]
     # ws[:, dep] = ws[:, ind] @ beta_s (in scaled columns), then undo the scaling
     beta_s = scipy.linalg.solve_triangular(r[:rank, :rank], r[:rank, rank:])

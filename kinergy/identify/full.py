@@ -74,8 +74,9 @@ from kinergy.dynamics.regressor import (
 )
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import (
-    LINEAR_PARAMETERS,
+    MODELS,
     friction_columns,
+    get_model,
     linear_values,
     start_parameters,
     with_linear_parameters,
@@ -358,7 +359,7 @@ def _friction_block(
     bounds them) so friction held through standstill sees each log's samples in time order.
     """
     n = n_mat.shape[0]
-    widths = [len(LINEAR_PARAMETERS[m]) for m in models]
+    widths = [len(get_model(m).linear) for m in models]
     out = np.zeros((wm.shape[0], n, sum(widths)))
     col = 0
     for m in range(n):
@@ -403,7 +404,7 @@ def _power_flow_load(
     Parameters
     ----------
     values : list of ndarray
-        Each motor's friction levels (:data:`kinergy.friction.registry.LINEAR_PARAMETERS`).
+        Each motor's friction levels (the model's ``linear`` parameters, :mod:`kinergy.friction`).
     wm, dwm, tau_m, previous : ndarray, shape (N, n)
         Motor speeds (rad/s), accelerations (rad/s^2), measured motor torques and the loads of the
         previous pass (N m, motor side).
@@ -525,9 +526,9 @@ def _check_options(solver: str, ridge: float, friction: str | None) -> None:
         raise KinergyError("solver 'ridge' needs ridge > 0 (the weight of the prior, e.g. 1e-4)")
     if solver != "ridge" and ridge != 0.0:
         raise KinergyError(f"ridge = {ridge:g} is only used by solver 'ridge', not {solver!r}")
-    if friction is not None and friction not in LINEAR_PARAMETERS:
+    if friction is not None and friction not in MODELS:
         raise KinergyError(
-            f"unknown friction model {friction!r} (known: {', '.join(sorted(LINEAR_PARAMETERS))})"
+            f"unknown friction model {friction!r} (known: {', '.join(sorted(MODELS))})"
         )
 
 
@@ -546,7 +547,7 @@ def _columns(
     robot: Robot, base: BaseParameters, models: list[str], params: list[dict[str, float]]
 ) -> _Columns:
     n = robot.n
-    widths = [len(LINEAR_PARAMETERS[m]) for m in models]
+    widths = [len(get_model(m).linear) for m in models]
     short = [base.names[k] for k in base.independent]
     joint = [f"joint {m + 1} ({j.name})" for m, j in enumerate(robot.joints)]
     prior = np.concatenate(
@@ -559,7 +560,7 @@ def _columns(
     return _Columns(
         names=[f"base parameter {s}" for s in short]
         + [f"rotor inertia of {joint[m]}" for m in range(n)]
-        + [f"friction {p} of {joint[m]}" for m in range(n) for p in LINEAR_PARAMETERS[models[m]]],
+        + [f"friction {p} of {joint[m]}" for m in range(n) for p in get_model(models[m]).linear],
         group=["link"] * base.size + ["rotor"] * n + ["friction"] * sum(widths),
         prior=prior,
         n_link=base.size,
@@ -862,7 +863,7 @@ def identify_full(
                 "friction": {"model": joint.drive.friction.model, **joint.drive.friction.params},
                 "friction_std": {
                     name: None if np.isnan(s) else float(s)
-                    for name, s in zip(LINEAR_PARAMETERS[models[m]], std[fric], strict=True)
+                    for name, s in zip(get_model(models[m]).linear, std[fric], strict=True)
                 },
             }
         )
@@ -1206,7 +1207,7 @@ def _write_back(
             drive = dataclasses.replace(drive, motor_inertia=rotor - drive.reducer_inertia)
         if not commanded:
             values = x[cols.fric_at[m] : cols.fric_at[m + 1]]
-            for name, value in zip(LINEAR_PARAMETERS[models[m]], values, strict=True):
+            for name, value in zip(get_model(models[m]).linear, values, strict=True):
                 if value < 0.0 and name != "gamma1":
                     warnings.append(
                         f"joint {m + 1} ({joint.name}): friction {name} = {value:.3g} is negative"

@@ -66,7 +66,7 @@ from kinergy.dynamics.kinematics import joint_axes
 from kinergy.dynamics.regressor import BaseParameters, base_parameters, inertial_parameters
 from kinergy.dynamics.regressor import regressor as full_regressor
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import FRICTION_MODELS
+from kinergy.friction.registry import get_model
 from kinergy.identify.metrics import r_squared, rmse
 from kinergy.identify.preprocess import IdentData, lowpass
 from kinergy.identify.pso import particle_swarm
@@ -149,7 +149,7 @@ BASE_FREQUENCY = 0.2 * np.pi
 #: the doc's low-pass cutoff for the motor currents, Hz
 FILTER_CUTOFF = 15.0
 
-_MAKKAR = FRICTION_MODELS["makkar"][0]  # ("gamma1", ..., "gamma6")
+_MAKKAR = get_model("makkar").parameters  # ("gamma1", ..., "gamma6")
 _RATES = (1, 2, 4)  # gamma2, gamma3, gamma5: the parameters the model is not linear in
 _GAINS = (0, 3, 5)  # gamma1, gamma4, gamma6
 

@@ -9,7 +9,7 @@
 3. Torque constant and friction of every motor together from the measured current (eqs 17-18):
    the current is linear in ``1/k_t`` (times the load torque from step 2's model) and in the
    friction parameters over ``k_t``. Any friction model linear in its parameters can be used
-   (:data:`kinergy.friction.registry.LINEAR_PARAMETERS`); the UR5e doc's is ``power_flow``.
+   (the model's ``linear`` parameters, :mod:`kinergy.friction`); the UR5e doc's is ``power_flow``.
 4. Motor inertia = rotor inertia - the model's reducer inertia (Table IV).
 
 Real controllers add one thing the seed does not model: a joint that stops stays in stiction,
@@ -31,8 +31,8 @@ from kinergy.drives.transmission import transmission_matrix
 from kinergy.dynamics.rnea import rnea
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import (
-    LINEAR_PARAMETERS,
     friction_columns,
+    get_model,
     start_parameters,
     with_linear_parameters,
 )
@@ -327,7 +327,7 @@ def identify_sequential(
             kt_std = std[0] / x[0] ** 2
             value_std = np.sqrt((std[1:] * kt) ** 2 + (x[1:] * kt_std * kt) ** 2)
             new_params = with_linear_parameters(model, params, values)
-            for name, value in zip(LINEAR_PARAMETERS[model], values, strict=True):
+            for name, value in zip(get_model(model).linear, values, strict=True):
                 if value < 0 and name not in ("gamma1",):
                     warnings.append(
                         f"joint {m + 1} ({joint.name}): friction {name} = {value:.3g} is negative"
@@ -345,7 +345,7 @@ def identify_sequential(
                     "torque_constant_std": float(kt_std),
                     "friction_std": {
                         name: float(s)
-                        for name, s in zip(LINEAR_PARAMETERS[model], value_std, strict=True)
+                        for name, s in zip(get_model(model).linear, value_std, strict=True)
                     },
                     "condition_current": cond,
                 }

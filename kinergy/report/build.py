@@ -443,9 +443,8 @@ def report_sections(
 
 def _timing_section(model: Robot, task: Any, figdir: Path) -> tuple[Section, Table]:
     """Energy-optimal timing of a movej program at its own cycle time, and the Pareto front."""
-    from kinergy.cli.optimize import pareto_figure
     from kinergy.optimize.timing import optimize_timing, pareto_front, timing_problem
-    from kinergy.report.plots import save
+    from kinergy.report.plots import save, timing_pareto
 
     problem = timing_problem(model, task.waypoints, blends=task.blends)
     common: dict[str, Any] = {
@@ -457,7 +456,7 @@ def _timing_section(model: Robot, task: Any, figdir: Path) -> tuple[Section, Tab
     result = optimize_timing(model, task.waypoints, **common)
     front = pareto_front(model, task.waypoints, points=6, **common)
     path = figdir / "pareto.png"
-    save(pareto_figure(result, front), path)
+    save(timing_pareto(result, front), path)
     rows = []
     for label, prog in (
         ("program as written", result.program),

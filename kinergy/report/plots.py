@@ -44,6 +44,7 @@ __all__ = [
     "power_energy",
     "save",
     "time_series",
+    "timing_pareto",
 ]
 
 Array = NDArray[np.float64]
@@ -550,6 +551,37 @@ def pareto(
 
 
 # -- output -------------------------------------------------------------------------------------
+
+
+def timing_pareto(result: Any, front: Sequence[Any]) -> Figure:
+    """The Pareto plot: optimised energy against cycle time, uniform scaling, and the program,
+    its uniform scaling and the optimum marked."""
+    x = np.array([p.cycle_time for p in front])
+    marked = {"program as written": (result.program.cycle_time, result.program.e_elec)}
+    if abs(result.cycle_time - result.program.cycle_time) > 1e-6:
+        marked["uniform scaling"] = (result.uniform.cycle_time, result.uniform.e_elec)
+    marked["optimized"] = (result.optimized.cycle_time, result.optimized.e_elec)
+    fig = pareto(x, np.array([p.optimized for p in front]), marked=marked)
+    ax = fig.axes[0]
+    for points in ax.collections:
+        if points.get_label() == "candidates":
+            points.set_label("optimised timing")
+    ok = np.array([p.uniform_ok for p in front])
+    if np.any(ok):
+        ax.plot(
+            x[ok],
+            np.array([p.uniform for p in front])[ok],
+            color="0.4",
+            linestyle="--",
+            linewidth=1.2,
+            marker="o",
+            markersize=3,
+            label="uniform time scaling",
+            zorder=2,
+        )
+    ax.legend(loc="upper right", fontsize=9, framealpha=0.9)
+    ax.set_title("Energy against cycle time: optimised timing and uniform scaling")
+    return fig
 
 
 def save(fig: Figure, path: str | os.PathLike[str]) -> Path:

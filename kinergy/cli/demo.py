@@ -1,0 +1,29 @@
+"""``kinergy demo``: the UR5e study on the built-in twin, from logs to report."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from kinergy.cli.common import print_tables, progress
+from kinergy.workflows.demo import run_demo
+
+__all__ = ["demo"]
+
+
+@click.command()
+@click.option(
+    "--out",
+    "out",
+    type=click.Path(file_okay=False),
+    default="kinergy-demo",
+    show_default=True,
+    help="Folder for the logs, figures and report.html.",
+)
+def demo(out: str) -> None:
+    """The UR5e study on the built-in twin: simulate tests A and B, identify on A, validate on A
+    and B, compute the energy, print UR5e Tables IV-VIII and write an HTML report."""
+    _sections, tables, report, seconds = run_demo(Path(out), progress())
+    print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown", "timing"])
+    click.echo(f"\nreport: {report} ({seconds:.1f} s)")

@@ -1,0 +1,92 @@
+"""``kinergy energy``: per-joint mechanical and electrical energy of a logged or planned motion."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import click
+
+from kinergy.cli.common import columns_option, load, payload_option, table
+from kinergy.energy.accounting import energy as account
+from kinergy.jsonable import dumps
+from kinergy.workflows.logs import read_motion
+
+__all__ = ["energy", "energy_text"]
+
+_PARTS = ("inertial", "gravity", "friction", "copper")
+
+
+def _row(name: str, e: dict[str, Any], efficiency: float | None, mean_power: float) -> list[str]:
+    eff = "-" if efficiency is None else f"{100 * efficiency:.1f}"
+    return [
+        name,
+        f"{e['e_mech']:.1f}",
+        f"{e['e_elec']:.1f}",
+        eff,
+        f"{mean_power:.1f}",
+        f"{e['peak_power']:.1f}",
+        *(f"{e['breakdown'][k]:.1f}" for k in _PARTS),
+    ]
+
+
+def energy_text(report: dict[str, Any]) -> str:
+    """The ``energy`` table: one row per joint and the total, with what the figures include."""
+    rows = [_row(j["name"], j, j["efficiency"], j["mean_power"]) for j in report["joints"]]
+    tot = report["total"]
+    rows.append(_row("total", tot, tot["efficiency"], tot["e_elec"] / report["duration"]))
+    head = f"{report['robot']}: {report['duration']:.3f} s, {report['samples']} samples; " + (
+        "signed integrals (braking energy returns to the bus)"
+        if report["recovery"]
+        else "no recovery (negative power clipped)"
+    )
+    headers = ["joint", "E_mech [J]", "E_elec [J]", "eta [%]", "mean P [W]", "peak P [W]"]
+    headers += [f"{k} [J]" for k in _PARTS]
+    lines = [
+        head,
+        "",
+        table(headers, rows),
+        "",
+        "E_mech = int tau_m wm dt, E_elec = int W_elec dt (UR5e eqs 23, 25, 26); eta = E_mech / E_elec.",
+        "E_elec = inertial + gravity + friction + copper (each motion part includes its k_b/k_t share).",
+    ]
+    if tot["standby"]:
+        lines.append(
+            f"standby: {tot['standby']:.1f} J; total drawn {tot['e_elec_with_standby']:.1f} J"
+        )
+    return "\n".join(lines)
+
+
+@click.command()
+@click.argument("model", metavar="MODEL")
+@click.argument("motion_path", metavar="LOG_OR_MOTION", type=click.Path(dir_okay=False))
+@columns_option
+@click.option("--json", "as_json", is_flag=True, help="Print JSON (DESIGN.md shape).")
+@click.option(
+    "--no-recovery", is_flag=True, help="Clip negative power: the supply takes no energy back."
+)
+@click.option(
+    "--source",
+    type=click.Choice(["auto", "target", "actual"]),
+    default="auto",
+    show_default=True,
+    help="Which motion of a log: commanded (target_*) or measured (actual_*).",
+)
+@payload_option
+def energy(
+    model: str,
+    motion_path: str,
+    columns: str | None,
+    as_json: bool,
+    no_recovery: bool,
+    source: str,
+    payload: str | None,
+) -> None:
+    """Per-joint mechanical and electrical energy of a logged or planned motion.
+
+    MODEL is a built-in name or a model file; LOG_OR_MOTION a log (record.py layout, or headerless
+    with --columns) or a motion file.
+    """
+    r = load(model, payload)
+    motion = read_motion(motion_path, n_joints=r.n, columns=columns, source=source)
+    report = account(r, motion, recovery=not no_recovery).to_dict()
+    click.echo(dumps(report) if as_json else energy_text(report))

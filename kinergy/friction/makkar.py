@@ -1,0 +1,48 @@
+"""``makkar``: Makkar's continuously differentiable friction (nursing eq 13):
+``gamma1 (tanh(gamma2 wm) - tanh(gamma3 wm)) + gamma4 tanh(gamma5 wm) + gamma6 wm``.
+
+``gamma1`` scales the Stribeck hump (rates ``gamma2``, ``gamma3``), ``gamma4`` the Coulomb level
+(rate ``gamma5``) and ``gamma6`` is the viscous coefficient; the model is linear in
+``gamma1``, ``gamma4`` and ``gamma6``."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from kinergy.friction.model import FrictionModel
+
+Array = NDArray[np.float64]
+
+PARAMETERS = tuple(f"gamma{k}" for k in range(1, 7))
+
+
+def makkar(gamma: Sequence[float] | ArrayLike, speed: ArrayLike) -> Array:
+    """Nursing eq 13 at ``speed`` (any shape) for ``gamma`` = ``[gamma1, ..., gamma6]``."""
+    g1, g2, g3, g4, g5, g6 = (float(g) for g in np.asarray(gamma, dtype=float))
+    v = np.asarray(speed, dtype=float)
+    return g1 * (np.tanh(g2 * v) - np.tanh(g3 * v)) + g4 * np.tanh(g5 * v) + g6 * v
+
+
+def _torque(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    return makkar([p[name] for name in PARAMETERS], wm)
+
+
+def _columns(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    return np.column_stack(
+        [np.tanh(p["gamma2"] * wm) - np.tanh(p["gamma3"] * wm), np.tanh(p["gamma5"] * wm), wm]
+    )
+
+
+MODEL = FrictionModel(
+    name="makkar",
+    parameters=PARAMETERS,
+    torque=_torque,
+    linear=("gamma1", "gamma4", "gamma6"),
+    columns=_columns,
+    bounds={"gamma1": (-np.inf, np.inf), "gamma4": (0.0, np.inf), "gamma6": (0.0, np.inf)},
+    shape_defaults={"gamma2": 50.0, "gamma3": 5.0, "gamma5": 100.0},
+    citation="nursing eq 13 (Makkar et al.)",
+)

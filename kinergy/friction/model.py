@@ -1,0 +1,84 @@
+"""What a friction model is: a name, its parameters, its torque and, where it is linear in some
+parameters, its regressor columns.
+
+A model is a :class:`FrictionModel` value; the registry (:mod:`kinergy.friction.registry`) names
+them. All quantities are motor side: speed ``wm`` in rad/s, torques in N m.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["Columns", "FrictionModel", "Torque"]
+
+Array = NDArray[np.float64]
+
+#: ``torque(params, wm, tau_load) -> (N,)``: friction torque, motor side, N m.
+Torque = Callable[[Mapping[str, float], Array, Array | None], Array]
+#: ``columns(params, wm, tau_load) -> (N, k)``: ``torque == columns @ linear values``.
+Columns = Callable[[Mapping[str, float], Array, Array | None], Array]
+
+
+def _by_name(model: FrictionModel, params: Mapping[str, float]) -> Array:
+    return np.array([params[name] for name in model.linear], dtype=float)
+
+
+def _replace_by_name(
+    model: FrictionModel, params: Mapping[str, float], values: Array
+) -> dict[str, float]:
+    out = dict(params)
+    out.update({name: float(v) for name, v in zip(model.linear, values, strict=True)})
+    return out
+
+
+@dataclass(frozen=True)
+class FrictionModel:
+    """One friction model.
+
+    Attributes
+    ----------
+    name : str
+        The name robot files use (``model = "power_flow"``).
+    parameters : tuple of str
+        Its parameters, in file order; all required.
+    torque : callable
+        ``torque(params, wm, tau_load) -> ndarray (N,)``, opposing the motion.
+    linear : tuple of str
+        The parameters the torque is linear in (fitted by least squares; the others, such as
+        ``smoothing``, shape the columns and stay fixed in a linear fit). A name not in
+        ``parameters`` is a combination that :attr:`linear_values` defines.
+    columns : callable or None
+        ``columns(params, wm, tau_load) -> ndarray (N, len(linear))`` with
+        ``torque == columns @ linear_values(params)``.
+    positive : frozenset of str
+        Parameters that must be > 0 (they divide).
+    bounds : mapping of str to (float, float)
+        Physically plausible range of each linear parameter (motor side), for constrained fits.
+    shape_defaults : mapping of str to float
+        Values a fit starts the non-linear parameters from when a joint switches to this model.
+    needs_load : bool
+        Whether ``torque`` needs the load torque (power-flow or load-dependent friction).
+    citation : str
+        Where the model comes from (``UR5e eqs 11-16``).
+    linear_values, with_linear : callable, optional
+        How :attr:`linear` maps to and from the parameters, when not one to one by name.
+    """
+
+    name: str
+    parameters: tuple[str, ...]
+    torque: Torque
+    linear: tuple[str, ...] = ()
+    columns: Columns | None = None
+    positive: frozenset[str] = frozenset()
+    bounds: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    shape_defaults: Mapping[str, float] = field(default_factory=dict)
+    needs_load: bool = False
+    citation: str = ""
+    linear_values: Callable[[FrictionModel, Mapping[str, float]], Array] = _by_name
+    with_linear: Callable[[FrictionModel, Mapping[str, float], Array], dict[str, float]] = (
+        _replace_by_name
+    )

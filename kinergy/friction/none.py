@@ -1,0 +1,23 @@
+"""``none``: no friction (an ideal drive)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kinergy.friction.model import FrictionModel
+
+Array = NDArray[np.float64]
+
+
+def _torque(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    return np.zeros_like(wm)
+
+
+def _columns(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    return np.zeros((wm.size, 0))
+
+
+MODEL = FrictionModel(name="none", parameters=(), torque=_torque, columns=_columns)

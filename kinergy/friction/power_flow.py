@@ -1,0 +1,53 @@
+"""``power_flow``: UR5e eqs 11-16, viscous friction plus a Coulomb level that depends on the
+direction of power flow through the harmonic drive:
+``viscous * wm + tanh(wm / smoothing) * Tc``, ``Tc = coulomb_direct`` when power flows from the
+motor to the load (``wm * tau_load > 0``), else ``coulomb_reverse``."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kinergy.errors import KinergyError
+from kinergy.friction.model import FrictionModel
+from kinergy.friction.viscous_coulomb import sign
+
+Array = NDArray[np.float64]
+
+
+def _load(tau_load: Array | None) -> Array:
+    if tau_load is None:
+        raise KinergyError(
+            "friction model 'power_flow' needs the load torque to tell the direction of power flow"
+        )
+    return np.asarray(tau_load, dtype=float)
+
+
+def _torque(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    direct = wm * _load(tau_load) > 0.0
+    coulomb = np.where(direct, p["coulomb_direct"], p["coulomb_reverse"])
+    return p["viscous"] * wm + coulomb * sign(wm, p["smoothing"])
+
+
+def _columns(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    """UR5e eq 18's columns ``[wm, tanh(wm_dir / e), tanh(wm_rev / e)]`` (eqs 15-16)."""
+    flow = wm * _load(tau_load)
+    w_dir = np.where(flow > 0.0, wm, 0.0)  # UR5e eq 15
+    w_rev = np.where(flow < 0.0, wm, 0.0)  # UR5e eq 16
+    return np.column_stack([wm, sign(w_dir, p["smoothing"]), sign(w_rev, p["smoothing"])])
+
+
+MODEL = FrictionModel(
+    name="power_flow",
+    parameters=("viscous", "coulomb_direct", "coulomb_reverse", "smoothing"),
+    torque=_torque,
+    linear=("viscous", "coulomb_direct", "coulomb_reverse"),
+    columns=_columns,
+    positive=frozenset({"smoothing"}),
+    bounds={k: (0.0, np.inf) for k in ("viscous", "coulomb_direct", "coulomb_reverse")},
+    shape_defaults={"smoothing": 1e-3},
+    needs_load=True,
+    citation="UR5e eqs 11-16",
+)

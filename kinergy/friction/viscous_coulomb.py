@@ -1,0 +1,40 @@
+"""``viscous_coulomb``: ``viscous * wm + coulomb * tanh(wm / smoothing)`` (framework Table 1,
+one friction source per joint)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kinergy.friction.model import FrictionModel
+
+Array = NDArray[np.float64]
+
+
+def sign(wm: Array, smoothing: float) -> Array:
+    """The smoothed sign ``tanh(wm / smoothing)`` every Coulomb term uses."""
+    return np.tanh(wm / smoothing)
+
+
+def _torque(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    return p["viscous"] * wm + p["coulomb"] * sign(wm, p["smoothing"])
+
+
+def columns(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+    """``[wm, tanh(wm / smoothing)]``, (N, 2): the viscous and Coulomb columns."""
+    return np.column_stack([wm, sign(wm, p["smoothing"])])
+
+
+MODEL = FrictionModel(
+    name="viscous_coulomb",
+    parameters=("viscous", "coulomb", "smoothing"),
+    torque=_torque,
+    linear=("viscous", "coulomb"),
+    columns=columns,
+    positive=frozenset({"smoothing"}),
+    bounds={"viscous": (0.0, np.inf), "coulomb": (0.0, np.inf)},
+    shape_defaults={"smoothing": 1e-3},
+    citation="framework Table 1",
+)

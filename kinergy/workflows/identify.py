@@ -1,0 +1,63 @@
+"""``kinergy identify``: a model (or a payload) from logs, written as a robot file."""
+
+from __future__ import annotations
+
+import datetime
+import os
+from collections.abc import Sequence
+from typing import Any
+
+from kinergy.identify.full import identify_full
+from kinergy.identify.nursing import identify_nursing
+from kinergy.identify.payload import identify_payload
+from kinergy.identify.preprocess import IdentData
+from kinergy.identify.result import IdentificationResult
+from kinergy.identify.sequential import identify_sequential
+from kinergy.model import Payload, Robot, save_robot
+
+__all__ = ["METHODS", "identify_model", "identify_payload_model"]
+
+#: identification methods by the name ``--method`` takes
+METHODS = ("sequential", "full", "nursing")
+
+
+def _header(what: str, logs: Sequence[str | os.PathLike[str]]) -> str:
+    from kinergy import __version__
+
+    stamp = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
+    return f"kinergy {__version__}: {what} from {', '.join(os.fspath(p) for p in logs)} on {stamp}"
+
+
+def identify_model(
+    robot: Robot,
+    datas: Sequence[IdentData],
+    out: str | os.PathLike[str],
+    *,
+    method: str = "sequential",
+    friction: str | None = None,
+    target: str = "auto",
+    solver: str = "ols",
+    ridge: float = 0.0,
+) -> IdentificationResult:
+    """Identify ``robot`` from prepared logs by ``method`` and write the model to ``out``."""
+    if method == "sequential":
+        result = identify_sequential(robot, list(datas), friction=friction)
+    elif method == "nursing":
+        result = identify_nursing(robot, list(datas))
+    else:
+        result = identify_full(
+            robot, list(datas), target=target, solver=solver, ridge=ridge, friction=friction
+        )
+    what = f"{robot.name} identified ({result.method} method)"
+    save_robot(result.robot, out, header=_header(what, [d.path for d in datas]))
+    return result
+
+
+def identify_payload_model(
+    robot: Robot, datas: Sequence[IdentData], out: str | os.PathLike[str]
+) -> tuple[Payload, dict[str, Any]]:
+    """Identify the payload of ``robot`` (the model without it) and write the model with it."""
+    payload, report = identify_payload(robot, list(datas))
+    what = f"{robot.name} with the payload identified"
+    save_robot(robot.with_payload(payload), out, header=_header(what, [d.path for d in datas]))
+    return payload, report

@@ -1,0 +1,49 @@
+"""Reading the user's logs for a command: each file read, its notes passed on, then prepared."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Sequence
+
+from kinergy.identify.preprocess import IdentData, prepare
+from kinergy.io.motion import motion_from_log
+from kinergy.io.rtde import read_log
+from kinergy.trajectory.motion import Motion
+
+__all__ = ["prepared_logs", "read_motion"]
+
+
+def prepared_logs(
+    paths: Sequence[str | os.PathLike[str]],
+    *,
+    n_joints: int,
+    columns: str | None = None,
+    repair: bool = False,
+    cutoff: float | None = None,
+    note: Callable[[str], None] | None = None,
+) -> list[IdentData]:
+    """Read and prepare every log (:func:`kinergy.identify.preprocess.prepare`).
+
+    ``note`` receives what reading changed (rows dropped by ``repair``), one message each.
+    """
+    datas = []
+    for path in paths:
+        log = read_log(path, columns=columns, repair=repair)
+        for message in log.notes:
+            if note is not None:
+                note(message)
+        datas.append(prepare(log, n_joints, cutoff=cutoff))
+    return datas
+
+
+def read_motion(
+    path: str | os.PathLike[str],
+    *,
+    n_joints: int,
+    columns: str | None = None,
+    repair: bool = False,
+    source: str = "auto",
+) -> Motion:
+    """The joint motion of a log or motion file (:func:`kinergy.io.motion.motion_from_log`)."""
+    log = read_log(path, columns=columns, repair=repair)
+    return motion_from_log(log, n_joints=n_joints, source=source)
