@@ -5,7 +5,8 @@ hold everywhere:
 
 - a dataclass becomes an object of its fields, in declaration order; a field declared with
   ``metadata={"json": False}`` is left out, one with ``metadata={"json": callable}`` is written as
-  ``callable(value)`` (say, a robot as its name);
+  ``callable(value)`` (say, a robot as its name); one declared with :data:`OPTIONAL` metadata
+  is left out while it is None (a figure a method reports only when it has the data);
 - numpy scalars and arrays become numbers and (nested) lists; tuples become lists; mappings
   become objects with string keys;
 - NaN and infinities become ``null``: JSON has no NaN, and a bare ``NaN`` breaks other tools'
@@ -22,7 +23,10 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["dumps", "to_jsonable"]
+__all__ = ["OPTIONAL", "dumps", "to_jsonable"]
+
+#: dataclass field metadata: leave the field out of JSON while its value is None
+OPTIONAL = {"omit_none": True}
 
 
 def _number(x: float) -> float | None:
@@ -55,6 +59,8 @@ def to_jsonable(value: Any) -> Any:
             if how is False:
                 continue
             item = getattr(value, f.name)
+            if item is None and f.metadata.get("omit_none"):
+                continue
             out[f.name] = to_jsonable(how(item) if callable(how) else item)
         return out
     if isinstance(value, Mapping):

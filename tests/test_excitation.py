@@ -113,8 +113,8 @@ def identified_base(
     from perturbed links, and their standard deviations."""
     data = prepare(simulate(robot, motion, settings), robot.n)
     result = identify_full(links_perturbed(robot, seed=2), [data], target=target)
-    values = np.array([p["value"] for p in result.fit["base_parameters"]])
-    std = np.array([p["std"] for p in result.fit["base_parameters"]])
+    values = np.array([p.value for p in result.fit.base_parameters])
+    std = np.array([p.std for p in result.fit.base_parameters])
     return values, std
 
 

@@ -61,8 +61,8 @@ def test_twin_parameters_within_the_issue_tolerances(ur5e: kinergy.Robot, twin_r
 def test_twin_predicts_an_unseen_log(twin_result) -> None:
     result, unseen = twin_result
     metrics = validation_metrics(result.robot, [unseen])
-    assert min(m["r2"] for m in metrics["current"]) >= 0.98
-    assert min(m["r2"] for m in metrics["torque"]) >= 0.99
+    assert min(m.r2 for m in metrics.current) >= 0.98
+    assert min(m.r2 for m in metrics.torque) >= 0.99
 
 
 def test_result_json_has_the_contract_keys(twin_result) -> None:
@@ -98,12 +98,10 @@ def test_a_joint_that_never_moves_gets_a_message_not_numbers(ur5e: kinergy.Robot
     log = _twin(ur5e, still, TwinSettings.exact(), "still")
     result = identify_sequential(ur5e, [prepare(log, 6)])
     entry = result.joints[3]
-    assert entry["identified"] is False and "never moves" in entry["problem"]
-    assert (
-        entry["torque_constant"] == ur5e.joints[3].drive.torque_constant
-    )  # the model's, untouched
+    assert entry.identified is False and "never moves" in entry.problem
+    assert entry.torque_constant == ur5e.joints[3].drive.torque_constant  # the model's, untouched
     assert any("joint 4 (wrist_1) never moves" in w for w in result.warnings)
-    assert all(j["identified"] for k, j in enumerate(result.joints) if k != 3)
+    assert all(j.identified for k, j in enumerate(result.joints) if k != 3)
 
 
 def test_nothing_identifiable_is_one_error(ur5e: kinergy.Robot) -> None:
@@ -144,7 +142,7 @@ def test_payload_from_a_twin_log(
     payload, report = identify_payload(ur5e, [prepare(log, 6)])
     assert payload.mass == pytest.approx(2.4, rel=tolerance)
     np.testing.assert_allclose(payload.com, truth.com, atol=max(0.002, 0.5 * tolerance))
-    assert report["signal"] == "current"
+    assert report.signal == "current"
 
 
 def test_payload_needs_a_payload(ur5e: kinergy.Robot) -> None:
@@ -209,12 +207,12 @@ def test_ur10e_predicts_the_held_out_point_to_point_program(ur10e_model) -> None
         read_log(UR10E / "validation_data" / "ur-20_01_17-ptp_10_points.csv", columns=UR10E_SPEC), 6
     )
     metrics = validation_metrics(ur10e_model, [val])
-    r2 = [m["r2"] for m in metrics["current"]]
+    r2 = [m.r2 for m in metrics.current]
     # measured (README): 0.963 0.995 0.997 0.977 0.958 0.808 -- wrist 3 rests 64 % of this run and
     # its standstill current wanders under the position loop (see README)
     assert min(r2[:5]) >= 0.95
     assert r2[5] >= 0.78
-    assert min(m["r2"] for m in metrics["torque"]) >= 0.95
+    assert min(m.r2 for m in metrics.torque) >= 0.95
 
 
 def test_ur10e_payload_within_five_percent(ur10e_model) -> None:

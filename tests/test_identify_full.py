@@ -96,11 +96,11 @@ def expected_unknowns(result: IdentificationResult, truth: kinergy.Robot) -> np.
         [
             base.project(kinergy.inertial_parameters(truth)),
             [j.drive.rotor_inertia for j in truth.joints],
-            np.full(len(result.fit["parameters"]) - base.size - truth.n, np.nan),
+            np.full(len(result.fit.parameters) - base.size - truth.n, np.nan),
         ]
     )
-    names = [p["name"] for p in result.fit["parameters"]]
-    for entry in result.fit["merged"]:
+    names = [p.name for p in result.fit.parameters]
+    for entry in result.fit.merged:
         k = names.index(entry["parameter"])
         for into in entry["into"]:
             x[into["index"]] += into["coefficient"] * (x[k] - entry["value"])
@@ -109,12 +109,12 @@ def expected_unknowns(result: IdentificationResult, truth: kinergy.Robot) -> np.
 
 def expected_base(result: IdentificationResult, truth: kinergy.Robot) -> np.ndarray:
     """The base-parameter part of :func:`expected_unknowns`."""
-    return expected_unknowns(result, truth)[: len(result.fit["base_parameters"])]
+    return expected_unknowns(result, truth)[: len(result.fit.base_parameters)]
 
 
 def identified_base(result: IdentificationResult) -> tuple[np.ndarray, np.ndarray]:
-    values = np.array([p["value"] for p in result.fit["base_parameters"]])
-    std = np.array([p["std"] for p in result.fit["base_parameters"]])
+    values = np.array([p.value for p in result.fit.base_parameters])
+    std = np.array([p.std for p in result.fit.base_parameters])
     return values, std
 
 
@@ -164,32 +164,32 @@ def test_moment_recovers_the_true_base_parameters_and_rotor_inertias(
 ) -> None:
     start = perturbed(ur5e, seed=2)
     result = identify_full(start, [exact_log], target="moment")
-    assert result.method == "full" and result.fit["target"] == "moment"
+    assert result.method == "full" and result.fit.target == "moment"
     values, std = identified_base(result)
     np.testing.assert_allclose(values, expected_base(result, ur5e), rtol=1e-6, atol=1e-9)
     assert np.all(np.isfinite(std))
     # on a UR arm J1 and J2 multiply the same signals as the Iyy1 and Izz2 groups
-    merged = [e["parameter"] for e in result.fit["merged"]]
+    merged = [e["parameter"] for e in result.fit.merged]
     assert merged == [
         "rotor inertia of joint 1 (shoulder_pan)",
         "rotor inertia of joint 2 (shoulder_lift)",
     ]
     assert sum("cannot be told apart" in w for w in result.warnings) == 2
     for m, (entry, joint) in enumerate(zip(result.joints, ur5e.joints, strict=True)):
-        assert entry["rotor_inertia_merged"] == (m < 2)
+        assert entry.rotor_inertia_merged == (m < 2)
         if m >= 2:  # the separable rotor inertias are exact
-            assert entry["rotor_inertia"] == pytest.approx(joint.drive.rotor_inertia, rel=1e-6)
-            assert entry["rotor_inertia_std"] > 0
+            assert entry.rotor_inertia == pytest.approx(joint.drive.rotor_inertia, rel=1e-6)
+            assert entry.rotor_inertia_std > 0
     # the returned robot reproduces target_moment; the moment carries no friction, kept
-    torque = result.fit["torque"]
-    assert min(t["r2"] for t in torque) > 1.0 - 1e-9
+    torque = result.fit.torque
+    assert min(t.r2 for t in torque) > 1.0 - 1e-9
     for joint, old in zip(result.robot.joints, start.joints, strict=True):
         assert joint.drive.friction.params == old.drive.friction.params
     assert result.robot.sources["inertia"].status == "identified"
     assert result.robot.sources["drive_inertia"].status == "identified"
     assert result.robot.sources["friction"].status != "identified"
-    assert result.fit["condition"] < 1e3
-    names = [b["name"] for b in result.fit["base_parameters"]]
+    assert result.fit.condition < 1e3
+    names = [b.name for b in result.fit.base_parameters]
     assert names == kinergy.base_parameters(ur5e).expressions()
     json.dumps(result.to_dict())  # the identify --json shape
 
@@ -201,17 +201,17 @@ def test_current_with_friction_reproduces_the_currents(
     result = identify_full(start, [exact_log], target="current")
     values, _ = identified_base(result)
     np.testing.assert_allclose(values, expected_base(result, ur5e), rtol=1e-6, atol=1e-9)
-    current = result.fit["current"]
-    assert min(c["r2"] for c in current) > 0.9999
+    current = result.fit.current
+    assert min(c.r2 for c in current) > 0.9999
     for entry, joint in zip(result.joints, ur5e.joints, strict=True):  # power-flow friction
-        assert entry["friction"]["model"] == "power_flow"
+        assert entry.friction["model"] == "power_flow"
         for name in ("viscous", "coulomb_direct", "coulomb_reverse"):
-            assert entry["friction"][name] == pytest.approx(
+            assert entry.friction[name] == pytest.approx(
                 joint.drive.friction.params[name], rel=1e-6
             )
-        assert entry["friction"]["smoothing"] == joint.drive.friction.params["smoothing"]
-        assert entry["torque_constant"] == joint.drive.torque_constant
-    assert result.fit["power_flow_mismatch"] == 0
+        assert entry.friction["smoothing"] == joint.drive.friction.params["smoothing"]
+        assert entry.torque_constant == joint.drive.torque_constant
+    assert result.fit.power_flow_mismatch == 0
     assert result.robot.sources["friction"].status == "identified"
 
 
@@ -222,25 +222,25 @@ def test_coupled_joints_are_identified_through_the_transmission() -> None:
     data = twin_data(robot, excitation(robot, seed=3), TwinSettings.exact())
     result = identify_full(perturbed(robot, seed=1), [data], target="moment")
     expected = expected_unknowns(result, robot)
-    values = np.array([p["value"] for p in result.fit["parameters"]])
-    b = len(result.fit["base_parameters"])
+    values = np.array([p.value for p in result.fit.parameters])
+    b = len(result.fit.base_parameters)
     np.testing.assert_allclose(values[:b], expected[:b], rtol=1e-6, atol=1e-9)
-    separable = ~np.array([j["rotor_inertia_merged"] for j in result.joints])
+    separable = ~np.array([j.rotor_inertia_merged for j in result.joints])
     np.testing.assert_allclose(
         values[b : b + 6][separable], expected[b : b + 6][separable], rtol=1e-6
     )
     # joint 2's rotor column is a combination of joint 1's and two link base columns
-    (merged,) = result.fit["merged"]
+    (merged,) = result.fit.merged
     assert merged["parameter"] == "rotor inertia of joint 2 (shoulder_rotation)"
     assert {e["parameter"] for e in merged["into"]} >= {"rotor inertia of joint 1 (shoulder_pitch)"}
-    assert min(t["r2"] for t in result.fit["torque"]) > 1.0 - 1e-9
-    assert all(result.fit["links_physical"])
+    assert min(t.r2 for t in result.fit.torque) > 1.0 - 1e-9
+    assert all(result.fit.links_physical)
 
 
 def test_auto_target_prefers_torque_then_moment(ur5e: kinergy.Robot, exact_log: IdentData) -> None:
-    assert identify_full(ur5e, [exact_log]).fit["target"] == "moment"
+    assert identify_full(ur5e, [exact_log]).fit.target == "moment"
     torque = dataclasses.replace(exact_log, torque=exact_log.tau_ref)
-    assert identify_full(ur5e, [torque]).fit["target"] == "torque"
+    assert identify_full(ur5e, [torque]).fit.target == "torque"
 
 
 # ------------------------------------------------------------------------------- noisy twin logs
@@ -261,20 +261,20 @@ def test_noisy_currents_give_honest_estimates(
     z = (values - truth) / std
     assert np.max(np.abs(z)) < 5.0, np.round(z, 2)
     # ... and the well-determined ones (relative std below 1 %) within 3 %
-    rel = np.array([b["rel_std"] for b in result.fit["base_parameters"]])
+    rel = np.array([b.rel_std for b in result.fit.base_parameters])
     good = rel < 0.01
     assert good.sum() >= 2
     np.testing.assert_allclose(values[good], truth[good], rtol=0.03)
     # the residual is the current noise: 0.04 A times k_t times the gear ratio at each joint
     noise = np.array([0.04 * j.drive.torque_constant * j.drive.gear_ratio for j in ur5e_vc.joints])
-    assert np.all(np.abs(np.array(result.fit["residual_std"]) / noise - 1.0) < 0.1)
-    rotor_std = [j["rotor_inertia_std"] for j in result.joints]
+    assert np.all(np.abs(np.array(result.fit.residual_std) / noise - 1.0) < 0.1)
+    rotor_std = [j.rotor_inertia_std for j in result.joints]
     assert all(s is None or (np.isfinite(s) and s > 0) for s in rotor_std)
     for j in result.joints:
-        assert all(np.isfinite(s) for s in j["friction_std"].values())
-    assert all(result.fit["links_physical"])
+        assert all(np.isfinite(s) for s in j.friction_std.values())
+    assert all(result.fit.links_physical)
     if solver == "wls":  # Gautier's weights are the inverse noise variances
-        weights = np.array(result.fit["weights"])
+        weights = np.array(result.fit.weights)
         np.testing.assert_allclose(weights / weights[0], (noise[0] / noise) ** 2, rtol=0.2)
 
 
@@ -285,7 +285,7 @@ def test_noisy_currents_with_power_flow_friction(ur5e: kinergy.Robot, noisy_log:
     result = identify_full(perturbed(ur5e, seed=4), [noisy_log], target="current", solver="wls")
     values, std = identified_base(result)
     truth = expected_base(result, ur5e)
-    rel = np.array([b["rel_std"] for b in result.fit["base_parameters"]])
+    rel = np.array([b.rel_std for b in result.fit.base_parameters])
     good = rel < 0.01
     np.testing.assert_allclose(values[good], truth[good], rtol=0.03)
     assert np.max(np.abs((values - truth) / std)) < 10.0
@@ -293,11 +293,11 @@ def test_noisy_currents_with_power_flow_friction(ur5e: kinergy.Robot, noisy_log:
     # direction from its own load torque, and joint 5's Coulomb levels (0.0201 direct, 0.001
     # reverse) make that sensitive near zero load: its R^2 drops (0.84 here, 0.96 for the true
     # model) while the other joints keep theirs
-    regression = [c["r2"] for c in result.fit["regression"]]
+    regression = [c.r2 for c in result.fit.regression]
     assert min(regression) > 0.95
-    current = [c["r2"] for c in result.fit["current"]]
+    current = [c.r2 for c in result.fit.current]
     assert min(current[:4]) > 0.98 and min(current) > 0.8
-    assert all(result.fit["links_physical"])
+    assert all(result.fit.links_physical)
 
 
 def test_ridge_moves_from_least_squares_to_the_prior(
@@ -343,9 +343,9 @@ def test_unphysical_base_parameters_are_flagged(ur5e: kinergy.Robot, ur5e_motion
     flagged = [w for w in result.warnings if w.startswith("link 6 (wrist_3)")]
     assert len(flagged) == 1 and "not positive definite" in flagged[0]
     # ... and a valid robot anyway: the fit constrained to physical links
-    assert result.fit["write_back"] == "physically consistent least squares"
-    assert all(result.fit["links_physical"])
-    assert result.fit["physical_fit"]["chi2_increase"] > 1.0
+    assert result.fit.write_back == "physically consistent least squares"
+    assert all(result.fit.links_physical)
+    assert result.fit.physical_fit["chi2_increase"] > 1.0
     pi = kinergy.inertial_parameters(result.robot)
     assert all(p is None for p in link_consistency(pi))
     assert np.all(np.linalg.eigvalsh(pseudo_inertia(pi))[:, 0] > 0)
@@ -361,7 +361,7 @@ def test_a_link_that_cannot_be_made_physical_keeps_the_model(
     result = identify_full(ur5e, [_moment_log(ur5e, ur5e_motion, pi_b)], target="moment")
     kept = [w for w in result.warnings if w.startswith("link 6 (wrist_3)")]
     assert len(kept) == 1 and "kept the model's mass, centre of mass and inertia" in kept[0]
-    assert result.fit["links_physical"][5] is False
+    assert result.fit.links_physical[5] is False
     link6, model6 = result.robot.joints[5].link, ur5e.joints[5].link
     assert link6.mass == model6.mass
     np.testing.assert_array_equal(link6.inertia, model6.inertia)
@@ -503,13 +503,13 @@ def test_panda_predicts_held_out_measured_torques() -> None:
     assert data.q.shape == (21000, 7)  # 21 s resampled at the median 1 ms
     split = int(0.7 * len(data))
     result = identify_full(robot, [data.sliced(0, split)], target="torque")
-    held_out = validation_metrics(result.robot, [data.sliced(split, len(data))])["joint_torque"]
-    r2 = np.array([m["r2"] for m in held_out])
-    rms = np.array([m["rms"] for m in held_out])
+    held_out = validation_metrics(result.robot, [data.sliced(split, len(data))]).joint_torque
+    r2 = np.array([m.r2 for m in held_out])
+    rms = np.array([m.rms for m in held_out])
     # measured: R^2 0.979 0.9994 0.998 0.994 0.983 0.987 0.957, RMS 0.36 0.41 0.29 0.43 0.13 0.14
     # 0.058 N m (Gaz et al.'s own parameters: R^2 0.977 0.998 0.998 0.993 0.970 0.986 0.935)
     assert np.all(r2 > [0.95, 0.995, 0.99, 0.98, 0.95, 0.95, 0.90]), np.round(r2, 4)
     assert np.all(rms < [0.5, 0.6, 0.4, 0.6, 0.2, 0.2, 0.09]), np.round(rms, 3)
     # link-side torque sensors see no rotor inertia: the fit finds it about zero
-    assert all(j["rotor_inertia"] * 100**2 < 0.05 for j in result.joints)
-    assert all(result.fit["links_physical"])
+    assert all(j.rotor_inertia * 100**2 < 0.05 for j in result.joints)
+    assert all(result.fit.links_physical)

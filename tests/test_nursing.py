@@ -313,13 +313,13 @@ def test_identify_nursing_on_a_noise_free_excitation(arm, tmp_path) -> None:
     motion, _, _ = nu.table6_motion(arm, periods=2, dt=0.004)
     data = _twin_data(arm, motion, TwinSettings.exact(), "excitation")
     result = nu.identify_nursing(arm, [data])
-    ridge = result.fit["ridge"]
+    ridge = result.fit.ridge
     assert result.method == "nursing"
-    assert len(result.fit["base_parameters"]) == 36  # the doc's Table 3
+    assert len(result.fit.base_parameters) == 36  # the doc's Table 3
     assert ridge["logs"][0]["period"] == pytest.approx(10.0, abs=0.005)
     assert np.all(np.isfinite(ridge["rmse_test"]))
     assert max(ridge["rmse_test"]) < 5e-3  # N m, on torques of 0.1-0.5 N m spread
-    assert max(m["rms"] for m in result.fit["current"]) < 1e-3  # A
+    assert max(m.rms for m in result.fit.current) < 1e-3  # A
     # no friction runs: the motors keep the model's friction, and say so
     assert any("no friction run" in w for w in result.warnings)
     save_robot(result.robot, tmp_path / "identified.toml")

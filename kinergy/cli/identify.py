@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import click
 
 from kinergy.cli.common import columns_option, fmt, fmt_vector, note, repair_option, table
 from kinergy.cli.validate import validation_text
+from kinergy.identify.payload import PayloadEstimate
 from kinergy.identify.result import IdentificationResult
 from kinergy.jsonable import dumps
 from kinergy.model import load_robot
@@ -17,29 +16,29 @@ from kinergy.workflows.logs import prepared_logs
 __all__ = ["identify"]
 
 
-def _payload_text(report: dict[str, Any], out: str) -> str:
+def _payload_text(report: PayloadEstimate, out: str) -> str:
     lines = [
-        f"payload: {report['mass']:.4f} +- {report['mass_std']:.4f} kg at "
-        f"{fmt_vector(report['com'])} m (flange frame), from {report['signal']}; wrote {out}"
+        f"payload: {report.mass:.4f} +- {report.mass_std:.4f} kg at "
+        f"{fmt_vector(report.com)} m (flange frame), from {report.signal}; wrote {out}"
     ]
-    lines += [f"note: {n}" for n in report["notes"]]
+    lines += [f"note: {n}" for n in report.notes]
     return "\n".join(lines)
 
 
 def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     rows = []
     for j in result.joints:
-        fr = " ".join(f"{k}={fmt(v)}" for k, v in j["friction"].items() if k != "model")
+        fr = " ".join(f"{k}={fmt(v)}" for k, v in j.friction.items() if k != "model")
         rows.append(
             [
-                j["name"],
-                f"{j['rotor_inertia']:.4e}",
-                f"{j['motor_inertia']:.4e}",
-                f"{j['torque_constant']:.4f}",
-                f"{j['friction']['model']} {fr}",
+                j.name,
+                f"{j.rotor_inertia:.4e}",
+                f"{j.motor_inertia:.4e}",
+                f"{j.torque_constant:.4f}",
+                f"{j.friction['model']} {fr}",
             ]
         )
-    samples = result.fit.get("samples", 0)
+    samples = result.fit.samples
     headers = ["joint", "J_m+J_r [kg m^2]", "J_m [kg m^2]", "k_t [N m/A]", "friction (motor side)"]
     lines = [
         f"{result.robot.name}: {result.method} identification from {logs} log(s), {samples} samples",

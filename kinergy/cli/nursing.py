@@ -148,7 +148,9 @@ def nursing_study(
     say("identifying (nursing method: Makkar friction per motor, ridge on the minimal set)")
     result = nu.identify_nursing(robot, datas, fit="lsq", seed=seed)
     timings["identify"] = time.perf_counter() - t2
-    ridge = result.fit["ridge"]
+    fit = result.fit
+    assert isinstance(fit, nu.NursingFit) and fit.ridge is not None and fit.base_parameters
+    ridge = fit.ridge
     out = {
         "robot": robot.name,
         "noise": noise,
@@ -163,12 +165,12 @@ def nursing_study(
             "table8": list(nu.DOC_TABLE8),
             "alpha": ridge["alpha"],
             "intercept": ridge["intercept"],
-            "parameters": len(result.fit["base_parameters"]),
+            "parameters": len(fit.base_parameters),
             "split": ridge["split"],
             "period": ridge["logs"][0]["period"],
             "cutoff": ridge["logs"][0].get("cutoff"),
         },
-        "friction_motors": result.fit["friction_motors"],
+        "friction_motors": fit.friction_motors,
         "excitation_notes": notes,
         "warnings": result.warnings,
         "timings": timings,

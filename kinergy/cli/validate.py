@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Sequence
 
 import click
 
 from kinergy.cli.common import columns_option, load, note, payload_option, repair_option, table
+from kinergy.identify.metrics import JointMetrics
+from kinergy.identify.result import Validation
 from kinergy.jsonable import dumps
 from kinergy.workflows.logs import prepared_logs
 from kinergy.workflows.validate import validate_logs
@@ -15,26 +16,26 @@ from kinergy.workflows.validate import validate_logs
 __all__ = ["validate", "validation_text"]
 
 
-def _metrics_table(metrics: Sequence[Mapping[str, float]], names: Sequence[str], unit: str) -> str:
+def _metrics_table(metrics: Sequence[JointMetrics], names: Sequence[str], unit: str) -> str:
     return table(
         ["joint", f"mean [{unit}]", f"max [{unit}]", f"RMS [{unit}]", "R^2"],
         [
-            [name, f"{m['mean']:.4f}", f"{m['max']:.4f}", f"{m['rms']:.4f}", f"{m['r2']:.4f}"]
+            [name, f"{m.mean:.4f}", f"{m.max:.4f}", f"{m.rms:.4f}", f"{m.r2:.4f}"]
             for name, m in zip(names, metrics, strict=True)
         ],
     )
 
 
-def validation_text(report: Mapping[str, Any], names: Sequence[str]) -> str:
+def validation_text(report: Validation, names: Sequence[str]) -> str:
     """The torque, current and joint-torque tables of a validation report ('' when it has none)."""
     parts = []
-    for key, title, unit in (
-        ("torque", "Torque against target_moment (UR5e Table V)", "N m"),
-        ("current", "Current against actual_current (UR5e Table VII)", "A"),
-        ("joint_torque", "Joint torque against measured torque", "N m"),
+    for metrics, title, unit in (
+        (report.torque, "Torque against target_moment (UR5e Table V)", "N m"),
+        (report.current, "Current against actual_current (UR5e Table VII)", "A"),
+        (report.joint_torque, "Joint torque against measured torque", "N m"),
     ):
-        if report.get(key):
-            parts += [title, _metrics_table(report[key], names, unit), ""]
+        if metrics:
+            parts += [title, _metrics_table(metrics, names, unit), ""]
     return "\n".join(parts).rstrip()
 
 

@@ -56,7 +56,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -81,9 +81,16 @@ from kinergy.friction.registry import (
     start_parameters,
     with_linear_parameters,
 )
-from kinergy.identify.metrics import fit_metrics
+from kinergy.identify.metrics import JointMetrics, fit_metrics
 from kinergy.identify.preprocess import IdentData
-from kinergy.identify.result import IdentificationResult, validation_metrics
+from kinergy.identify.result import (
+    DriveEstimate,
+    Fit,
+    IdentificationResult,
+    friction_entry,
+    validation_metrics,
+)
+from kinergy.jsonable import OPTIONAL
 from kinergy.model.robot import Friction, Joint, Link, Robot, Source
 from kinergy.predict import drive_state
 
@@ -123,6 +130,54 @@ _REF = "kinergy identify (full base-parameter regression, nursing eqs 15-16, UR5
 
 # ---------------------------------------------------------------------------------------------
 # From base parameters back to links
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One unknown of the regression: its value, standard error and relative standard error
+    (None where not estimable) and, for the stacked unknowns, its group (``link``, ``rotor``,
+    ``friction``)."""
+
+    name: str
+    value: float
+    std: float | None
+    rel_std: float | None
+    group: str | None = field(default=None, metadata=OPTIONAL)
+
+
+@dataclass(frozen=True)
+class FullJoint(DriveEstimate):
+    """A joint's drive from the full method: the rotor inertia's standard error, whether its
+    column was merged into the link parameters, and the friction parameters' standard errors."""
+
+    rotor_inertia_std: float | None = None
+    rotor_inertia_merged: bool = False
+    friction_std: dict[str, float | None] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class FullFit(Fit):
+    """The full method's fit (module docstring): the regression's settings and condition, its
+    unknowns with standard errors, merged columns, and how the robot was written back."""
+
+    target: str = ""
+    solver: str = "ols"
+    ridge: float = 0.0
+    condition: float = float("nan")
+    power_flow_iterations: int = 0
+    power_flow_mismatch: int = 0
+    weights: tuple[float, ...] | None = field(default=None, metadata=OPTIONAL)
+    condition_weighted: float | None = field(default=None, metadata=OPTIONAL)
+    residual_std: tuple[float, ...] = ()
+    regression: tuple[JointMetrics, ...] = ()
+    merged: tuple[dict[str, Any], ...] = ()
+    parameters: tuple[Parameter, ...] = ()
+    base_parameters: tuple[Parameter, ...] = ()
+    physical_fit: dict[str, Any] | None = field(default=None, metadata=OPTIONAL)
+    write_back: str = "closest"
+    links_not_physical_closest: tuple[int, ...] = ()
+    links_physical: tuple[bool, ...] = ()
+    standard_parameters: dict[str, float] = field(default_factory=dict)
 
 
 def _projection(base: BaseParameters, p: int) -> Array:
@@ -786,7 +841,7 @@ def identify_full(
         used = _reduce(a_flat * w[:, None], y * w)
         r_y = used.r_y - used.r_a[:, dropped] @ (cols.prior * used.scale)[dropped]
         sol = _solve(used.r_a[:, kept], r_y, used.rows)
-        fit["weights"] = (w_j**2).tolist()
+        fit["weights"] = tuple((w_j**2).tolist())
         fit["condition_weighted"] = sol.cond
     elif solver == "ridge":
         lam = float(ridge)
@@ -798,7 +853,7 @@ def identify_full(
     std = np.full(n_cols, np.nan)
     std[kept] = sol.std / used.scale[kept]
     predicted3 = (a_flat @ x).reshape(samples, n)
-    fit["residual_std"] = np.sqrt(np.mean((y3 - predicted3) ** 2, axis=0)).tolist()
+    fit["residual_std"] = tuple(np.sqrt(np.mean((y3 - predicted3) ** 2, axis=0)).tolist())
     fit["regression"] = fit_metrics(y3, predicted3)
 
     # dropped (merged) columns: each as a combination of the kept ones
@@ -819,23 +874,22 @@ def identify_full(
                 for e in into:
                     c_vec[e["index"]] = e["coefficient"]
                 merged_rotor[int(k - n_link)] = c_vec
-    fit["merged"] = merged
+    fit["merged"] = tuple(merged)
 
     with np.errstate(divide="ignore", invalid="ignore"):
         rel = np.abs(std) / np.abs(x)
 
-    def described(name: str, k: int) -> dict[str, Any]:
-        return {
-            "name": name,
-            "value": float(x[k]),
-            "std": None if np.isnan(std[k]) else float(std[k]),
-            "rel_std": None if np.isnan(rel[k]) else float(rel[k]),
-        }
+    def described(name: str, k: int, group: str | None = None) -> Parameter:
+        return Parameter(
+            name=name,
+            value=float(x[k]),
+            std=None if np.isnan(std[k]) else float(std[k]),
+            rel_std=None if np.isnan(rel[k]) else float(rel[k]),
+            group=group,
+        )
 
-    fit["parameters"] = [
-        {**described(cols.names[k], k), "group": cols.group[k]} for k in range(n_cols)
-    ]
-    fit["base_parameters"] = [described(name, k) for k, name in enumerate(base.expressions())]
+    fit["parameters"] = tuple(described(cols.names[k], k, cols.group[k]) for k in range(n_cols))
+    fit["base_parameters"] = tuple(described(name, k) for k, name in enumerate(base.expressions()))
 
     problem = _Problem(used, kept, dropped, lam, sol.sse / max(used.rows - kept.size, 1))
     identified, x_written = _write_back(
@@ -845,29 +899,31 @@ def identify_full(
         fit["physical_fit"]["regression"] = fit_metrics(
             y3, (a_flat @ x_written).reshape(samples, n)
         )
-    fit.update(validation_metrics(identified, list(datas)))
-    fit["warnings"] = warnings
+    validation = validation_metrics(identified, datas)
+    fit.update(vars(validation))
+    fit["warnings"] = tuple(warnings)
+    fit["logs"], fit["lag"] = tuple(fit["logs"]), tuple(fit["lag"])
 
     joints_out = []
     for m, joint in enumerate(identified.joints):
         col = n_link + m
         fric = slice(cols.fric_at[m], cols.fric_at[m + 1])
         joints_out.append(
-            {
-                "name": joint.name,
-                "rotor_inertia": float(x_written[col]),
-                "rotor_inertia_std": None if np.isnan(std[col]) else float(std[col]),
-                "rotor_inertia_merged": bool(col in dropped),
-                "motor_inertia": joint.drive.motor_inertia,
-                "torque_constant": joint.drive.torque_constant,
-                "friction": {"model": joint.drive.friction.model, **joint.drive.friction.params},
-                "friction_std": {
+            FullJoint(
+                name=joint.name,
+                rotor_inertia=float(x_written[col]),
+                rotor_inertia_std=None if np.isnan(std[col]) else float(std[col]),
+                rotor_inertia_merged=bool(col in dropped),
+                motor_inertia=joint.drive.motor_inertia,
+                torque_constant=joint.drive.torque_constant,
+                friction=friction_entry(joint),
+                friction_std={
                     name: None if np.isnan(s) else float(s)
                     for name, s in zip(get_model(models[m]).linear, std[fric], strict=True)
                 },
-            }
+            )
         )
-    return IdentificationResult(identified, "full", joints_out, fit)
+    return IdentificationResult(identified, "full", tuple(joints_out), FullFit(**fit))
 
 
 def _merge_note(
@@ -1161,7 +1217,7 @@ def _write_back(
                 )
             problems = link_consistency(pi - payload)
     fit["write_back"] = method
-    fit["links_not_physical_closest"] = sorted(j + 1 for j in flagged)
+    fit["links_not_physical_closest"] = tuple(sorted(j + 1 for j in flagged))
     links = pi - payload
     joints: list[Joint] = []
     for j, joint in enumerate(robot.joints):
@@ -1185,7 +1241,7 @@ def _write_back(
             ]
         problems[j] = problem_j
         joints.append(dataclasses.replace(joint, link=link))
-    fit["links_physical"] = [p is None for p in problems]
+    fit["links_physical"] = tuple(p is None for p in problems)
     fit["standard_parameters"] = dict(zip(parameter_names(robot), links.tolist(), strict=True))
 
     final = []

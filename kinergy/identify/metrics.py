@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["fit_metrics", "r_squared", "rmse"]
+__all__ = ["JointMetrics", "fit_metrics", "r_squared", "rmse"]
 
 Array = NDArray[np.float64]
 
@@ -26,24 +28,30 @@ def rmse(measured: ArrayLike, predicted: ArrayLike) -> Array:
     return np.sqrt(np.mean(e**2, axis=0))
 
 
-def fit_metrics(measured: ArrayLike, predicted: ArrayLike) -> list[dict[str, float]]:
-    """Per joint: mean, max |.| and RMS of the error (measured - predicted) and R^2 (UR5e Tables V, VII).
+@dataclass(frozen=True)
+class JointMetrics:
+    """How well one joint's signal is predicted (UR5e Tables V, VII): mean, max |.| and RMS of
+    the error (measured - predicted), in the signal's unit, and R^2 (NaN when the signal does not
+    vary)."""
 
-    Returns
-    -------
-    list of dict
-        ``{"mean", "max", "rms", "r2"}`` per column.
-    """
+    mean: float
+    max: float
+    rms: float
+    r2: float
+
+
+def fit_metrics(measured: ArrayLike, predicted: ArrayLike) -> tuple[JointMetrics, ...]:
+    """Per joint (column of ``measured`` and ``predicted``, both (N, n)): :class:`JointMetrics`."""
     y = np.asarray(measured, dtype=float)
     p = np.asarray(predicted, dtype=float)
     err = y - p
     r2 = r_squared(y, p)
-    return [
-        {
-            "mean": float(np.mean(err[:, j])),
-            "max": float(np.max(np.abs(err[:, j]))),
-            "rms": float(np.sqrt(np.mean(err[:, j] ** 2))),
-            "r2": float(r2[j]),
-        }
+    return tuple(
+        JointMetrics(
+            mean=float(np.mean(err[:, j])),
+            max=float(np.max(np.abs(err[:, j]))),
+            rms=float(np.sqrt(np.mean(err[:, j] ** 2))),
+            r2=float(r2[j]),
+        )
         for j in range(y.shape[1])
-    ]
+    )

@@ -52,7 +52,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -70,7 +70,14 @@ from kinergy.friction.registry import get_model
 from kinergy.identify.metrics import r_squared, rmse
 from kinergy.identify.preprocess import IdentData, lowpass
 from kinergy.identify.pso import particle_swarm
-from kinergy.identify.result import IdentificationResult, validation_metrics
+from kinergy.identify.result import (
+    DriveEstimate,
+    Fit,
+    IdentificationResult,
+    friction_entry,
+    validation_metrics,
+)
+from kinergy.jsonable import OPTIONAL
 from kinergy.model.robot import Friction, Link, Robot, Source
 from kinergy.trajectory.fourier import fourier_motion
 from kinergy.trajectory.motion import Motion
@@ -1393,6 +1400,25 @@ def _excitation_arrays(
     return signals, note
 
 
+@dataclass(frozen=True)
+class NursingJoint(DriveEstimate):
+    """A joint's drive from the nursing method; ``identified``: its friction came from runs."""
+
+    identified: bool = False
+
+
+@dataclass(frozen=True)
+class NursingFit(Fit):
+    """The nursing method's fit: friction per joint run and per motor group, the ridge
+    regression of the links and its base parameters, and the links kept from the model."""
+
+    friction_runs: tuple[dict[str, Any], ...] | list[dict[str, Any]] = ()
+    friction_motors: tuple[dict[str, Any], ...] | list[dict[str, Any]] = ()
+    ridge: dict[str, Any] | None = field(default=None, metadata=OPTIONAL)
+    base_parameters: list[dict[str, Any]] | None = field(default=None, metadata=OPTIONAL)
+    links_kept: list[int] | None = field(default=None, metadata=OPTIONAL)
+
+
 def identify_nursing(
     robot: Robot,
     datas: Sequence[IdentData],
@@ -1474,7 +1500,8 @@ def identify_nursing(
     warnings: list[str] = []
     fit_out: dict[str, Any] = {
         "samples": int(sum(len(d) for d in datas)),
-        "logs": [d.path for d in datas],
+        "logs": tuple(d.path for d in datas),
+        "lag": tuple(d.lag for d in datas),
     }
 
     # 1. friction runs
@@ -1629,20 +1656,20 @@ def identify_nursing(
         for cat in ("mass", "com", "inertia"):
             sources[cat] = Source("identified", "kinergy identify (nursing, eqs 16, 22-26, ridge)")
     identified = dataclasses.replace(identified, sources=sources)
-    fit_out.update(validation_metrics(identified, list(datas)))
-    fit_out["warnings"] = warnings
-    joints_out = [
-        {
-            "name": jt.name,
-            "rotor_inertia": jt.drive.rotor_inertia,
-            "motor_inertia": jt.drive.motor_inertia,
-            "torque_constant": jt.drive.torque_constant,
-            "friction": {"model": jt.drive.friction.model, **jt.drive.friction.params},
-            "identified": m in new_friction,
-        }
+    fit_out.update(vars(validation_metrics(identified, datas)))
+    fit_out["warnings"] = tuple(warnings)
+    joints_out = tuple(
+        NursingJoint(
+            name=jt.name,
+            rotor_inertia=jt.drive.rotor_inertia,
+            motor_inertia=jt.drive.motor_inertia,
+            torque_constant=jt.drive.torque_constant,
+            friction=friction_entry(jt),
+            identified=m in new_friction,
+        )
         for m, jt in enumerate(identified.joints)
-    ]
-    return IdentificationResult(identified, "nursing", joints_out, fit_out)
+    )
+    return IdentificationResult(identified, "nursing", joints_out, NursingFit(**fit_out))
 
 
 def _write_links(robot: Robot, rf: RidgeFit, warnings: list[str], fit: dict[str, Any]) -> Robot:

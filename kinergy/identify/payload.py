@@ -16,7 +16,7 @@ is a point mass, as UR's own ``set_payload`` takes it.
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,10 +26,11 @@ from kinergy.drives.transmission import joint_torque
 from kinergy.dynamics.regressor import regressor
 from kinergy.errors import KinergyError
 from kinergy.identify.preprocess import IdentData
+from kinergy.linalg import scaled_lstsq
 from kinergy.model.robot import Payload, Robot
 from kinergy.predict import drive_state
 
-__all__ = ["identify_payload"]
+__all__ = ["PayloadEstimate", "identify_payload"]
 
 Array = NDArray[np.float64]
 
@@ -37,21 +38,41 @@ Array = NDArray[np.float64]
 MAX_INERTIA_SPREAD = 0.2
 
 
-def _solve(a: Array, b: Array) -> tuple[Array, Array, float]:
-    scale = np.linalg.norm(a, axis=0)
-    scale[scale == 0] = 1.0
-    x, _, _, sv = np.linalg.lstsq(a / scale, b, rcond=None)
-    x = x / scale
-    dof = max(a.shape[0] - a.shape[1], 1)
-    sigma2 = float(np.sum((b - a @ x) ** 2) / dof)
-    cov = sigma2 * np.linalg.pinv((a / scale).T @ (a / scale)) / np.outer(scale, scale)
-    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
-    return x, np.sqrt(np.clip(np.diag(cov), 0, None)), cond
+@dataclass(frozen=True)
+class PayloadEstimate:
+    """An identified payload and its uncertainty.
+
+    Attributes
+    ----------
+    signal : str
+        What it was fitted to (``current`` or ``target_moment``).
+    mass, mass_std : float
+        kg, and its standard error.
+    com, com_std : tuple of float
+        Centre of mass in the flange frame, m, and standard errors.
+    inertia : tuple of float or None
+        ``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]`` about the centre of mass, flange axes, kg m^2; None
+        when the motion does not excite it (a point mass is written).
+    condition : float
+        Condition number of the column-scaled regression.
+    samples : int
+    notes : tuple of str
+    """
+
+    signal: str
+    mass: float
+    mass_std: float
+    com: tuple[float, ...]
+    com_std: tuple[float, ...]
+    inertia: tuple[float, ...] | None
+    condition: float
+    samples: int
+    notes: tuple[str, ...]
 
 
 def identify_payload(
     robot: Robot, datas: list[IdentData], *, signal: str = "auto"
-) -> tuple[Payload, dict[str, Any]]:
+) -> tuple[Payload, PayloadEstimate]:
     """Identify the payload at the flange.
 
     Parameters
@@ -94,13 +115,13 @@ def identify_payload(
     # the payload moves the friction's power-flow direction (UR5e eqs 12-13): iterate to a fixed point
     for _ in range(30):
         a, b = _residuals(bare, guess, datas, signal)
-        x_new, std, cond = _solve(a[:, :4], b)
+        x_new, std, cond = scaled_lstsq(a[:, :4], b)
         change = float(np.max(np.abs(x_new - x[:4])))
         x[:4] = x_new
         guess = bare.with_payload(Payload(mass=max(float(x[0]), 1e-6), com=_com(robot, x)))
         if change < 1e-9 * max(abs(float(x[0])), 1.0):
             break
-    full, full_std, cond_full = _solve(a, b)
+    full, full_std, cond_full = scaled_lstsq(a, b)
     inertia_ok = bool(
         np.all(full_std[4:] < MAX_INERTIA_SPREAD * np.maximum(np.abs(full[4:]), 1e-3))
     )
@@ -158,7 +179,7 @@ def _finish(
     inertia_ok: bool,
     signal: str,
     datas: list[IdentData],
-) -> tuple[Payload, dict[str, Any]]:
+) -> tuple[Payload, PayloadEstimate]:
     mass = float(x[0])
     if mass <= 0 or std[0] > 0.5 * abs(mass):
         raise KinergyError(
@@ -186,15 +207,15 @@ def _finish(
     else:
         notes.append("the motion does not excite the payload's inertia enough: point mass")
     payload = Payload(mass=mass, com=com, inertia=inertia6)
-    report = {
-        "signal": signal,
-        "mass": mass,
-        "mass_std": float(std[0]),
-        "com": com.tolist(),
-        "com_std": (std[1:4] / mass).tolist(),
-        "inertia": inertia6.tolist() if inertia_ok else None,
-        "condition": cond,
-        "samples": int(sum(len(d) for d in datas)),
-        "notes": notes,
-    }
+    report = PayloadEstimate(
+        signal=signal,
+        mass=mass,
+        mass_std=float(std[0]),
+        com=tuple(com.tolist()),
+        com_std=tuple((std[1:4] / mass).tolist()),
+        inertia=tuple(inertia6.tolist()) if inertia_ok else None,
+        condition=cond,
+        samples=int(sum(len(d) for d in datas)),
+        notes=tuple(notes),
+    )
     return payload, report

@@ -1,7 +1,20 @@
-"""What an identification returns, and the model's predictions on a log."""
+"""What an identification returns, and the model's predictions on a log.
+
+Results are frozen dataclasses, written as JSON by :mod:`kinergy.jsonable`:
+
+- :class:`Validation`: per-joint :class:`~kinergy.identify.metrics.JointMetrics` of the reference
+  torque, the current and the measured joint torque (``validate --json``);
+- :class:`Fit`: a validation on the identification logs plus what every method reports (samples,
+  logs, lag, warnings); each method extends it with its own diagnostics;
+- :class:`DriveEstimate`: one joint's identified drive (each method extends it with standard
+  errors and flags);
+- :class:`IdentificationResult`: the identified robot, the method, the joints and the fit
+  (``identify --json``).
+"""
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -9,14 +22,66 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.drives.transmission import joint_torque
-from kinergy.identify.metrics import fit_metrics
+from kinergy.identify.metrics import JointMetrics, fit_metrics
 from kinergy.identify.preprocess import IdentData
-from kinergy.model.robot import Robot
+from kinergy.jsonable import to_jsonable
+from kinergy.model.robot import Joint, Robot
 from kinergy.predict import drive_state
 
-__all__ = ["IdentificationResult", "Prediction", "predict", "validation_metrics"]
+__all__ = [
+    "DriveEstimate",
+    "Fit",
+    "IdentificationResult",
+    "Prediction",
+    "Validation",
+    "predict",
+    "validation_metrics",
+]
 
 Array = NDArray[np.float64]
+
+#: a per-joint metrics field: one entry per joint, or None when no log has the signal
+Metrics = tuple[JointMetrics, ...] | None
+
+
+@dataclass(frozen=True)
+class Validation:
+    """UR5e Tables V and VII: per joint, how well the model predicts ``target_moment``
+    (``torque``), ``actual_current`` (``current``) and measured joint torques
+    (``joint_torque``); None where no log has the signal."""
+
+    torque: Metrics = None
+    current: Metrics = None
+    joint_torque: Metrics = None
+
+
+@dataclass(frozen=True)
+class Fit(Validation):
+    """The fit on the identification logs (the identified model's :class:`Validation`) and what
+    every method reports: samples used, the logs, each log's lag (s) and the warnings."""
+
+    samples: int = 0
+    logs: tuple[str, ...] = ()
+    lag: tuple[float, ...] = ()
+    warnings: tuple[str, ...] = ()
+
+
+def friction_entry(joint: Joint) -> dict[str, Any]:
+    """``{"model": name, **parameters}`` of a joint's friction, as results report it."""
+    return {"model": joint.drive.friction.model, **joint.drive.friction.params}
+
+
+@dataclass(frozen=True)
+class DriveEstimate:
+    """One joint's identified drive, motor side: ``rotor_inertia`` = J_m + J_r and
+    ``motor_inertia`` J_m (kg m^2), ``torque_constant`` k_t (N m/A), ``friction``
+    (:func:`friction_entry`)."""
+
+    name: str
+    rotor_inertia: float
+    motor_inertia: float
+    torque_constant: float
+    friction: Mapping[str, Any]
 
 
 @dataclass(frozen=True, eq=False)
@@ -26,33 +91,29 @@ class IdentificationResult:
     Attributes
     ----------
     robot : Robot
-        The identified model (the input model with the identified parameters replaced).
+        The identified model (the input model with the identified parameters replaced); JSON
+        gives its name.
     method : str
-    joints : list of dict
-        Per joint: ``rotor_inertia``, ``motor_inertia``, ``torque_constant`` (motor side),
-        ``friction`` ({model, parameters}) and, where estimated, their standard deviations.
-    fit : dict
-        Fit statistics on the identification logs (``torque``, ``current`` metrics per joint,
-        condition numbers, the lag found, the number of samples) and ``warnings``.
+    joints : tuple of DriveEstimate
+        Per joint, the identified drive (a method's subclass adds its standard errors and flags).
+    fit : Fit
+        Fit statistics on the identification logs (a method's subclass adds its diagnostics).
     """
 
-    robot: Robot
+    robot: Robot = field(metadata={"json": lambda r: r.name})
     method: str
-    joints: list[dict[str, Any]]
-    fit: dict[str, Any] = field(default_factory=dict)
+    joints: tuple[DriveEstimate, ...]
+    fit: Fit
 
     @property
     def warnings(self) -> list[str]:
-        return list(self.fit.get("warnings", []))
+        return list(self.fit.warnings)
 
     def to_dict(self) -> dict[str, Any]:
         """The ``identify --json`` shape of DESIGN.md."""
-        return {
-            "robot": self.robot.name,
-            "method": self.method,
-            "joints": self.joints,
-            "fit": self.fit,
-        }
+        out = to_jsonable(self)
+        assert isinstance(out, dict)
+        return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,16 +144,10 @@ def predict(robot: Robot, data: IdentData) -> Prediction:
     return Prediction(torque, current, joint)
 
 
-def validation_metrics(robot: Robot, datas: list[IdentData]) -> dict[str, Any]:
-    """UR5e Tables V and VII over several logs: per joint mean, max, RMS error and R^2 of the
-    torque (against ``target_moment``), the current (against ``actual_current``) and, for arms
-    with torque sensors, the joint torque; ``None`` where no log has the signal.
-
-    Returns
-    -------
-    dict
-        ``{"torque": [...] | None, "current": [...] | None, "joint_torque": [...] | None}``.
-    """
+def validation_metrics(robot: Robot, datas: Sequence[IdentData]) -> Validation:
+    """UR5e Tables V and VII over several logs (pooled): per joint mean, max, RMS error and R^2
+    of the torque (against ``target_moment``), the current (against ``actual_current``) and, for
+    arms with torque sensors, the joint torque."""
     pairs: dict[str, tuple[list[Array], list[Array]]] = {
         "torque": ([], []),
         "current": ([], []),
@@ -108,7 +163,8 @@ def validation_metrics(robot: Robot, datas: list[IdentData]) -> dict[str, Any]:
             if measured is not None and predicted is not None:
                 pairs[key][0].append(measured)
                 pairs[key][1].append(predicted)
-    out: dict[str, Any] = {}
-    for key, (meas, preds) in pairs.items():
-        out[key] = fit_metrics(np.vstack(meas), np.vstack(preds)) if meas else None
-    return out
+    found = {
+        key: fit_metrics(np.vstack(meas), np.vstack(preds)) if meas else None
+        for key, (meas, preds) in pairs.items()
+    }
+    return Validation(**found)

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -37,10 +38,18 @@ from kinergy.friction.registry import (
     with_linear_parameters,
 )
 from kinergy.identify.preprocess import IdentData
-from kinergy.identify.result import IdentificationResult, validation_metrics
+from kinergy.identify.result import (
+    DriveEstimate,
+    Fit,
+    IdentificationResult,
+    friction_entry,
+    validation_metrics,
+)
+from kinergy.jsonable import OPTIONAL
+from kinergy.linalg import scaled_lstsq
 from kinergy.model.robot import Friction, Robot, Source
 
-__all__ = ["identify_sequential", "rotor_inertias"]
+__all__ = ["SequentialFit", "SequentialJoint", "identify_sequential", "rotor_inertias"]
 
 Array = NDArray[np.float64]
 
@@ -60,21 +69,26 @@ def _stack(datas: Sequence[IdentData], name: str) -> Array:
     return np.vstack([getattr(d, name) for d in datas])
 
 
-def _lstsq(a: Array, y: Array) -> tuple[Array, Array, float]:
-    """Least squares with column scaling: solution, standard deviations, condition number."""
-    scale = np.linalg.norm(a, axis=0)
-    scale[scale == 0.0] = 1.0
-    sol, _, _, sv = np.linalg.lstsq(a / scale, y, rcond=None)
-    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
-    x = sol / scale
-    dof = max(a.shape[0] - a.shape[1], 1)
-    sigma2 = float(np.sum((y - a @ x) ** 2) / dof)
-    try:
-        cov = sigma2 * np.linalg.inv((a / scale).T @ (a / scale)) / np.outer(scale, scale)
-        std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    except np.linalg.LinAlgError:
-        std = np.full(a.shape[1], np.inf)
-    return x, std, cond
+@dataclass(frozen=True)
+class SequentialJoint(DriveEstimate):
+    """A joint's drive from the sequential method, with standard errors (motor side) and
+    whether the logs identified it (``problem`` says why not)."""
+
+    rotor_inertia_std: float | None = None
+    torque_constant_std: float | None = field(default=None, metadata=OPTIONAL)
+    friction_std: dict[str, float] | None = field(default=None, metadata=OPTIONAL)
+    condition_current: float | None = field(default=None, metadata=OPTIONAL)
+    identified: bool = True
+    problem: str | None = field(default=None, metadata=OPTIONAL)
+
+
+@dataclass(frozen=True)
+class SequentialFit(Fit):
+    """The sequential method's fit: the condition numbers of its regressions and the friction
+    hold chosen per joint (None where not fitted)."""
+
+    condition_rotor_inertia: float | None = field(default=None, metadata=OPTIONAL)
+    friction_holding: tuple[float | None, ...] | None = field(default=None, metadata=OPTIONAL)
 
 
 def rotor_inertias(
@@ -103,7 +117,7 @@ def rotor_inertias(
     fixed = [m for m in range(robot.n) if m not in active]
     known = np.array([j.drive.rotor_inertia for j in robot.joints])
     y = (tau_ref - f_link).reshape(-1) - a[:, fixed] @ known[fixed]
-    sol, sol_std, cond = _lstsq(a[:, active], y)
+    sol, sol_std, cond = scaled_lstsq(a[:, active], y)
     inertia, std = known.copy(), np.full(robot.n, np.nan)
     inertia[active], std[active] = sol, sol_std
     return inertia, std, cond
@@ -158,10 +172,10 @@ def _current_fit(
     """
     cols = friction_columns(model, params, wm, tau_load, dwm)
     a = np.column_stack([tau_load, cols])
-    x, std, cond = _lstsq(a, current)
+    x, std, cond = scaled_lstsq(a, current)
     fixed = not (x[0] > 0 and std[0] < MAX_KT_SPREAD * x[0])
     if fixed:
-        rest, rest_std, cond = _lstsq(cols, current - tau_load / kt_prior)
+        rest, rest_std, cond = scaled_lstsq(cols, current - tau_load / kt_prior)
         x = np.concatenate([[1.0 / kt_prior], rest])
         std = np.concatenate([[0.0], rest_std])
         a_used = a
@@ -367,23 +381,30 @@ def identify_sequential(
         )
         sources["friction"] = Source("identified", "kinergy identify (sequential, UR5e eqs 17-18)")
     identified = dataclasses.replace(staged, sources=sources)
-    joints_out = []
-    for j, joint in enumerate(identified.joints):
-        entry = {
-            "name": joint.name,
-            "rotor_inertia": float(joint.drive.motor_inertia + joint.drive.reducer_inertia)
+    joints_out = tuple(
+        SequentialJoint(
+            name=joint.name,
+            rotor_inertia=float(joint.drive.motor_inertia + joint.drive.reducer_inertia)
             if rotor[j] >= joint.drive.reducer_inertia
             else float(rotor[j]),
-            "rotor_inertia_std": None if np.isnan(rotor_std[j]) else float(rotor_std[j]),
-            "motor_inertia": joint.drive.motor_inertia,
-            "torque_constant": joint.drive.torque_constant,
-            "friction": {"model": joint.drive.friction.model, **joint.drive.friction.params},
-        }
-        entry.update(per_joint[j])
-        entry["identified"] = j not in problems
-        if j in problems:
-            entry["problem"] = problems[j]
-        joints_out.append(entry)
-    fit.update(validation_metrics(identified, list(datas)))
-    fit["warnings"] = warnings
-    return IdentificationResult(identified, "sequential", joints_out, fit)
+            rotor_inertia_std=None if np.isnan(rotor_std[j]) else float(rotor_std[j]),
+            motor_inertia=joint.drive.motor_inertia,
+            torque_constant=joint.drive.torque_constant,
+            friction=friction_entry(joint),
+            identified=j not in problems,
+            problem=problems.get(j),
+            **per_joint[j],
+        )
+        for j, joint in enumerate(identified.joints)
+    )
+    validation = validation_metrics(identified, datas)
+    result_fit = SequentialFit(
+        **vars(validation),
+        samples=fit["samples"],
+        logs=tuple(fit["logs"]),
+        lag=tuple(fit["lag"]),
+        warnings=tuple(warnings),
+        condition_rotor_inertia=fit.get("condition_rotor_inertia"),
+        friction_holding=tuple(fit["friction_holding"]) if "friction_holding" in fit else None,
+    )
+    return IdentificationResult(identified, "sequential", joints_out, result_fit)

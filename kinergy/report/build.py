@@ -8,7 +8,7 @@ by ``kinergy demo`` and ``kinergy report`` and laid out in ``report.html`` by
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from kinergy.energy.accounting import EnergyReport, energy
-from kinergy.identify.metrics import fit_metrics
+from kinergy.identify.metrics import JointMetrics, fit_metrics
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult, predict
 from kinergy.model.robot import Robot
@@ -131,7 +131,7 @@ def _parameter_tables(inputs: StudyInputs) -> list[Table]:
 def _accuracy_tables(
     caption: str,
     unit: str,
-    metrics: Mapping[str, list[dict[str, float]]],
+    metrics: Mapping[str, Sequence[JointMetrics]],
     names: list[str],
     paper: Mapping[str, list[tuple[float, float, float, float]]] | None,
 ) -> list[Table]:
@@ -144,7 +144,7 @@ def _accuracy_tables(
             headers += ["RMS (paper)", "R² (paper)"]
         rows = []
         for j, name in enumerate(names):
-            row = [name, _f(m[j]["mean"]), _f(m[j]["max"]), _f(m[j]["rms"]), _f(m[j]["r2"])]
+            row = [name, _f(m[j].mean), _f(m[j].max), _f(m[j].rms), _f(m[j].r2)]
             if key and paper is not None:
                 row += [_f(paper[key][j][2], 3), _f(paper[key][j][3], 3)]
             rows.append(row)
@@ -285,8 +285,8 @@ def report_sections(
     text = intro + ("\n\nWarnings:\n" + "\n".join(warnings) if warnings else "")
     sections.append(Section("Identified drive parameters", text, param_tables, []))
 
-    torque_metrics: dict[str, list[dict[str, float]]] = {}
-    current_metrics: dict[str, list[dict[str, float]]] = {}
+    torque_metrics: dict[str, Sequence[JointMetrics]] = {}
+    current_metrics: dict[str, Sequence[JointMetrics]] = {}
     torque_errors: dict[str, np.ndarray] = {}
     current_errors: dict[str, np.ndarray] = {}
     torque_figs: list[Figure] = []

@@ -5,11 +5,10 @@ from __future__ import annotations
 import datetime
 import os
 from collections.abc import Sequence
-from typing import Any
 
 from kinergy.identify.full import identify_full
 from kinergy.identify.nursing import identify_nursing
-from kinergy.identify.payload import identify_payload
+from kinergy.identify.payload import PayloadEstimate, identify_payload
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult
 from kinergy.identify.sequential import identify_sequential
@@ -55,7 +54,7 @@ def identify_model(
 
 def identify_payload_model(
     robot: Robot, datas: Sequence[IdentData], out: str | os.PathLike[str]
-) -> tuple[Payload, dict[str, Any]]:
+) -> tuple[Payload, PayloadEstimate]:
     """Identify the payload of ``robot`` (the model without it) and write the model with it."""
     payload, report = identify_payload(robot, list(datas))
     what = f"{robot.name} with the payload identified"

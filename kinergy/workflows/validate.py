@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from kinergy.identify.preprocess import IdentData
-from kinergy.identify.result import predict, validation_metrics
+from kinergy.identify.result import Validation, predict, validation_metrics
 from kinergy.model.robot import Robot
 from kinergy.report.plots import error_boxplot, save, time_series
 
@@ -17,7 +17,7 @@ __all__ = ["validate_logs", "write_validation_plots"]
 
 def validate_logs(
     robot: Robot, datas: Sequence[IdentData], *, plots: str | os.PathLike[str] | None = None
-) -> dict[str, Any]:
+) -> Validation:
     """UR5e Tables V and VII for ``datas`` (:func:`validation_metrics`); with ``plots``, also
     write the measured-against-predicted figures to that folder."""
     report = validation_metrics(robot, list(datas))
