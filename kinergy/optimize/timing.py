@@ -67,10 +67,9 @@ are tightened by the excess and the problem solved again.
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
@@ -80,6 +79,7 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.optimize import minimize
 
 from kinergy.drives.transmission import joint_torque
+from kinergy.dynamics.threads import kernel_threads
 from kinergy.energy.accounting import energy
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
@@ -122,34 +122,13 @@ _FD_STEP = 1e-6
 _F = TypeVar("_F", bound=Callable[..., Any])
 
 
-@contextlib.contextmanager
-def _one_thread() -> Iterator[None]:
-    """Run numba kernels on the calling thread only, then restore the thread count.
-
-    The optimiser evaluates the model on a few thousand samples at a time, thousands of times: at
-    that size a parallel launch costs more than the work, and on a busy machine (threads
-    waiting for cores) far more (measured: 1.3 ms serial vs 33 ms on two busy threads for one
-    drive-model call of 500 samples).
-    """
-    try:
-        import numba
-    except ImportError:  # pragma: no cover - numba is a dependency
-        yield
-        return
-    before = numba.get_num_threads()
-    numba.set_num_threads(1)
-    try:
-        yield
-    finally:
-        numba.set_num_threads(before)
-
-
 def _serial(func: _F) -> _F:
-    """Decorate a public entry point with :func:`_one_thread`."""
+    """Decorate a public entry point: its dynamics run on the calling thread only
+    (:func:`kinergy.dynamics.threads.kernel_threads`)."""
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        with _one_thread():
+        with kernel_threads(1):
             return func(*args, **kwargs)
 
     return wrapper  # type: ignore[return-value]
