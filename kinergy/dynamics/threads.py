@@ -28,7 +28,8 @@ def kernel_threads(count: int | None) -> Iterator[int]:
     if count is None:
         yield before
         return
-    numba.set_num_threads(max(1, min(int(count), numba.config.NUMBA_NUM_THREADS)))
+    most = int(getattr(numba.config, "NUMBA_NUM_THREADS", before))
+    numba.set_num_threads(max(1, min(int(count), most)))
     try:
         yield numba.get_num_threads()
     finally:
