@@ -38,7 +38,8 @@ from kinergy.experiments.excitation import (
     excitation_problem,
     random_feasible,
 )
-from kinergy.identify.full import identify_full, parameter_scale
+from kinergy.identify.full import identify_full
+from kinergy.identify.physical import parameter_scale
 from kinergy.identify.preprocess import prepare
 from kinergy.io.rtde import read_log
 from kinergy.io.urscript import servoj_program

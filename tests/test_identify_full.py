@@ -19,8 +19,8 @@ import pytest
 
 import kinergy
 import kinergy.identify.full as full
-from kinergy.identify.full import (
-    identify_full,
+from kinergy.identify.full import identify_full
+from kinergy.identify.physical import (
     link_consistency,
     parameter_scale,
     pseudo_inertia,

@@ -62,7 +62,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 import scipy.optimize
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.dynamics.regressor import (
@@ -82,6 +82,15 @@ from kinergy.friction.registry import (
     with_linear_parameters,
 )
 from kinergy.identify.metrics import JointMetrics, fit_metrics
+from kinergy.identify.physical import (
+    PSEUDO_BASIS,
+    base_projection,
+    link_consistency,
+    link_from_standard,
+    parameter_scale,
+    pseudo_inertia,
+    standard_from_base,
+)
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import (
     DriveEstimate,
@@ -99,10 +108,6 @@ __all__ = [
     "SOLVERS",
     "TARGETS",
     "identify_full",
-    "link_consistency",
-    "parameter_scale",
-    "pseudo_inertia",
-    "standard_from_base",
 ]
 
 Array = NDArray[np.float64]
@@ -119,8 +124,6 @@ MAX_CONDITION = 1e10
 DEPENDENT_TOL = 1e-8
 #: samples needed per unknown parameter
 SAMPLES_PER_PARAMETER = 2
-#: length (m) that puts masses, first moments and inertias on one scale when "closest" is measured
-LENGTH_SCALE = 0.1
 #: friction models whose columns depend on the load torque (the direction of power flow)
 _LOAD_DEPENDENT = ("power_flow",)
 _MAX_FLOW_ITERATIONS = 10
@@ -178,154 +181,6 @@ class FullFit(Fit):
     links_not_physical_closest: tuple[int, ...] = ()
     links_physical: tuple[bool, ...] = ()
     standard_parameters: dict[str, float] = field(default_factory=dict)
-
-
-def _projection(base: BaseParameters, p: int) -> Array:
-    """``P``, shape (b, p): ``pi -> pi[independent] + beta @ pi[dependent]`` (nursing eq 16)."""
-    p_mat = np.zeros((base.size, p))
-    p_mat[:, base.independent] = np.eye(base.size)
-    p_mat[:, base.dependent] = base.beta
-    return p_mat
-
-
-def parameter_scale(robot: Robot, length: float = LENGTH_SCALE) -> Array:
-    """Typical size of each standard parameter: ``m``, ``m L`` and ``m L^2`` per link, shape (10 n,).
-
-    ``m`` is the link's model mass (kg) and ``L`` = ``length`` (m); used to measure "closest" in
-    one unit across kg, kg m and kg m^2 (:func:`standard_from_base`).
-    """
-    per = np.array([1.0, length, length, length] + [length**2] * 6)
-    return np.concatenate([j.link.mass * per for j in robot.joints])
-
-
-def standard_from_base(
-    base: BaseParameters, pi_b: ArrayLike, prior: ArrayLike, *, scale: ArrayLike | None = None
-) -> Array:
-    """The standard parameters closest to ``prior`` that have the base parameters ``pi_b``.
-
-    With ``P`` the base projection ``pi -> pi[independent] + beta @ pi[dependent]`` (nursing
-    eq 16) and ``S = diag(scale)``, the smallest change ``|S^-1 (pi - pi0)|`` that reaches
-    ``pi_b`` is ::
-
-        pi = pi0 + S^2 P^T (P S^2 P^T)^-1 (pi_b - P pi0)
-
-    (``S = 1``: ``pi0 + P^T (P P^T)^-1 (pi_b - P pi0)``). It reproduces ``pi_b`` exactly, so the
-    torques are the identified ones; the directions the data cannot see (the null space of ``P``)
-    keep the prior's values.
-
-    Parameters
-    ----------
-    base : BaseParameters
-    pi_b : array_like, shape (b,)
-        Base parameters (units of their leading standard parameter: kg, kg m or kg m^2).
-    prior : array_like, shape (p,)
-        Standard parameters of the model (:func:`kinergy.dynamics.regressor.inertial_parameters`).
-    scale : array_like, shape (p,), optional
-        Typical size of each parameter (:func:`parameter_scale`); default 1.
-
-    Returns
-    -------
-    ndarray, shape (p,)
-    """
-    pi0 = np.asarray(prior, dtype=float)
-    w = np.ones_like(pi0) if scale is None else np.asarray(scale, dtype=float) ** 2
-    p_mat = _projection(base, pi0.size)
-    gap = np.asarray(pi_b, dtype=float) - p_mat @ pi0
-    return np.asarray(pi0 + w * (p_mat.T @ np.linalg.solve((p_mat * w) @ p_mat.T, gap)))
-
-
-def _pseudo_basis() -> Array:
-    """``E`` (10, 4, 4) with ``pseudo_inertia = sum_k pi_k E_k`` for one link."""
-    e = np.zeros((10, 4, 4))
-    e[0, 3, 3] = 1.0
-    for k in range(3):
-        e[1 + k, k, 3] = e[1 + k, 3, k] = 1.0
-    # Ixx, Ixy, Iyy, Ixz, Iyz, Izz -> Sigma = tr(I)/2 1 - I
-    for k, (a, b) in zip(
-        range(4, 10), [(0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)], strict=True
-    ):
-        unit = np.zeros((3, 3))
-        unit[a, b] = unit[b, a] = 1.0
-        e[k, :3, :3] = 0.5 * np.trace(unit) * np.eye(3) - unit
-    return e
-
-
-_PSEUDO = _pseudo_basis()
-
-
-def pseudo_inertia(standard: ArrayLike) -> Array:
-    """Pseudo-inertia matrices ``[[Sigma, h], [h^T, m]]`` of each link, shape (n, 4, 4).
-
-    ``Sigma = tr(I_o)/2 1 - I_o`` (kg m^2) is the second moment of the mass about the link origin,
-    ``h = m c`` (kg m). A link is physically consistent (positive mass, inertia about the centre of
-    mass positive definite and satisfying the triangle inequality) exactly when its pseudo-inertia
-    is positive definite (Wensing, Kim, Slotine, IEEE RA-L 2018).
-
-    Parameters
-    ----------
-    standard : array_like, shape (10 n,)
-        ``[m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` per link (inertia about the link origin).
-    """
-    pi = np.asarray(standard, dtype=float).reshape(-1, 10)
-    return np.asarray(np.einsum("lk,kab->lab", pi, _PSEUDO))
-
-
-def _link_from_standard(pi: Array) -> tuple[float, Array, Array]:
-    """Mass (kg), centre of mass (m, (3,)) and inertia about it (kg m^2, (3, 3)) of one link's
-    ``[m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` (inertia about the link origin)."""
-    m = float(pi[0])
-    ixx, ixy, iyy, ixz, iyz, izz = pi[4:10]
-    i_o = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-    if m <= 0.0:
-        return m, np.zeros(3), i_o
-    c = pi[1:4] / m
-    # parallel-axis theorem: I_o = I_c + m (|c|^2 1 - c c^T)
-    return m, c, i_o - m * (float(c @ c) * np.eye(3) - np.outer(c, c))
-
-
-def link_consistency(standard: ArrayLike) -> list[str | None]:
-    """Physical consistency of each link's standard parameters.
-
-    A link is physical when its mass is positive and its inertia about the centre of mass,
-    ``I_c = I_o - m (|c|^2 1 - c c^T)`` with ``c = h / m``, is positive definite with principal
-    moments satisfying the triangle inequality (the checks :class:`kinergy.model.robot.Link`
-    makes).
-
-    Parameters
-    ----------
-    standard : array_like, shape (10 n,)
-        ``[m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` per link (inertia about the link origin).
-
-    Returns
-    -------
-    list of str or None, length n
-        ``None`` for a physical link, else what is wrong with it (one phrase with the numbers).
-    """
-    out: list[str | None] = []
-    for row in np.asarray(standard, dtype=float).reshape(-1, 10):
-        m, c, i_c = _link_from_standard(row)
-        if not m > 0.0:
-            out.append(f"identified mass {m:.4g} kg is not physical")
-            continue
-        eig = np.linalg.eigvalsh(i_c)
-        moments = np.array2string(eig, precision=4)
-        if eig[0] <= 0.0:
-            out.append(
-                "identified inertia about the centre of mass is not positive definite "
-                f"(principal moments {moments} kg m^2, centre of mass "
-                f"{np.array2string(c, precision=4)} m)"
-            )
-        elif eig[0] + eig[1] < eig[2] * (1.0 - 1e-9):
-            out.append(
-                f"identified inertia violates the triangle inequality (principal moments {moments} kg m^2)"
-            )
-        else:
-            out.append(None)
-    return out
-
-
-# ---------------------------------------------------------------------------------------------
-# The regression
 
 
 @dataclass(frozen=True)
@@ -1081,7 +936,7 @@ def _physical_fit(
     if lam_h[0] <= 0:
         return None
     m_mat = vec_h / np.sqrt(lam_h) / s[:, None]  # x[kept] - x_hat[kept] = m_mat @ eta
-    p_mat = _projection(base, p)
+    p_mat = base_projection(base, p)
     k_mat = (scale**2)[:, None] * p_mat.T @ np.linalg.inv((p_mat * scale**2) @ p_mat.T)  # pi_s
     _, sv, vt = np.linalg.svd(p_mat * scale)
     z_null = vt[int(np.sum(sv > 1e-12 * sv[0])) :].T  # orthonormal, scaled coordinates
@@ -1118,7 +973,7 @@ def _physical_fit(
         pi_start[10 * link + np.array([4, 6, 9])] += 2e-6 * eig0[link, -1]
     ref = np.linalg.eigvalsh(pseudo_inertia(pi_start - payload))[:, 0]
     c_blocks = pseudo_inertia(pi_a - payload) / ref[:, None, None] - 1e-3 * np.eye(4)
-    b_blocks = np.einsum("lpk,pab->lkab", b_mat.reshape(n_links, 10, -1), _PSEUDO)
+    b_blocks = np.einsum("lpk,pab->lkab", b_mat.reshape(n_links, 10, -1), PSEUDO_BASIS)
     b_blocks /= ref[:, None, None, None]
     # rotor inertias, affine in u (kept ones through eta, merged ones through delta), >= 0
     # (>= -1e-3 of their size for the barrier's strict start; clipped to 0 after)
@@ -1223,7 +1078,7 @@ def _write_back(
     for j, joint in enumerate(robot.joints):
         link, problem_j = joint.link, problems[j]
         if problem_j is None:
-            mass, c, i_c = _link_from_standard(links[10 * j : 10 * j + 10])
+            mass, c, i_c = link_from_standard(links[10 * j : 10 * j + 10])
             inertia = np.array([i_c[0, 0], i_c[1, 1], i_c[2, 2], i_c[0, 1], i_c[1, 2], i_c[0, 2]])
             try:
                 link = Link(mass=mass, com=c, inertia=inertia)

@@ -1676,7 +1676,7 @@ def _write_links(robot: Robot, rf: RidgeFit, warnings: list[str], fit: dict[str,
     """Links with the identified base parameters: the standard parameters closest to the model's
     (:func:`kinergy.identify.full.standard_from_base`); a link that is not physical keeps the
     model's data, with a warning."""
-    from kinergy.identify.full import link_consistency, parameter_scale, standard_from_base
+    from kinergy.identify.physical import link_consistency, parameter_scale, standard_from_base
 
     pi0 = inertial_parameters(robot)
     payload = pi0 - inertial_parameters(robot, include_payload=False)
