@@ -30,7 +30,7 @@ def demo_run(tmp_path_factory: pytest.TempPathFactory):
 
 
 def test_demo_writes_a_report_whose_images_all_exist(demo_run) -> None:
-    out, (_sections, _tables, report, _seconds) = demo_run
+    out, (_tables, report, _seconds) = demo_run
     assert report == out / "report.html" and report.exists()
     parser = _Images()
     parser.feed(report.read_text())
@@ -43,7 +43,7 @@ def test_demo_writes_a_report_whose_images_all_exist(demo_run) -> None:
 
 
 def test_demo_prints_the_five_tables_with_comparisons(demo_run) -> None:
-    _out, (_sections, tables, _report, _seconds) = demo_run
+    _out, (tables, _report, _seconds) = demo_run
     assert {"IV", "V", "VI", "VII", "VIII", "timing"} <= set(tables)
     program, _uniform, optimised = tables["timing"][0].rows
     assert float(optimised[2]) < float(program[2]) and optimised[-1] == "yes"
@@ -55,7 +55,7 @@ def test_demo_prints_the_five_tables_with_comparisons(demo_run) -> None:
 
 def test_demo_identifies_within_the_issue_tolerances(demo_run) -> None:
     # identification issue: rotor inertia 3 %, k_t 2 %, friction 10 % (or 0.005 N m)
-    _out, (_sections, tables, _report, _seconds) = demo_run
+    _out, (tables, _report, _seconds) = demo_run
     truth = kinergy.load_robot("ur5e")
     for j, row in enumerate(tables["IV"][0].rows):
         assert abs(float(row[-1])) < 3.0  # J_m + J_r error in %

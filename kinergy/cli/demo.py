@@ -24,6 +24,6 @@ __all__ = ["demo"]
 def demo(out: str) -> None:
     """The UR5e study on the built-in twin: simulate tests A and B, identify on A, validate on A
     and B, compute the energy, print UR5e Tables IV-VIII and write an HTML report."""
-    _sections, tables, report, seconds = run_demo(Path(out), progress())
+    tables, report, seconds = run_demo(Path(out), progress())
     print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown", "timing"])
     click.echo(f"\nreport: {report} ({seconds:.1f} s)")

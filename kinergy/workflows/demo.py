@@ -16,17 +16,17 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from kinergy import __version__
 from kinergy.identify.preprocess import prepare
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.motion import motion_from_log
 from kinergy.io.rtde import read_log, write_log
+from kinergy.io.task import load_task
 from kinergy.model.robot import Friction, Robot
 from kinergy.model.toml import load_robot
-from kinergy.report.build import StudyInputs, report_sections
-from kinergy.report.html import Section, Table, write_report
+from kinergy.report.html import Table
 from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.workflows.study import run_study, write_study
 
 __all__ = ["nominal_drives", "run_demo"]
 
@@ -50,13 +50,14 @@ def nominal_drives(robot: Robot) -> Robot:
 
 def run_demo(
     out: Path, progress: Callable[[str], None] | None = None
-) -> tuple[list[Section], dict[str, list[Table]], Path, float]:
+) -> tuple[dict[str, list[Table]], Path, float]:
     """Run the demo into folder ``out``.
 
     Returns
     -------
-    sections, tables
-        The report's content (tables keyed ``"IV"``, ``"V"``, ``"VI"``, ``"VII"``, ``"VIII"``).
+    tables
+        The report's tables (keyed ``"IV"``, ``"V"``, ``"VI"``, ``"VII"``, ``"VIII"``,
+        ``"breakdown"``, ``"timing"``).
     report : Path
         ``out / "report.html"``.
     seconds : float
@@ -79,32 +80,28 @@ def run_demo(
         motions[label] = motion_from_log(log, n_joints=truth.n, source="target")
     say("identifying on test A (sequential method, UR5e doc sections 3-4)")
     result = identify_sequential(nominal_drives(truth), [datas["test A"]])
-    from kinergy.io.task import load_task
-
-    inputs = StudyInputs(
-        model=result.robot,
+    study = run_study(
+        result.robot,
         validation=datas,
         motions=motions,
         result=result,
         truth=truth,
         paper=True,
         task=load_task("test-a", robot=result.robot),
+        progress=say,
     )
-    sections, tables = report_sections(inputs, out, say)
     say("writing the report")
-    report = write_report(
-        out / "report.html",
+    report, tables = write_study(
+        study,
+        out,
         title="kinergy demo: the UR5e study on the digital twin",
         subtitle=(
             "Tests A and B simulated on the twin, drives identified on test A, validated on A and "
             "the unseen B, energy of both (UR5e doc Tables IV-VIII)"
         ),
-        sections=sections,
         meta={
             "robot": truth.name,
-            "kinergy": __version__,
             "logs": ", ".join(str(p.relative_to(out)) for p in sorted(logs.glob("*.csv"))),
-            "date": time.strftime("%Y-%m-%d %H:%M"),
         },
     )
-    return sections, tables, Path(report), time.perf_counter() - start
+    return tables, report, time.perf_counter() - start

@@ -1,20 +1,122 @@
-"""``kinergy report``: the study report (tables, figures, report.html) from a user's model and logs."""
+"""The study pipeline: predictions on logs, energy of motions and an optimal timing, then the
+report (tables, figures, ``report.html``). ``kinergy report`` and ``kinergy demo`` run it."""
 
 from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from kinergy.energy.accounting import energy
+from kinergy.identify.metrics import fit_metrics
+from kinergy.identify.preprocess import IdentData
+from kinergy.identify.result import IdentificationResult, predict
 from kinergy.identify.sequential import identify_sequential
+from kinergy.io.task import Task
 from kinergy.model.robot import Robot
-from kinergy.report.build import StudyInputs, report_sections
-from kinergy.report.html import write_report
+from kinergy.optimize.timing import optimize_timing, pareto_front, timing_problem
+from kinergy.report.html import Table, write_report
+from kinergy.report.study import Comparison, Study, Timing, study_sections
+from kinergy.trajectory.motion import Motion
 from kinergy.workflows.logs import prepared_logs, read_motion
 
-__all__ = ["study_report"]
+__all__ = ["optimal_timing", "run_study", "study_report", "write_study"]
+
+Progress = Callable[[str], None]
+
+
+def _comparisons(
+    model: Robot, validation: Mapping[str, IdentData], say: Progress
+) -> tuple[dict[str, Comparison], dict[str, Comparison]]:
+    """Per log: the model's reference torque and current against the logged ones."""
+    torque, current = {}, {}
+    for name, data in validation.items():
+        say(f"validating on {name}")
+        pred = predict(model, data)
+        t = data.t - data.t[0]
+        if data.tau_ref is not None and pred.torque is not None:
+            metrics = fit_metrics(data.tau_ref, pred.torque)
+            torque[name] = Comparison(t, data.tau_ref, pred.torque, metrics)
+        if data.current is not None and pred.current is not None:
+            metrics = fit_metrics(data.current, pred.current)
+            current[name] = Comparison(t, data.current, pred.current, metrics)
+    return torque, current
+
+
+def optimal_timing(model: Robot, task: Task, *, points: int = 6) -> Timing:
+    """The energy-optimal timing of ``task`` at its own cycle time and the Pareto front."""
+    problem = timing_problem(model, task.waypoints, blends=task.blends)
+    common: dict[str, Any] = {
+        "speeds": task.speeds,
+        "accels": task.accels,
+        "blends": task.blends,
+        "problem": problem,
+    }
+    result = optimize_timing(model, task.waypoints, **common)
+    front = pareto_front(model, task.waypoints, points=points, **common)
+    return Timing(task.name, result, front)
+
+
+def run_study(
+    model: Robot,
+    *,
+    validation: Mapping[str, IdentData] | None = None,
+    motions: Mapping[str, Motion] | None = None,
+    result: IdentificationResult | None = None,
+    truth: Robot | None = None,
+    paper: bool = False,
+    task: Task | None = None,
+    progress: Progress | None = None,
+) -> Study:
+    """Compute everything a study report shows (:class:`kinergy.report.study.Study`).
+
+    Parameters
+    ----------
+    model : Robot
+    validation : mapping of str to IdentData
+        Logs to compare the model with, by name (``"test A"``).
+    motions : mapping of str to Motion
+        Motions to account the energy of, by name.
+    result, truth, paper
+        See :class:`~kinergy.report.study.Study`.
+    task : Task, optional
+        A movej program whose energy-optimal timing and Pareto front the report shows.
+    """
+    say = progress or (lambda _msg: None)
+    torque, current = _comparisons(model, validation or {}, say)
+    reports = {}
+    for name, motion in (motions or {}).items():
+        say(f"energy of {name}")
+        reports[name] = energy(model, motion)
+    timing = None
+    if task is not None:
+        say(f"optimising the timing of {task.name}")
+        timing = optimal_timing(model, task)
+    return Study(model, result, truth, paper, torque, current, reports, timing)
+
+
+def write_study(
+    study: Study,
+    folder: str | os.PathLike[str],
+    *,
+    title: str,
+    subtitle: str,
+    meta: Mapping[str, str],
+) -> tuple[Path, dict[str, list[Table]]]:
+    """Write the study's figures and ``folder/report.html``; return its path and the tables."""
+    from kinergy import __version__
+
+    sections, tables = study_sections(study, Path(folder))
+    path = write_report(
+        Path(folder) / "report.html",
+        title=title,
+        subtitle=subtitle,
+        sections=sections,
+        meta={**meta, "kinergy": __version__, "date": time.strftime("%Y-%m-%d %H:%M")},
+    )
+    return Path(path), tables
 
 
 def study_report(
@@ -27,16 +129,11 @@ def study_report(
     columns: str | None = None,
     repair: bool = False,
     model_name: str = "",
-    progress: Callable[[str], None] | None = None,
+    progress: Progress | None = None,
     note: Callable[[str], None] | None = None,
-) -> tuple[Path, dict[str, Any]]:
-    """Identify (sequential method) on ``identify_logs`` if any, validate on ``validate_logs``,
-    account the energy of ``energy_logs``, and write ``out/report.html`` with its figures.
-
-    Returns the report's path and its tables (keyed as :func:`report_sections` keys them).
-    """
-    from kinergy import __version__
-
+) -> tuple[Path, dict[str, list[Table]]]:
+    """``kinergy report``: identify (sequential method) on ``identify_logs`` if any, validate on
+    ``validate_logs``, account the energy of ``energy_logs``, and write ``out/report.html``."""
     say = progress or (lambda _msg: None)
     result = None
     if identify_logs:
@@ -59,19 +156,16 @@ def study_report(
         Path(p).name: read_motion(p, n_joints=robot.n, columns=columns, repair=repair)
         for p in energy_logs
     }
-    folder = Path(out)
-    inputs = StudyInputs(model=robot, validation=validation, motions=motions, result=result)
-    sections, tables = report_sections(inputs, folder, say)
-    path = write_report(
-        folder / "report.html",
+    study = run_study(
+        robot, validation=validation, motions=motions, result=result, progress=progress
+    )
+    return write_study(
+        study,
+        out,
         title=f"kinergy report: {robot.name}",
         subtitle="Model parameters, accuracy on logs and energy of motions",
-        sections=sections,
         meta={
             "model": model_name or robot.name,
-            "kinergy": __version__,
-            "date": time.strftime("%Y-%m-%d %H:%M"),
             "logs": ", ".join([*identify_logs, *validate_logs, *energy_logs]),
         },
     )
-    return path, tables
