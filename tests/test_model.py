@@ -309,3 +309,24 @@ def test_saved_file_is_valid_toml_with_header(tmp_path: Path) -> None:
     assert text.startswith("# line one\n# line two\n")
     assert tomllib.loads(text)["name"] == "ur5e"
     assert [p.name for p in tmp_path.iterdir()] == ["x.toml"]  # no temporary left behind
+
+
+def _rz_ry_rx(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """URDF's fixed-axis rpy written out: Rz(yaw) @ Ry(pitch) @ Rx(roll)."""
+    c, s = np.cos, np.sin
+    rx = np.array([[1, 0, 0], [0, c(roll), -s(roll)], [0, s(roll), c(roll)]])
+    ry = np.array([[c(pitch), 0, s(pitch)], [0, 1, 0], [-s(pitch), 0, c(pitch)]])
+    rz = np.array([[c(yaw), -s(yaw), 0], [s(yaw), c(yaw), 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def test_rpy_is_urdfs_fixed_axis_convention_and_round_trips() -> None:
+    from kinergy.model.toml import matrix_rpy, rpy_matrix
+
+    rng = np.random.default_rng(4)
+    angles = rng.uniform(-np.pi, np.pi, (200, 3)) * np.array([1.0, 0.5, 1.0])
+    angles[:2, 1] = [np.pi / 2, -np.pi / 2]  # gimbal lock: other angles, the same rotation
+    for a in angles:
+        rot = _rz_ry_rx(*a)
+        np.testing.assert_allclose(rpy_matrix(a), rot, atol=1e-14)
+        np.testing.assert_allclose(rpy_matrix(matrix_rpy(rot)), rot, atol=1e-9)

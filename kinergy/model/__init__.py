@@ -1,5 +1,6 @@
 """Robot models as data: dataclasses, robot files (TOML, URDF) and the built-in library."""
 
+from kinergy.model.library import library_names, load_robot
 from kinergy.model.robot import (
     CONVENTIONS,
     SOURCE_CATEGORIES,
@@ -15,8 +16,6 @@ from kinergy.model.robot import (
     inertia_matrix,
 )
 from kinergy.model.toml import (
-    library_names,
-    load_robot,
     parse_payload,
     read_robot_file,
     robot_from_dict,

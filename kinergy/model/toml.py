@@ -1,4 +1,4 @@
-"""Robot files: TOML in and out, the built-in library, and the plain-dict form used for JSON.
+"""Robot files: TOML in and out, and the plain-dict form used for JSON.
 
 A robot file is TOML with the same structure as :func:`robot_to_dict` (which is also the
 ``robot show --json`` shape of DESIGN.md)::
@@ -50,13 +50,14 @@ Every error names the file and the field, e.g.
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable, Mapping
-from importlib import resources
 from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
 import tomli_w
+from scipy.spatial.transform import Rotation
 
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write, read_toml
@@ -73,8 +74,6 @@ from kinergy.model.robot import (
 )
 
 __all__ = [
-    "library_names",
-    "load_robot",
     "parse_payload",
     "read_robot_file",
     "robot_from_dict",
@@ -206,28 +205,17 @@ def _joint_from_dict(data: Any, index: int) -> Joint:
 
 
 def rpy_matrix(rpy: Any) -> np.ndarray:
-    """Rotation from fixed-axis roll, pitch, yaw (URDF's ``rpy``): ``Rz(y) Ry(p) Rx(r)``."""
-    r, p, y = (float(v) for v in rpy)
-    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
+    """Rotation (3, 3) from fixed-axis roll, pitch, yaw in rad (URDF's ``rpy``): ``Rz(y) Ry(p) Rx(r)``."""
+    return np.asarray(Rotation.from_euler("xyz", [float(v) for v in rpy]).as_matrix())
 
 
 def matrix_rpy(rot: np.ndarray) -> np.ndarray:
-    """Roll, pitch, yaw of a rotation matrix, the inverse of :func:`rpy_matrix` (pitch in
-    [-pi/2, pi/2]; at the gimbal lock yaw is set to 0)."""
-    pitch = float(np.arcsin(np.clip(-rot[2, 0], -1.0, 1.0)))
-    if abs(rot[2, 0]) < 1.0 - 1e-12:
-        roll = float(np.arctan2(rot[2, 1], rot[2, 2]))
-        yaw = float(np.arctan2(rot[1, 0], rot[0, 0]))
-    else:
-        roll, yaw = float(np.arctan2(-rot[1, 2], rot[1, 1])), 0.0
-    return np.array([roll, pitch, yaw])
+    """Roll, pitch, yaw (rad, shape (3,)) of a rotation matrix, the inverse of :func:`rpy_matrix`
+    (pitch in [-pi/2, pi/2]; at the gimbal lock one of the angles is set to 0, and the angles
+    still give back ``rot``)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # scipy's gimbal-lock notice
+        return np.asarray(Rotation.from_matrix(rot).as_euler("xyz"))
 
 
 def _pose_from_dict(data: Any, where: str) -> np.ndarray:
@@ -380,7 +368,7 @@ def read_robot_file(path: str | os.PathLike[str]) -> Robot:
     """
     path = Path(path)
     if path.suffix.lower() == ".urdf":
-        from kinergy.model.urdf import robot_from_urdf
+        from kinergy.model.urdf import robot_from_urdf  # needs the urdf extra (yourdfpy)
 
         return robot_from_urdf(path)
     data = read_toml(path, "robot file")
@@ -398,47 +386,6 @@ def save_robot(robot: Robot, path: str | os.PathLike[str], *, header: str = "") 
     body = tomli_w.dumps(robot_to_dict(robot))
     comment = "".join(f"# {line}\n" for line in header.splitlines())
     atomic_write(path, lambda fh: fh.write(comment + body))
-
-
-def _library_dir() -> Any:
-    return resources.files("kinergy.model") / "library"
-
-
-def library_names() -> list[str]:
-    """Names of the built-in robot files, sorted."""
-    return sorted(
-        p.name.removesuffix(".toml") for p in _library_dir().iterdir() if p.name.endswith(".toml")
-    )
-
-
-def load_robot(name_or_path: str | os.PathLike[str], *, payload: Payload | None = None) -> Robot:
-    """Load a built-in robot by name (``"ur5e"``) or a robot file by path (TOML or URDF).
-
-    Parameters
-    ----------
-    name_or_path : str or path
-        A name from :func:`library_names` or a path to a ``.toml`` / ``.urdf`` file.
-    payload : Payload, optional
-        Replaces the file's payload.
-
-    Raises
-    ------
-    KinergyError
-        Unknown name (listing the built-in ones), unreadable or invalid file.
-    """
-    key = os.fspath(name_or_path)
-    if key in library_names():
-        ref = _library_dir() / f"{key}.toml"
-        with resources.as_file(ref) as path:
-            robot = read_robot_file(path)
-    elif Path(key).exists():
-        robot = read_robot_file(key)
-    else:
-        raise KinergyError(
-            f"unknown robot {key!r}: not a built-in robot ({', '.join(library_names())}) "
-            "and no such file"
-        )
-    return robot if payload is None else robot.with_payload(payload)
 
 
 def parse_payload(text: str) -> Payload:

@@ -21,8 +21,8 @@ from kinergy.identify.sequential import identify_sequential
 from kinergy.io.motion import motion_from_log
 from kinergy.io.rtde import read_log, write_log
 from kinergy.io.task import load_task
+from kinergy.model.library import load_robot
 from kinergy.model.robot import Friction, Robot
-from kinergy.model.toml import load_robot
 from kinergy.report.html import Table
 from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.programs import paper_trajectory
