@@ -40,7 +40,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
-from kinergy.model.robot import Drive, Friction, Joint, Limits, Link, Robot, Source
+from kinergy.model.robot import (
+    SOURCE_CATEGORIES,
+    Drive,
+    Friction,
+    Joint,
+    Limits,
+    Link,
+    Robot,
+    Source,
+)
 
 __all__ = ["mdh_frames", "mdh_parameters", "mdh_transform", "robot_from_urdf"]
 
@@ -469,6 +478,98 @@ def _nominal_drive() -> Drive:
     )
 
 
+def _revolute_chain(tree: _Tree, root: str, tip: str, where: str) -> list[Any]:
+    """The revolute and continuous joints from ``root`` to ``tip``; fixed joints are skipped,
+    any other type is refused."""
+    revolute = []
+    for joint in _chain_joints(tree, root, tip, where):
+        if joint.type in _REVOLUTE:
+            revolute.append(joint)
+        elif joint.type != "fixed":
+            raise _fail(
+                f"{where}: joint {joint.name!r}",
+                f"type {joint.type!r} is not supported (kinergy models serial arms of revolute "
+                "joints; fixed joints are merged)",
+            )
+    if not revolute:
+        raise _fail(where, f"no revolute or continuous joint between links {root!r} and {tip!r}")
+    return revolute
+
+
+def _mdh_chain(
+    revolute: Sequence[Any], poses: Mapping[str, Array], where: str
+) -> tuple[Array, Array]:
+    """MDH parameters (n, 4) of the joints and the frames (n + 1, 4, 4) they rebuild, frame 0
+    the root-frame pose of joint 1's frame, exactly as :mod:`kinergy.dynamics.chain` does."""
+    # joint frames at q = 0 in the root frame: the URDF child-link frames of the joints
+    axes = np.array([poses[j.child][:3, :3] @ _unit_axis(j, where) for j in revolute])
+    points = np.array([poses[j.child][:3, 3] for j in revolute])
+    nominal_frames = mdh_frames(axes, points)
+    params = mdh_parameters(nominal_frames)
+    frames = np.empty((len(revolute) + 1, 4, 4))
+    frames[0] = nominal_frames[0]
+    frames[0][np.abs(frames[0]) < 1e-14] = 0.0  # rounding noise, for readable robot files
+    for i, row in enumerate(params):
+        frames[i + 1] = frames[i] @ mdh_transform(*row)
+    return params, frames
+
+
+def _body_parts(
+    tree: _Tree,
+    body: Mapping[str, int],
+    poses: Mapping[str, Array],
+    frames: Array,
+    n: int,
+    where: str,
+) -> list[list[tuple[float, Array, Array]]]:
+    """Per moving body, the inertials of the URDF links fixed to it, posed in its MDH frame."""
+    parts: list[list[tuple[float, Array, Array]]] = [[] for _ in range(n)]
+    for link_name, b in body.items():
+        if b == 0:
+            continue
+        mass, origin, inertia = _link_inertial(tree.links[link_name], where)
+        if mass > 0.0:
+            pose = np.linalg.solve(frames[b], poses[link_name] @ origin)
+            parts[b - 1].append((mass, pose, inertia))
+    return parts
+
+
+def _joint(joint: Any, row: Array, parts: list[tuple[float, Array, Array]], where: str) -> Joint:
+    """kinergy's joint for a URDF joint: MDH ``row`` = (a, alpha, offset, d), its body's rigid
+    inertial, nominal drive, the URDF's limits."""
+    lwhere = f"{where}: link {joint.child!r}"
+    mass, com, inertia = _body_inertial(parts)
+    if mass <= 0.0:
+        raise _fail(
+            lwhere,
+            f"moved by joint {joint.name!r} but has no mass (nor do the links fixed to it); "
+            "every moving body needs a positive mass",
+        )
+    try:
+        link = Link(mass=mass, com=com, inertia=inertia)
+    except KinergyError as exc:
+        raise exc.prefixed(lwhere) from None
+    a, alpha, offset, d = (float(x) for x in row)
+    return Joint(
+        name=joint.name,
+        d=d,
+        a=a,
+        alpha=alpha,
+        offset=offset,
+        link=link,
+        drive=_nominal_drive(),
+        limits=_limits(joint, where),
+    )
+
+
+def _sources(file: str) -> dict[str, Source]:
+    """Provenance: geometry, inertials and limits from the URDF; drives nominal."""
+    published = Source("published", f"URDF {file}")
+    nominal = Source("nominal", f"not in URDF {file}")
+    drive = ("drive_inertia", "torque_constant", "friction", "motor_constant")
+    return {c: nominal if c in drive else published for c in SOURCE_CATEGORIES}
+
+
 # --------------------------------------------------------------------------------------------
 # The public function
 # --------------------------------------------------------------------------------------------
@@ -526,87 +627,16 @@ def robot_from_urdf(
     tree = _tree(urdf, where)
     root = _root_link(tree, root, where)
     tip = _tip_link(tree, root, where) if tip is None else tip
-    chain = _chain_joints(tree, root, tip, where)
-
-    revolute = []
-    for joint in chain:
-        if joint.type in _REVOLUTE:
-            revolute.append(joint)
-        elif joint.type != "fixed":
-            raise _fail(
-                f"{where}: joint {joint.name!r}",
-                f"type {joint.type!r} is not supported (kinergy models serial arms of revolute "
-                "joints; fixed joints are merged)",
-            )
-    if not revolute:
-        raise _fail(where, f"no revolute or continuous joint between links {root!r} and {tip!r}")
-    moving = {joint.name: i + 1 for i, joint in enumerate(revolute)}
-    poses, body = _poses_and_bodies(tree, root, moving)
-
-    # joint frames at q = 0 in the root frame: the URDF child-link frames of the joints
-    axes = np.array([poses[j.child][:3, :3] @ _unit_axis(j, where) for j in revolute])
-    points = np.array([poses[j.child][:3, 3] for j in revolute])
-    nominal_frames = mdh_frames(axes, points)
-    params = mdh_parameters(nominal_frames)
-    # rebuild the frames from the parameters, exactly as kinergy.dynamics.chain will
-    frames = np.empty((len(revolute) + 1, 4, 4))
-    frames[0] = nominal_frames[0]
-    frames[0][np.abs(frames[0]) < 1e-14] = 0.0  # rounding noise, for readable robot files
-    for i, row in enumerate(params):
-        frames[i + 1] = frames[i] @ mdh_transform(*row)
-
-    parts: list[list[tuple[float, Array, Array]]] = [[] for _ in revolute]
-    for link_name, b in body.items():
-        if b == 0:
-            continue
-        mass, origin, inertia = _link_inertial(tree.links[link_name], where)
-        if mass > 0.0:
-            pose = np.linalg.solve(frames[b], poses[link_name] @ origin)
-            parts[b - 1].append((mass, pose, inertia))
-
-    joints = []
-    for i, (joint, row) in enumerate(zip(revolute, params, strict=True)):
-        lwhere = f"{where}: link {joint.child!r}"
-        mass, com, inertia = _body_inertial(parts[i])
-        if mass <= 0.0:
-            raise _fail(
-                lwhere,
-                f"moved by joint {joint.name!r} but has no mass (nor do the links fixed to it); "
-                "every moving body needs a positive mass",
-            )
-        try:
-            link = Link(mass=mass, com=com, inertia=inertia)
-        except KinergyError as exc:
-            raise exc.prefixed(lwhere) from None
-        a, alpha, offset, d = (float(x) for x in row)
-        joints.append(
-            Joint(
-                name=joint.name,
-                d=d,
-                a=a,
-                alpha=alpha,
-                offset=offset,
-                link=link,
-                drive=_nominal_drive(),
-                limits=_limits(joint, where),
-            )
-        )
-
+    revolute = _revolute_chain(tree, root, tip, where)
+    poses, body = _poses_and_bodies(tree, root, {j.name: i + 1 for i, j in enumerate(revolute)})
+    params, frames = _mdh_chain(revolute, poses, where)
+    parts = _body_parts(tree, body, poses, frames, len(revolute), where)
+    joints = [
+        _joint(joint, row, parts[i], where)
+        for i, (joint, row) in enumerate(zip(revolute, params, strict=True))
+    ]
     flange = np.linalg.solve(frames[-1], poses[tip])
     flange[np.abs(flange) < 1e-14] = 0.0
-    published = Source("published", f"URDF {path.name}")
-    nominal = Source("nominal", f"not in URDF {path.name}")
-    sources = {
-        "kinematics": published,
-        "mass": published,
-        "com": published,
-        "inertia": published,
-        "limits": published,
-        "drive_inertia": nominal,
-        "torque_constant": nominal,
-        "friction": nominal,
-        "motor_constant": nominal,
-    }
     try:
         return Robot(
             name=name or urdf.robot.name or path.stem,
@@ -614,7 +644,7 @@ def robot_from_urdf(
             joints=tuple(joints),
             base=frames[0],
             flange=flange,
-            sources=sources,
+            sources=_sources(path.name),
             description=f"imported from URDF {path.name} (links {root!r} to {tip!r}); "
             "drives are nominal",
         )
