@@ -57,7 +57,6 @@ from typing import Any, TypeVar
 
 import numpy as np
 import tomli_w
-from scipy.spatial.transform import Rotation
 
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write, read_toml
@@ -206,6 +205,8 @@ def _joint_from_dict(data: Any, index: int) -> Joint:
 
 def rpy_matrix(rpy: Any) -> np.ndarray:
     """Rotation (3, 3) from fixed-axis roll, pitch, yaw in rad (URDF's ``rpy``): ``Rz(y) Ry(p) Rx(r)``."""
+    from scipy.spatial.transform import Rotation  # heavy (0.2 s): imported on first use
+
     return np.asarray(Rotation.from_euler("xyz", [float(v) for v in rpy]).as_matrix())
 
 
@@ -213,6 +214,8 @@ def matrix_rpy(rot: np.ndarray) -> np.ndarray:
     """Roll, pitch, yaw (rad, shape (3,)) of a rotation matrix, the inverse of :func:`rpy_matrix`
     (pitch in [-pi/2, pi/2]; at the gimbal lock one of the angles is set to 0, and the angles
     still give back ``rot``)."""
+    from scipy.spatial.transform import Rotation  # heavy (0.2 s): imported on first use
+
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # scipy's gimbal-lock notice
         return np.asarray(Rotation.from_matrix(rot).as_euler("xyz"))
