@@ -26,11 +26,15 @@ def makkar(gamma: Sequence[float] | ArrayLike, speed: ArrayLike) -> Array:
     return g1 * (np.tanh(g2 * v) - np.tanh(g3 * v)) + g4 * np.tanh(g5 * v) + g6 * v
 
 
-def _torque(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+def _torque(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
     return makkar([p[name] for name in PARAMETERS], wm)
 
 
-def _columns(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+def _columns(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
     return np.column_stack(
         [np.tanh(p["gamma2"] * wm) - np.tanh(p["gamma3"] * wm), np.tanh(p["gamma5"] * wm), wm]
     )

@@ -17,10 +17,12 @@ __all__ = ["Columns", "FrictionModel", "Torque"]
 
 Array = NDArray[np.float64]
 
-#: ``torque(params, wm, tau_load) -> (N,)``: friction torque, motor side, N m.
-Torque = Callable[[Mapping[str, float], Array, Array | None], Array]
-#: ``columns(params, wm, tau_load) -> (N, k)``: ``torque == columns @ linear values``.
-Columns = Callable[[Mapping[str, float], Array, Array | None], Array]
+#: ``torque(params, wm, tau_load, temperature) -> (N,)``: friction torque, motor side, N m.
+#: ``tau_load`` (N m, motor side) and ``temperature`` (deg C, the joint's) may be None when the
+#: model does not need them.
+Torque = Callable[[Mapping[str, float], Array, Array | None, Array | None], Array]
+#: ``columns(params, wm, tau_load, temperature) -> (N, k)``: ``torque == columns @ linear values``.
+Columns = Callable[[Mapping[str, float], Array, Array | None, Array | None], Array]
 
 
 def _by_name(model: FrictionModel, params: Mapping[str, float]) -> Array:
@@ -46,13 +48,13 @@ class FrictionModel:
     parameters : tuple of str
         Its parameters, in file order; all required.
     torque : callable
-        ``torque(params, wm, tau_load) -> ndarray (N,)``, opposing the motion.
+        ``torque(params, wm, tau_load, temperature) -> ndarray (N,)``, opposing the motion.
     linear : tuple of str
         The parameters the torque is linear in (fitted by least squares; the others, such as
         ``smoothing``, shape the columns and stay fixed in a linear fit). A name not in
         ``parameters`` is a combination that :attr:`linear_values` defines.
     columns : callable or None
-        ``columns(params, wm, tau_load) -> ndarray (N, len(linear))`` with
+        ``columns(params, wm, tau_load, temperature) -> ndarray (N, len(linear))`` with
         ``torque == columns @ linear_values(params)``.
     positive : frozenset of str
         Parameters that must be > 0 (they divide).
@@ -62,6 +64,8 @@ class FrictionModel:
         Values a fit starts the non-linear parameters from when a joint switches to this model.
     needs_load : bool
         Whether ``torque`` needs the load torque (power-flow or load-dependent friction).
+    needs_temperature : bool
+        Whether ``torque`` needs the joint temperature (temperature-dependent friction).
     citation : str
         Where the model comes from (``UR5e eqs 11-16``).
     linear_values, with_linear : callable, optional
@@ -77,6 +81,7 @@ class FrictionModel:
     bounds: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     shape_defaults: Mapping[str, float] = field(default_factory=dict)
     needs_load: bool = False
+    needs_temperature: bool = False
     citation: str = ""
     linear_values: Callable[[FrictionModel, Mapping[str, float]], Array] = _by_name
     with_linear: Callable[[FrictionModel, Mapping[str, float], Array], dict[str, float]] = (

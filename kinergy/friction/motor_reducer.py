@@ -19,7 +19,9 @@ from kinergy.friction.viscous_coulomb import columns, sign
 Array = NDArray[np.float64]
 
 
-def _torque(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+def _torque(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
     coulomb = p["motor_coulomb"] + p["reducer_coulomb"]
     return p["motor_viscous"] * wm + coulomb * sign(wm, p["smoothing"])
 

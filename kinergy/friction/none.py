@@ -12,11 +12,15 @@ from kinergy.friction.model import FrictionModel
 Array = NDArray[np.float64]
 
 
-def _torque(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+def _torque(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
     return np.zeros_like(wm)
 
 
-def _columns(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+def _columns(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
     return np.zeros((wm.size, 0))
 
 

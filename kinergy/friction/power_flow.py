@@ -25,13 +25,17 @@ def _load(tau_load: Array | None) -> Array:
     return np.asarray(tau_load, dtype=float)
 
 
-def _torque(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+def _torque(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
     direct = wm * _load(tau_load) > 0.0
     coulomb = np.where(direct, p["coulomb_direct"], p["coulomb_reverse"])
     return p["viscous"] * wm + coulomb * sign(wm, p["smoothing"])
 
 
-def _columns(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+def _columns(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
     """UR5e eq 18's columns ``[wm, tanh(wm_dir / e), tanh(wm_rev / e)]`` (eqs 15-16)."""
     flow = wm * _load(tau_load)
     w_dir = np.where(flow > 0.0, wm, 0.0)  # UR5e eq 15

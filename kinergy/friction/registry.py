@@ -98,6 +98,8 @@ def friction_torque(
     wm: Array,
     tau_load: Array | None = None,
     dwm: Array | None = None,
+    *,
+    temperature: Array | None = None,
 ) -> Array:
     """Friction torque on the motor side.
 
@@ -114,6 +116,8 @@ def friction_torque(
         models with ``needs_load`` (``power_flow``: UR5e eqs 12-13).
     dwm : array_like, shape like ``wm``, optional
         Motor acceleration, rad/s^2; with ``standstill`` it tells a stop from a reversal.
+    temperature : array_like, shape like ``wm``, optional
+        The joint's temperature, deg C; needed by models with ``needs_temperature``.
 
     Returns
     -------
@@ -122,10 +126,15 @@ def friction_torque(
     """
     spec = get_model(model)
     wm = np.asarray(wm, dtype=float)
-    load = None if tau_load is None else np.asarray(tau_load, dtype=float)
+    load, temp = _optional(tau_load), _optional(temperature)
     if params.get("standstill", 0.0) > 0.0 and wm.ndim == 1:
-        return friction_columns(model, params, wm, load, dwm) @ linear_values(model, params)
-    return spec.torque(params, wm, load)
+        columns = friction_columns(model, params, wm, load, dwm, temperature=temp)
+        return columns @ linear_values(model, params)
+    return spec.torque(params, wm, load, temp)
+
+
+def _optional(x: Array | None) -> Array | None:
+    return None if x is None else np.asarray(x, dtype=float)
 
 
 def friction_columns(
@@ -134,6 +143,8 @@ def friction_columns(
     wm: Array,
     tau_load: Array | None = None,
     dwm: Array | None = None,
+    *,
+    temperature: Array | None = None,
 ) -> Array:
     """Regressor columns of a friction model: ``friction_torque == columns @ linear values``.
 
@@ -148,6 +159,8 @@ def friction_columns(
         Load torque (motor side), for models that need it.
     dwm : array_like, shape (N,), optional
         Motor acceleration, rad/s^2 (for ``standstill``).
+    temperature : array_like, shape (N,), optional
+        The joint's temperature, deg C, for models that need it.
 
     Returns
     -------
@@ -157,8 +170,8 @@ def friction_columns(
     if spec.columns is None:
         raise KinergyError(f"friction model {model!r} is not linear in any parameter")
     wm = np.asarray(wm, dtype=float)
-    load = None if tau_load is None else np.asarray(tau_load, dtype=float)
-    return hold(params, spec.columns(params, wm, load), wm, dwm)
+    columns = spec.columns(params, wm, _optional(tau_load), _optional(temperature))
+    return hold(params, columns, wm, dwm)
 
 
 def linear_values(model: str, params: Mapping[str, float]) -> Array:

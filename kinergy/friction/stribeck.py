@@ -19,12 +19,16 @@ def _bump(p: Mapping[str, float], wm: Array) -> Array:
     return np.exp(-((wm / p["stribeck_speed"]) ** 2))
 
 
-def _torque(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+def _torque(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
     level = p["coulomb"] + (p["static"] - p["coulomb"]) * _bump(p, wm)
     return level * sign(wm, p["smoothing"]) + p["viscous"] * wm
 
 
-def _columns(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+def _columns(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
     s, bump = sign(wm, p["smoothing"]), _bump(p, wm)
     return np.column_stack([s * (1.0 - bump), s * bump, wm])
 

@@ -18,11 +18,15 @@ def sign(wm: Array, smoothing: float) -> Array:
     return np.tanh(wm / smoothing)
 
 
-def _torque(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+def _torque(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
     return p["viscous"] * wm + p["coulomb"] * sign(wm, p["smoothing"])
 
 
-def columns(p: Mapping[str, float], wm: Array, tau_load: Array | None) -> Array:
+def columns(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None = None
+) -> Array:
     """``[wm, tanh(wm / smoothing)]``, (N, 2): the viscous and Coulomb columns."""
     return np.column_stack([wm, sign(wm, p["smoothing"])])
 
