@@ -178,7 +178,3 @@ def link_consistency(standard: ArrayLike) -> list[str | None]:
         else:
             out.append(None)
     return out
-
-
-# ---------------------------------------------------------------------------------------------
-# The regression
