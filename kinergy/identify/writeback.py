@@ -29,6 +29,7 @@ from kinergy.friction.registry import get_model, with_linear_parameters
 from kinergy.identify.columns import Columns
 from kinergy.identify.constrained import physical_fit
 from kinergy.identify.physical import (
+    inertia_vector,
     link_consistency,
     link_from_standard,
     parameter_scale,
@@ -143,9 +144,8 @@ def _with_links(
         link = joint.link
         if problem is None:
             mass, c, i_c = link_from_standard(links[10 * j : 10 * j + 10])
-            inertia = np.array([i_c[0, 0], i_c[1, 1], i_c[2, 2], i_c[0, 1], i_c[1, 2], i_c[0, 2]])
             try:
-                link = Link(mass=mass, com=c, inertia=inertia)
+                link = Link(mass=mass, com=c, inertia=inertia_vector(i_c))
             except KinergyError as err:
                 problem = str(err)
         if problem is not None:
