@@ -21,6 +21,7 @@ import kinergy
 import kinergy.identify.writeback as writeback
 from kinergy.identify.full import identify_full
 from kinergy.identify.physical import (
+    inertia_vector,
     link_consistency,
     parameter_scale,
     pseudo_inertia,
@@ -29,7 +30,7 @@ from kinergy.identify.physical import (
 from kinergy.identify.preprocess import IdentData, lowpass, prepare
 from kinergy.identify.result import IdentificationResult, validation_metrics
 from kinergy.io.log import Log
-from kinergy.model.robot import Friction
+from kinergy.model.robot import Friction, inertia_matrix
 from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_motion
 from kinergy.trajectory.motion import Motion
@@ -400,6 +401,11 @@ def test_pseudo_inertia_is_positive_definite_exactly_for_physical_links() -> Non
         assert physical == definite
         counts[physical] += 1
     assert min(counts) > 50  # both kinds were drawn
+
+
+def test_inertia_vector_inverts_inertia_matrix() -> None:
+    six = np.random.default_rng(3).normal(size=6)
+    np.testing.assert_array_equal(inertia_vector(inertia_matrix(six)), six)
 
 
 @pytest.mark.parametrize("name", ["ur5e", "panda"])
