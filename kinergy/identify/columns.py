@@ -39,6 +39,7 @@ __all__ = [
     "columns",
     "joint_frictions",
     "power_flow_load",
+    "rotor_columns",
     "set_friction",
     "stack",
 ]
@@ -76,6 +77,13 @@ class Columns:
     def friction(self, x: Array, m: int) -> Array:
         """Motor ``m``'s friction levels in the unknowns ``x`` (p,)."""
         return x[self.fric_at[m] : self.fric_at[m + 1]]
+
+
+def rotor_columns(n_mat: Array, dwm: Array) -> Array:
+    """Reflected rotor inertia columns, shape (N, n, n): motor ``m``'s column on joint ``j`` is
+    ``N[m, j] (N qdd)_m`` (UR5e eq 2), ``dwm = qdd N^T`` (N, n) the motor accelerations, rad/s^2;
+    times ``J`` (kg m^2, motor side) they give joint torques ``N^T diag(J) N qdd``."""
+    return n_mat.T[None, :, :] * dwm[:, None, :]
 
 
 def joint_frictions(
@@ -202,7 +210,7 @@ def stack(
     a = np.empty((samples, n, cols.prior.size))
     a[:, :, :n_link] = base.regressor(regressor(robot, q, qd, qdd))
     wm, dwm = qd @ n_mat.T, qdd @ n_mat.T
-    a[:, :, n_link : n_link + n] = n_mat.T[None, :, :] * dwm[:, None, :]  # N[m, j] (N qdd)_m
+    a[:, :, n_link : n_link + n] = rotor_columns(n_mat, dwm)
     tau_m = np.asarray(np.linalg.solve(n_mat.T, y3.T).T, dtype=float)
     starts = np.cumsum([0, *lengths])
     return Stacked(cols, *frictions, n_mat, q, qd, qdd, a, y3, tau_m, wm, dwm, starts)

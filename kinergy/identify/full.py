@@ -42,8 +42,11 @@ into absorb the difference (``fit.merged`` gives the combination, ``fit.warnings
 Solvers: ordinary least squares; Gautier's weighted least squares (the rows of joint ``j``
 weighted by ``1 / sigma_j``, ``sigma_j`` its residual standard deviation after an OLS pass); ridge
 regression on unit-norm columns shrinking toward the model's values (a weakly excited parameter
-stays near its prior instead of collapsing to zero). Each regression is solved from one QR
-factorisation of the column-scaled ``[A | y]``; everything after it works on the small triangle.
+stays near its prior instead of collapsing to zero): with the columns scaled, ``z_k = |A_k| x_k``,
+``|y - A_s z|^2 + lambda |z - z_model|^2`` is minimised, so ``lambda`` compares with the unit
+diagonal of the scaled normal matrix and a direction whose scaled singular value is below
+``sqrt(lambda)`` stays near the model. Each regression is solved from one QR factorisation of the
+column-scaled ``[A | y]``; everything after it works on the small triangle.
 
 A robot file stores masses, centres of mass and inertias, not base parameters. The standard
 parameters closest to the model's that reproduce the identified base parameters exactly are
@@ -372,13 +375,18 @@ def _physical(stacked: Stacked, written: WriteBack) -> PhysicalFit | None:
 
 def _fit(
     datas: Sequence[IdentData],
-    settings: tuple[str, str, float],
     stacked: Stacked,
-    steps: tuple[FlowFit, Solved, Merging, WriteBack],
     base: BaseParameters,
+    flow: FlowFit,
+    solved: Solved,
+    merging: Merging,
+    written: WriteBack,
+    *,
+    target: str,
+    solver: str,
+    ridge: float,
 ) -> FullFit:
-    """The fit record; ``settings`` = (target, solver, ridge)."""
-    flow, solved, merging, written = steps
+    """The fit record of the steps of :func:`identify_full`."""
     cols, y3 = stacked.cols, stacked.y3
     predicted = (stacked.a_flat @ solved.x).reshape(y3.shape)
     warnings = (
@@ -395,9 +403,9 @@ def _fit(
         logs=tuple(d.path for d in datas),
         lag=tuple(d.lag for d in datas),
         warnings=(*warnings, *merging.warnings, *written.warnings),
-        target=settings[0],
-        solver=settings[1],
-        ridge=float(settings[2]),
+        target=target,
+        solver=solver,
+        ridge=float(ridge),
         condition=flow.ols.solution.cond,
         power_flow_iterations=flow.iterations,
         power_flow_mismatch=flow.mismatch,
@@ -450,11 +458,8 @@ def identify_full(
         Ordinary least squares; weighted least squares, per-joint weights ``1 / sigma_j^2`` from an
         OLS pass's residuals (Gautier); ridge regression toward the model's values.
     ridge : float
-        The ridge weight ``lambda`` (``solver="ridge"`` only, > 0). Columns are scaled to unit
-        norm, ``z_k = |A_k| x_k``, and ``|y - A_s z|^2 + lambda |z - z_model|^2`` is minimised:
-        ``lambda`` compares with the unit diagonal of the scaled normal matrix, and a direction
-        whose scaled singular value is below ``sqrt(lambda)`` stays near the model (1e-6 to 1e-2
-        are typical).
+        The ridge weight ``lambda`` on unit-norm columns (``solver="ridge"`` only, > 0; module
+        docstring): 1e-6 to 1e-2 are typical.
     friction : str, optional
         Friction model for every joint (default: each joint's own). Its shape parameters are the
         joint's when the model is the same, else defaults (smoothing 1e-3 rad/s, ...). Unused for
@@ -484,10 +489,18 @@ def identify_full(
     flow = fit_power_flow(robot, stacked, base.expressions())
     solved = solve(stacked, flow.ols, solver, ridge)
     merging = merged_columns(flow.ols, stacked.cols)
-    frictions = (stacked.models, stacked.params)
-    commanded = target == "moment"
-    written = write_back(robot, base, solved, stacked.cols, frictions, commanded, merging.rotor)
-    steps = (flow, solved, merging, written)
-    fit = _fit(datas, (target, solver, ridge), stacked, steps, base)
+    written = write_back(robot, base, solved, stacked, target == "moment", merging.rotor)
+    fit = _fit(
+        datas,
+        stacked,
+        base,
+        flow,
+        solved,
+        merging,
+        written,
+        target=target,
+        solver=solver,
+        ridge=ridge,
+    )
     joints = _joints(written, solved, stacked.cols, stacked.models)
     return IdentificationResult(written.robot, "full", joints, fit)

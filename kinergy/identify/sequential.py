@@ -36,6 +36,7 @@ from kinergy.friction.registry import (
     start_parameters,
     with_linear_parameters,
 )
+from kinergy.identify.columns import rotor_columns
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import (
     DriveEstimate,
@@ -109,10 +110,8 @@ def rotor_inertias(
     tau_ref = _stack(datas, "tau_ref")
     f_link = rnea(robot, q, qd, qdd)
     n_mat = transmission_matrix(robot)
-    motor_acc = qdd @ n_mat.T  # (N, n): N qdd
-    # column m: contribution of J_m to every joint torque, n_mat[m, j] * (N qdd)_m
-    cols = n_mat[None, :, :] * motor_acc[:, :, None]  # (N, m, j)
-    a = np.transpose(cols, (0, 2, 1)).reshape(-1, robot.n)  # rows (sample, joint), columns m
+    # rows (sample, joint), column m: contribution of J_m, n_mat[m, j] * (N qdd)_m
+    a = rotor_columns(n_mat, qdd @ n_mat.T).reshape(-1, robot.n)
     fixed = [m for m in range(robot.n) if m not in active]
     known = np.array([j.drive.rotor_inertia for j in robot.joints])
     y = (tau_ref - f_link).reshape(-1) - a[:, fixed] @ known[fixed]

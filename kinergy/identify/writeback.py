@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 from kinergy.dynamics.regressor import BaseParameters, inertial_parameters, parameter_names
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import get_model, with_linear_parameters
-from kinergy.identify.columns import Columns
+from kinergy.identify.columns import Columns, Stacked
 from kinergy.identify.constrained import physical_fit
 from kinergy.identify.physical import (
     inertia_vector,
@@ -83,10 +83,11 @@ class WriteBack:
 
 @dataclass(frozen=True, eq=False)
 class _Links:
-    """The written standard parameters of the links (payload included, (p,)), the unknowns
-    they go with, how, the chi^2 increase of the constrained fit, and the links flagged."""
+    """The standard parameters of the links (the payload's share taken out of the last, (p,)),
+    the unknowns they go with, how, the chi^2 increase of the constrained fit, and the links
+    flagged."""
 
-    pi: Array
+    links: Array
     x: Array
     method: str
     chi2: float | None
@@ -110,10 +111,10 @@ def _links(
     flagged = {j: p for j, p in enumerate(link_consistency(pi - payload)) if p is not None}
     negative = [m for m in range(robot.n) if x[n_link + m] < 0.0]
     if not (flagged or negative):
-        return _Links(pi, x, CLOSEST, None, flagged)
+        return _Links(pi - payload, x, CLOSEST, None, flagged)
     refit = physical_fit(problem, base, cols, pi0, scale, payload, merged_rotor)
     if refit is None:
-        return _Links(pi, x, CLOSEST, None, flagged)
+        return _Links(pi - payload, x, CLOSEST, None, flagged)
     instead = (
         "the returned robot takes its links, rotor inertias and friction from the "
         f"least-squares fit constrained to physical links and non-negative rotor "
@@ -127,7 +128,7 @@ def _links(
             f"joint {m + 1} ({robot.joints[m].name}): identified rotor inertia "
             f"{x[n_link + m]:.3g} kg m^2 is negative; {instead}"
         )
-    return _Links(refit.pi, refit.x, CONSTRAINED, refit.chi2, flagged)
+    return _Links(refit.pi - payload, refit.x, CONSTRAINED, refit.chi2, flagged)
 
 
 def _with_links(
@@ -214,30 +215,29 @@ def write_back(
     robot: Robot,
     base: BaseParameters,
     problem: Solved,
-    cols: Columns,
-    frictions: tuple[list[str], list[dict[str, float]]],
+    stacked: Stacked,
     commanded: bool,
     merged_rotor: dict[int, Array],
 ) -> WriteBack:
-    """The identified robot from the solved regression ``problem`` (module docstring).
+    """The identified robot from the solved regression ``problem`` of ``stacked`` (module
+    docstring).
 
-    ``frictions`` are the regression's friction models and parameters (unused when
-    ``commanded``: a fit against ``target_moment`` keeps the model's friction);
+    ``commanded``: a fit against ``target_moment``, which keeps the model's friction;
     ``merged_rotor`` gives each merged rotor inertia's column in link base columns (motor ->
     (b,)), which the constrained fit may move.
     """
     warnings: list[str] = []
+    cols = stacked.cols
     n_link = cols.n_link
     written = _links(robot, base, problem, cols, merged_rotor, warnings)
-    payload = inertial_parameters(robot) - inertial_parameters(robot, include_payload=False)
-    link_joints, links, physical = _with_links(robot, written.pi - payload, warnings)
+    link_joints, links, physical = _with_links(robot, written.links, warnings)
     final = []
     for m, joint in enumerate(link_joints):
         joint = dataclasses.replace(
             joint, drive=_with_rotor(m, joint, float(written.x[n_link + m]), warnings)
         )
         if not commanded:
-            friction = (frictions[0][m], frictions[1][m])
+            friction = (stacked.models[m], stacked.params[m])
             values = cols.friction(written.x, m)
             joint = dataclasses.replace(
                 joint, drive=_with_friction(m, joint, friction, values, warnings)
