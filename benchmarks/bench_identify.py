@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 import kinergy
+from kinergy.identify.full import identify_full
 from kinergy.identify.preprocess import prepare
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.rtde import read_log, write_log
@@ -66,8 +67,6 @@ def main() -> None:
         steps["sequential"].append(t3 - t2)
         steps["total"].append(t3 - t0)
         if args.full:
-            from kinergy.identify.full import identify_full
-
             t4 = time.perf_counter()
             identify_full(robot, [data])
             steps["full"].append(time.perf_counter() - t4)

@@ -18,9 +18,10 @@ import numpy as np
 import pytest
 
 import kinergy
-import kinergy.identify.full as full
+import kinergy.identify.writeback as writeback
 from kinergy.identify.full import identify_full
 from kinergy.identify.physical import (
+    inertia_vector,
     link_consistency,
     parameter_scale,
     pseudo_inertia,
@@ -29,7 +30,7 @@ from kinergy.identify.physical import (
 from kinergy.identify.preprocess import IdentData, lowpass, prepare
 from kinergy.identify.result import IdentificationResult, validation_metrics
 from kinergy.io.log import Log
-from kinergy.model.robot import Friction
+from kinergy.model.robot import Friction, inertia_matrix
 from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_motion
 from kinergy.trajectory.motion import Motion
@@ -87,10 +88,10 @@ def perturbed(robot: kinergy.Robot, seed: int, spread: float = 0.2) -> kinergy.R
 
 
 def expected_unknowns(result: IdentificationResult, truth: kinergy.Robot) -> np.ndarray:
-    """The true value of every regression unknown (``fit["parameters"]``: base parameters, rotor
+    """The true value of every regression unknown (``fit.parameters``: base parameters, rotor
     inertias, friction levels), plus what merged rotor inertias put into the others: a dropped
     column keeps the model's value, so the unknowns it merges into carry ``coefficient *
-    (true - model)`` (``fit["merged"]``)."""
+    (true - model)`` (``fit.merged``)."""
     base = kinergy.base_parameters(truth)
     x = np.concatenate(
         [
@@ -101,9 +102,9 @@ def expected_unknowns(result: IdentificationResult, truth: kinergy.Robot) -> np.
     )
     names = [p.name for p in result.fit.parameters]
     for entry in result.fit.merged:
-        k = names.index(entry["parameter"])
-        for into in entry["into"]:
-            x[into["index"]] += into["coefficient"] * (x[k] - entry["value"])
+        k = names.index(entry.parameter)
+        for into in entry.into:
+            x[into.index] += into.coefficient * (x[k] - entry.value)
     return x
 
 
@@ -169,7 +170,7 @@ def test_moment_recovers_the_true_base_parameters_and_rotor_inertias(
     np.testing.assert_allclose(values, expected_base(result, ur5e), rtol=1e-6, atol=1e-9)
     assert np.all(np.isfinite(std))
     # on a UR arm J1 and J2 multiply the same signals as the Iyy1 and Izz2 groups
-    merged = [e["parameter"] for e in result.fit.merged]
+    merged = [e.parameter for e in result.fit.merged]
     assert merged == [
         "rotor inertia of joint 1 (shoulder_pan)",
         "rotor inertia of joint 2 (shoulder_lift)",
@@ -231,8 +232,8 @@ def test_coupled_joints_are_identified_through_the_transmission() -> None:
     )
     # joint 2's rotor column is a combination of joint 1's and two link base columns
     (merged,) = result.fit.merged
-    assert merged["parameter"] == "rotor inertia of joint 2 (shoulder_rotation)"
-    assert {e["parameter"] for e in merged["into"]} >= {"rotor inertia of joint 1 (shoulder_pitch)"}
+    assert merged.parameter == "rotor inertia of joint 2 (shoulder_rotation)"
+    assert {e.parameter for e in merged.into} >= {"rotor inertia of joint 1 (shoulder_pitch)"}
     assert min(t.r2 for t in result.fit.torque) > 1.0 - 1e-9
     assert all(result.fit.links_physical)
 
@@ -345,7 +346,8 @@ def test_unphysical_base_parameters_are_flagged(ur5e: kinergy.Robot, ur5e_motion
     # ... and a valid robot anyway: the fit constrained to physical links
     assert result.fit.write_back == "physically consistent least squares"
     assert all(result.fit.links_physical)
-    assert result.fit.physical_fit["chi2_increase"] > 1.0
+    assert result.fit.physical_fit is not None
+    assert result.fit.physical_fit.chi2_increase > 1.0
     pi = kinergy.inertial_parameters(result.robot)
     assert all(p is None for p in link_consistency(pi))
     assert np.all(np.linalg.eigvalsh(pseudo_inertia(pi))[:, 0] > 0)
@@ -357,7 +359,7 @@ def test_a_link_that_cannot_be_made_physical_keeps_the_model(
     base = kinergy.base_parameters(ur5e)
     pi_b = base.project(kinergy.inertial_parameters(ur5e))
     pi_b[base.expressions().index("Izz6")] = -0.05
-    monkeypatch.setattr(full, "_physical_fit", lambda *args, **kwargs: None)
+    monkeypatch.setattr(writeback, "physical_fit", lambda *args, **kwargs: None)
     result = identify_full(ur5e, [_moment_log(ur5e, ur5e_motion, pi_b)], target="moment")
     kept = [w for w in result.warnings if w.startswith("link 6 (wrist_3)")]
     assert len(kept) == 1 and "kept the model's mass, centre of mass and inertia" in kept[0]
@@ -399,6 +401,11 @@ def test_pseudo_inertia_is_positive_definite_exactly_for_physical_links() -> Non
         assert physical == definite
         counts[physical] += 1
     assert min(counts) > 50  # both kinds were drawn
+
+
+def test_inertia_vector_inverts_inertia_matrix() -> None:
+    six = np.random.default_rng(3).normal(size=6)
+    np.testing.assert_array_equal(inertia_vector(inertia_matrix(six)), six)
 
 
 @pytest.mark.parametrize("name", ["ur5e", "panda"])

@@ -25,6 +25,7 @@ from kinergy.drives.electrics import torque_constants
 from kinergy.drives.transmission import joint_torque
 from kinergy.dynamics.regressor import regressor
 from kinergy.errors import KinergyError
+from kinergy.identify.physical import inertia_vector, link_from_standard
 from kinergy.identify.preprocess import IdentData
 from kinergy.linalg import scaled_lstsq
 from kinergy.model.robot import Payload, Robot
@@ -99,28 +100,8 @@ def identify_payload(
         No usable signal, a negative mass, or a motion that does not excite the payload.
     """
     bare = robot.with_payload(None)
-    if signal == "auto":
-        if all(d.current is not None for d in datas):
-            signal = "current"
-        elif all(d.torque is not None for d in datas):
-            signal = "torque"
-        elif all(d.tau_ref is not None for d in datas):
-            signal = "moment"
-        else:
-            raise KinergyError(
-                "payload identification needs actual_current, measured torques or target_moment"
-            )
-    guess: Robot = bare
-    x = np.zeros(10)
-    # the payload moves the friction's power-flow direction (UR5e eqs 12-13): iterate to a fixed point
-    for _ in range(30):
-        a, b = _residuals(bare, guess, datas, signal)
-        x_new, std, cond = scaled_lstsq(a[:, :4], b)
-        change = float(np.max(np.abs(x_new - x[:4])))
-        x[:4] = x_new
-        guess = bare.with_payload(Payload(mass=max(float(x[0]), 1e-6), com=_com(robot, x)))
-        if change < 1e-9 * max(abs(float(x[0])), 1.0):
-            break
+    signal = _pick_signal(datas) if signal == "auto" else signal
+    a, b, x, std, cond = _point_mass(robot, bare, datas, signal)
     full, full_std, cond_full = scaled_lstsq(a, b)
     inertia_ok = bool(
         np.all(full_std[4:] < MAX_INERTIA_SPREAD * np.maximum(np.abs(full[4:]), 1e-3))
@@ -128,9 +109,39 @@ def identify_payload(
     if inertia_ok:
         x, std, cond = full, full_std, cond_full
     else:
-        x = np.concatenate([x[:4], np.zeros(6)])
+        x = np.concatenate([x, np.zeros(6)])
         std = np.concatenate([std, np.zeros(6)])
     return _finish(robot, x, std, cond, inertia_ok, signal, datas)
+
+
+def _pick_signal(datas: list[IdentData]) -> str:
+    """The signal every log has: currents, else measured torques, else ``target_moment``."""
+    for name, attr in (("current", "current"), ("torque", "torque"), ("moment", "tau_ref")):
+        if all(getattr(d, attr) is not None for d in datas):
+            return name
+    raise KinergyError(
+        "payload identification needs actual_current, measured torques or target_moment"
+    )
+
+
+def _point_mass(
+    robot: Robot, bare: Robot, datas: list[IdentData], signal: str
+) -> tuple[Array, Array, Array, Array, float]:
+    """Mass and first moment ``[m, m c]`` (4,) by least squares, iterated to a fixed point because
+    the payload moves the friction's power-flow direction (UR5e eqs 12-13): the last pass's
+    regressor (rows samples x joints, 10 columns) and unexplained torque, the estimate, its
+    standard errors and the condition number."""
+    guess: Robot = bare
+    x = np.zeros(4)
+    for _ in range(30):
+        a, b = _residuals(bare, guess, datas, signal)
+        x_new, std, cond = scaled_lstsq(a[:, :4], b)
+        change = float(np.max(np.abs(x_new - x)))
+        x = x_new
+        guess = bare.with_payload(Payload(mass=max(float(x[0]), 1e-6), com=_com(robot, x)))
+        if change < 1e-9 * max(abs(float(x[0])), 1.0):
+            break
+    return a, b, x, std, cond
 
 
 def _com(robot: Robot, x: Array) -> Array:
@@ -171,6 +182,21 @@ def _residuals(
     return np.vstack(rows_a), np.concatenate(rows_b)
 
 
+def _inertia(robot: Robot, x: Array) -> tuple[Array, str | None]:
+    """The inertia 6-vector about the centre of mass in flange axes (kg m^2) of ``x`` (10,),
+    whose ``x[4:]`` are ``[Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` about the last link's origin; zeros
+    and a note when it is not physical."""
+    mass, _, i_c = link_from_standard(x)
+    rot = robot.flange[:3, :3]
+    inertia6 = inertia_vector(rot.T @ i_c @ rot)
+    try:
+        Payload(mass=mass, com=_com(robot, x), inertia=inertia6)
+    except KinergyError as exc:
+        note = f"identified inertia is not physical ({exc}); payload taken as a point mass"
+        return np.zeros(6), note
+    return inertia6, None
+
+
 def _finish(
     robot: Robot,
     x: Array,
@@ -180,33 +206,17 @@ def _finish(
     signal: str,
     datas: list[IdentData],
 ) -> tuple[Payload, PayloadEstimate]:
+    """The payload and its report from ``[m, m c, I_o]`` (10,) and standard errors."""
     mass = float(x[0])
     if mass <= 0 or std[0] > 0.5 * abs(mass):
         raise KinergyError(
             f"the logs do not show a payload: identified mass {mass:.3g} +- {std[0]:.2g} kg"
         )
-    com_link = x[1:4] / mass
-    rot, pos = robot.flange[:3, :3], robot.flange[:3, 3]
-    com = rot.T @ (com_link - pos)
-    inertia6 = np.zeros(6)
-    notes = []
-    if inertia_ok:
-        # x[4:] = [Ixx, Ixy, Iyy, Ixz, Iyz, Izz] about the last link's origin; move to the CoM
-        io = np.array([[x[4], x[5], x[7]], [x[5], x[6], x[8]], [x[7], x[8], x[9]]])
-        ic = io - mass * (float(com_link @ com_link) * np.eye(3) - np.outer(com_link, com_link))
-        ic = rot.T @ ic @ rot
-        inertia6 = np.array([ic[0, 0], ic[1, 1], ic[2, 2], ic[0, 1], ic[1, 2], ic[0, 2]])
-        try:
-            payload = Payload(mass=mass, com=com, inertia=inertia6)
-        except KinergyError as exc:
-            notes.append(
-                f"identified inertia is not physical ({exc}); payload taken as a point mass"
-            )
-            inertia6 = np.zeros(6)
-            inertia_ok = False
-    else:
-        notes.append("the motion does not excite the payload's inertia enough: point mass")
-    payload = Payload(mass=mass, com=com, inertia=inertia6)
+    com = _com(robot, x)
+    inertia6, note = _inertia(robot, x) if inertia_ok else (np.zeros(6), None)
+    if not inertia_ok:
+        note = "the motion does not excite the payload's inertia enough: point mass"
+    inertia_ok = inertia_ok and note is None
     report = PayloadEstimate(
         signal=signal,
         mass=mass,
@@ -216,6 +226,6 @@ def _finish(
         inertia=tuple(inertia6.tolist()) if inertia_ok else None,
         condition=cond,
         samples=int(sum(len(d) for d in datas)),
-        notes=tuple(notes),
+        notes=() if note is None else (note,),
     )
-    return payload, report
+    return Payload(mass=mass, com=com, inertia=inertia6), report

@@ -23,6 +23,7 @@ __all__ = [
     "LENGTH_SCALE",
     "PSEUDO_BASIS",
     "base_projection",
+    "inertia_vector",
     "link_consistency",
     "link_from_standard",
     "parameter_scale",
@@ -139,6 +140,12 @@ def link_from_standard(pi: Array) -> tuple[float, Array, Array]:
     return m, c, i_o - m * (float(c @ c) * np.eye(3) - np.outer(c, c))
 
 
+def inertia_vector(i: Array) -> Array:
+    """``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]`` (the model's 6-vector, kg m^2) of a symmetric 3x3
+    inertia matrix ``i``; :func:`kinergy.model.robot.inertia_matrix` goes the other way."""
+    return np.array([i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[1, 2], i[0, 2]])
+
+
 def link_consistency(standard: ArrayLike) -> list[str | None]:
     """Physical consistency of each link's standard parameters.
 
@@ -178,7 +185,3 @@ def link_consistency(standard: ArrayLike) -> list[str | None]:
         else:
             out.append(None)
     return out
-
-
-# ---------------------------------------------------------------------------------------------
-# The regression

@@ -159,14 +159,19 @@ def uniform(log: Log, *, tolerance: float = 0.01) -> Log:
     return Log(log.path, grid, signals)
 
 
-def lowpass(x: Array, fs: float, cutoff: float, order: int = 4) -> Array:
-    """Zero-phase Butterworth low-pass of ``x`` (N, ...) along time; ``cutoff`` Hz, ``fs`` Hz."""
-    from scipy.signal import butter, sosfiltfilt  # slow to import; only filtering needs it
-
+def _check_cutoff(fs: float, cutoff: float) -> None:
+    """Raise unless ``0 < cutoff < fs / 2`` (Hz)."""
     if not 0.0 < cutoff < fs / 2.0:
         raise KinergyError(
             f"filter cutoff must be between 0 and {fs / 2:g} Hz (half of {fs:g} Hz), got {cutoff:g}"
         )
+
+
+def lowpass(x: Array, fs: float, cutoff: float, order: int = 4) -> Array:
+    """Zero-phase Butterworth low-pass of ``x`` (N, ...) along time; ``cutoff`` Hz, ``fs`` Hz."""
+    from scipy.signal import butter, sosfiltfilt  # slow to import; only filtering needs it
+
+    _check_cutoff(fs, cutoff)
     sos = butter(order, cutoff / (fs / 2.0), output="sos")
     # pad by several periods of the cutoff so the ends have settled
     padlen = min(int(np.ceil(6.0 * fs / cutoff)), x.shape[0] - 1)
@@ -206,6 +211,67 @@ def _delay(t: Array, x: Array, lag: float) -> Array:
     return np.asarray(spline(np.clip(t - lag, t[0], t[-1])), dtype=float)
 
 
+#: (N, n) signals whose joint count must match the robot's
+_JOINT_SIGNALS = (
+    "target_q",
+    "target_qd",
+    "target_qdd",
+    "actual_q",
+    "actual_qd",
+    "target_moment",
+    "actual_current",
+)
+
+
+def _with_torque(log: Log, n_joints: int, torque: Array) -> Log:
+    """``log`` carrying measured torques (N, n) as a signal, so they go through the same sample
+    selection and resampling as the log's own signals."""
+    torque = np.asarray(torque, dtype=float)
+    if torque.shape != (len(log), n_joints):
+        raise KinergyError(
+            f"{log.path}: measured torques have shape {torque.shape}, expected {(len(log), n_joints)}"
+        )
+    return Log(log.path, log.t, {**log.signals, "_torque": torque}, log.notes)
+
+
+def _check_joints(log: Log, n_joints: int) -> None:
+    """Raise when a joint signal of ``log`` does not have ``n_joints`` columns."""
+    for name in _JOINT_SIGNALS:
+        if name in log and (log[name].ndim != 2 or log[name].shape[1] != n_joints):
+            width = 1 if log[name].ndim == 1 else log[name].shape[1]
+            raise KinergyError(
+                f"{log.path}: {name} has {width} joints but the robot has {n_joints}"
+            )
+
+
+#: (q, qd, qdd), each (N, n)
+_Motion3 = tuple[Array, Array, Array]
+
+
+def _motions(log: Log, cutoff: float) -> tuple[_Motion3, _Motion3, float, str]:
+    """The commanded and the real motion of a uniform ``log``, the lag (s) and how the real
+    motion was obtained (module docstring): the commanded motion delayed by the lag estimated
+    from ``target_qd`` against ``actual_qd``; without a target, the measured motion with the
+    speed low-pass filtered (``cutoff`` Hz) and differentiated."""
+    t = log.t
+    fs = 1.0 / float(t[1] - t[0])
+    has_target = "target_q" in log and "target_qd" in log
+    has_actual = "actual_q" in log and "actual_qd" in log
+    if not (has_target or has_actual):
+        log.require("actual_q", "actual_qd", purpose="identification")
+    if has_actual:
+        _check_cutoff(fs, cutoff)
+    if has_target:
+        q_cmd, qd_cmd = log["target_q"], log["target_qd"]
+        qdd_cmd = log["target_qdd"] if "target_qdd" in log else np.gradient(qd_cmd, t, axis=0)
+        lag = estimate_lag(t, qd_cmd, log["actual_qd"]) if has_actual else 0.0
+        q, qd, qdd = (_delay(t, x, lag) for x in (q_cmd, qd_cmd, qdd_cmd))
+        return (q_cmd, qd_cmd, qdd_cmd), (q, qd, qdd), lag, "delayed target"
+    qd_f = lowpass(log["actual_qd"], fs, cutoff)
+    measured = (log["actual_q"], qd_f, np.gradient(qd_f, t, axis=0))
+    return measured, measured, 0.0, "filtered actual"
+
+
 def prepare(
     log: Log,
     n_joints: int,
@@ -231,60 +297,24 @@ def prepare(
         No joint motion in the log; a joint count that does not match.
     """
     if torque is not None:
-        torque = np.asarray(torque, dtype=float)
-        if torque.shape != (len(log), n_joints):
-            raise KinergyError(
-                f"{log.path}: measured torques have shape {torque.shape}, expected {(len(log), n_joints)}"
-            )
-        # carried through the same sample selection and resampling as the log's own signals
-        log = Log(log.path, log.t, {**log.signals, "_torque": torque}, log.notes)
+        log = _with_torque(log, n_joints, torque)
     log = uniform(running(log))
     torque = log.signals.pop("_torque", None) if torque is not None else None
-    t = log.t
-    fs = 1.0 / float(t[1] - t[0])
+    fs = 1.0 / float(log.t[1] - log.t[0])
     cutoff = min(10.0, fs / 5.0) if cutoff is None else cutoff
-    for name in (
-        "target_q",
-        "target_qd",
-        "target_qdd",
-        "actual_q",
-        "actual_qd",
-        "target_moment",
-        "actual_current",
-    ):
-        if name in log and (log[name].ndim != 2 or log[name].shape[1] != n_joints):
-            width = 1 if log[name].ndim == 1 else log[name].shape[1]
-            raise KinergyError(
-                f"{log.path}: {name} has {width} joints but the robot has {n_joints}"
-            )
-    has_target = "target_q" in log and "target_qd" in log
-    has_actual = "actual_q" in log and "actual_qd" in log
-    if not (has_target or has_actual):
-        log.require("actual_q", "actual_qd", purpose="identification")
-    measured_q = log["actual_q"] if has_actual else None
-    if has_actual:
-        qd_f = lowpass(log["actual_qd"], fs, cutoff)
-        qdd_f = np.gradient(qd_f, t, axis=0)
-    if has_target:
-        q_cmd, qd_cmd = log["target_q"], log["target_qd"]
-        qdd_cmd = log["target_qdd"] if "target_qdd" in log else np.gradient(qd_cmd, t, axis=0)
-        lag = estimate_lag(t, qd_cmd, log["actual_qd"]) if has_actual else 0.0
-        q, qd, qdd = (_delay(t, x, lag) for x in (q_cmd, qd_cmd, qdd_cmd))
-        source = "delayed target"
-    else:
-        assert measured_q is not None
-        q_cmd, qd_cmd, qdd_cmd = measured_q, qd_f, qdd_f
-        q, qd, qdd, lag = measured_q, qd_f, qdd_f, 0.0
-        source = "filtered actual"
+    _check_joints(log, n_joints)
+    commanded, real, lag, source = _motions(log, cutoff)
+    q_cmd, qd_cmd, qdd_cmd = (np.asarray(x, dtype=float) for x in commanded)
+    q, qd, qdd = (np.asarray(x, dtype=float) for x in real)
     return IdentData(
         path=log.path,
-        t=t,
-        q_cmd=np.asarray(q_cmd, dtype=float),
-        qd_cmd=np.asarray(qd_cmd, dtype=float),
-        qdd_cmd=np.asarray(qdd_cmd, dtype=float),
-        q=np.asarray(q, dtype=float),
-        qd=np.asarray(qd, dtype=float),
-        qdd=np.asarray(qdd, dtype=float),
+        t=log.t,
+        q_cmd=q_cmd,
+        qd_cmd=qd_cmd,
+        qdd_cmd=qdd_cmd,
+        q=q,
+        qd=qd,
+        qdd=qdd,
         tau_ref=log["target_moment"] if "target_moment" in log else None,
         current=log["actual_current"] if "actual_current" in log else None,
         torque=torque,

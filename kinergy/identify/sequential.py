@@ -23,7 +23,6 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -37,6 +36,7 @@ from kinergy.friction.registry import (
     start_parameters,
     with_linear_parameters,
 )
+from kinergy.identify.columns import rotor_columns
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import (
     DriveEstimate,
@@ -47,7 +47,7 @@ from kinergy.identify.result import (
 )
 from kinergy.jsonable import OPTIONAL
 from kinergy.linalg import scaled_lstsq
-from kinergy.model.robot import Friction, Robot, Source
+from kinergy.model.robot import Friction, Joint, Robot, Source
 
 __all__ = ["SequentialFit", "SequentialJoint", "identify_sequential", "rotor_inertias"]
 
@@ -110,10 +110,8 @@ def rotor_inertias(
     tau_ref = _stack(datas, "tau_ref")
     f_link = rnea(robot, q, qd, qdd)
     n_mat = transmission_matrix(robot)
-    motor_acc = qdd @ n_mat.T  # (N, n): N qdd
-    # column m: contribution of J_m to every joint torque, n_mat[m, j] * (N qdd)_m
-    cols = n_mat[None, :, :] * motor_acc[:, :, None]  # (N, m, j)
-    a = np.transpose(cols, (0, 2, 1)).reshape(-1, robot.n)  # rows (sample, joint), columns m
+    # rows (sample, joint), column m: contribution of J_m, n_mat[m, j] * (N qdd)_m
+    a = rotor_columns(n_mat, qdd @ n_mat.T).reshape(-1, robot.n)
     fixed = [m for m in range(robot.n) if m not in active]
     known = np.array([j.drive.rotor_inertia for j in robot.joints])
     y = (tau_ref - f_link).reshape(-1) - a[:, fixed] @ known[fixed]
@@ -155,21 +153,34 @@ def _diagnose_motion(robot: Robot, datas: Sequence[IdentData]) -> dict[int, str]
     return problems
 
 
+@dataclass(frozen=True, eq=False)
+class _CurrentFit:
+    """Eq 18 for one motor: ``x = [1/k_t, values/k_t]`` with standard errors, the condition
+    number, the squared current error, and whether ``k_t`` was held at the model's."""
+
+    model: str
+    params: dict[str, float]
+    x: Array
+    std: Array
+    cond: float
+    sse: float
+    fixed: bool
+
+
 def _current_fit(
     model: str,
     params: dict[str, float],
-    tau_load: Array,
-    wm: Array,
-    dwm: Array,
-    current: Array,
+    signals: tuple[Array, Array, Array, Array],
     kt_prior: float,
-) -> tuple[Array, Array, float, float, bool]:
+) -> _CurrentFit:
     """Eq 18 for one motor: ``I = [tau_load, friction columns] @ [1/k_t, values/k_t]``.
 
-    When the load torque is too small against the friction and noise to pin ``1/k_t`` down
-    (relative standard deviation above :data:`MAX_KT_SPREAD`, or a non-positive estimate), ``k_t``
-    is fixed at ``kt_prior`` and only the friction is fitted; the last value returned says so.
+    ``signals`` = (``tau_load`` N m, ``wm`` rad/s, ``dwm`` rad/s^2, ``current`` A), each (N,),
+    motor side. When the load torque is too small against the friction and noise to pin ``1/k_t``
+    down (relative standard deviation above :data:`MAX_KT_SPREAD`, or a non-positive estimate),
+    ``k_t`` is fixed at ``kt_prior`` and only the friction is fitted.
     """
+    tau_load, wm, dwm, current = signals
     cols = friction_columns(model, params, wm, tau_load, dwm)
     a = np.column_stack([tau_load, cols])
     x, std, cond = scaled_lstsq(a, current)
@@ -178,11 +189,218 @@ def _current_fit(
         rest, rest_std, cond = scaled_lstsq(cols, current - tau_load / kt_prior)
         x = np.concatenate([[1.0 / kt_prior], rest])
         std = np.concatenate([[0.0], rest_std])
-        a_used = a
+    sse = float(np.sum((current - a @ x) ** 2))
+    return _CurrentFit(model, params, x, std, cond, sse, fixed)
+
+
+# ---------------------------------------------------------------------------------------------
+# Step 2: rotor inertias (UR5e eqs 7-9, Table IV)
+
+
+def _rotor_step(
+    robot: Robot, ref_logs: Sequence[IdentData], active: list[int], warnings: list[str]
+) -> tuple[Array, Array, float | None]:
+    """Rotor inertias (kg m^2, motor side), their standard errors (NaN where not identified) and
+    the regression's condition number (None without ``target_moment``)."""
+    rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
+    rotor_std = np.full(robot.n, np.nan)
+    cond = None
+    if ref_logs:
+        rotor, rotor_std, cond = rotor_inertias(robot, ref_logs, active)
+        if cond > MAX_CONDITION:
+            raise KinergyError(
+                f"rotor inertia regression is singular (condition {cond:.3g}): too little acceleration"
+            )
     else:
-        a_used = a
-    sse = float(np.sum((current - a_used @ x) ** 2))
-    return x, std, cond, sse, fixed
+        warnings.append("the logs have no target_moment: rotor inertias kept from the model")
+    for j, joint in enumerate(robot.joints):
+        if rotor[j] <= 0:
+            warnings.append(
+                f"joint {j + 1} ({joint.name}): identified rotor inertia {rotor[j]:.3g} kg m^2 is not positive"
+            )
+    return rotor, rotor_std, cond
+
+
+def _with_rotor_inertias(robot: Robot, rotor: Array, warnings: list[str]) -> Robot:
+    """Motor inertia = rotor inertia - the model's reducer inertia (Table IV), at least 0."""
+    joints = []
+    for j, joint in enumerate(robot.joints):
+        drive = joint.drive
+        motor = max(float(rotor[j]) - drive.reducer_inertia, 0.0)
+        joints.append(
+            dataclasses.replace(joint, drive=dataclasses.replace(drive, motor_inertia=motor))
+        )
+    for j, joint in enumerate(robot.joints):
+        if rotor[j] < joint.drive.reducer_inertia:
+            warnings.append(
+                f"joint {j + 1} ({joint.name}): rotor inertia {rotor[j]:.3g} is below the model's "
+                f"reducer inertia {joint.drive.reducer_inertia:.3g}; motor inertia set to 0"
+            )
+    return robot.with_joints(joints)
+
+
+# ---------------------------------------------------------------------------------------------
+# Step 3: torque constants and friction (UR5e eqs 17-18)
+
+
+def _motor_signals(
+    robot: Robot, rotor: Array, logs: Sequence[IdentData]
+) -> tuple[Array, Array, Array, Array]:
+    """Motor-side load torque of ``robot`` with rotor inertias ``rotor`` (N m), motor speed
+    (rad/s), acceleration (rad/s^2) and the measured current (A), each (N, n), on the real
+    motion of ``logs``."""
+    q, qd, qdd = _stack(logs, "q"), _stack(logs, "qd"), _stack(logs, "qdd")
+    n_mat = transmission_matrix(robot)
+    tau_sim = rnea(robot, q, qd, qdd) + qdd @ (n_mat.T @ (rotor[:, None] * n_mat)).T
+    tau_load = np.asarray(np.linalg.solve(n_mat.T, tau_sim.T).T, dtype=float)
+    return tau_load, qd @ n_mat.T, qdd @ n_mat.T, _stack(logs, "current")
+
+
+def _best_hold(
+    joint: Joint,
+    model: str,
+    standstill: float,
+    signals: tuple[Array, Array, Array, Array],
+    holdings: Sequence[float],
+) -> _CurrentFit:
+    """Eq 18 with each fraction of ``holdings`` of the friction held through standstill (below
+    ``standstill`` rad/s, motor side); the first whose squared current error no later one cuts by
+    :data:`MIN_GAIN`."""
+    best: _CurrentFit | None = None
+    for holding in holdings:
+        params = start_parameters(model, joint.drive.friction.model, joint.drive.friction.params)
+        params.pop("standstill", None)
+        params.pop("holding", None)
+        if holding > 0.0:
+            params["standstill"] = standstill
+            params["holding"] = holding
+        fit = _current_fit(model, params, signals, joint.drive.torque_constant)
+        if best is None or fit.sse < best.sse * (1.0 - MIN_GAIN):
+            best = fit
+    assert best is not None
+    return best
+
+
+@dataclass(frozen=True)
+class _CurrentStats:
+    """A joint's standard errors and condition number from eq 18 (:class:`SequentialJoint`)."""
+
+    torque_constant_std: float | None = None
+    friction_std: dict[str, float] | None = None
+    condition_current: float | None = None
+
+
+def _apply_current_fit(
+    m: int, joint: Joint, fit: _CurrentFit, warnings: list[str]
+) -> tuple[Joint, _CurrentStats]:
+    """``joint`` with the torque constant and friction of ``fit``, and their standard errors."""
+    if fit.fixed:
+        warnings.append(
+            f"joint {m + 1} ({joint.name}): the logs do not pin the torque constant down "
+            "(too little load torque against friction and noise); kept the model's "
+            f"{joint.drive.torque_constant:.4g} N m/A"
+        )
+    if fit.cond > MAX_CONDITION:
+        raise KinergyError(
+            f"joint {m + 1} ({joint.name}): the current regression is singular (condition "
+            f"{fit.cond:.3g}): the log does not excite every friction term of model {fit.model!r}"
+        )
+    x, std, names = fit.x, fit.std, get_model(fit.model).linear
+    kt = 1.0 / x[0]
+    values = x[1:] * kt
+    kt_std = std[0] / x[0] ** 2
+    value_std = np.sqrt((std[1:] * kt) ** 2 + (x[1:] * kt_std * kt) ** 2)
+    for name, value in zip(names, values, strict=True):
+        if value < 0 and name not in ("gamma1",):
+            warnings.append(
+                f"joint {m + 1} ({joint.name}): friction {name} = {value:.3g} is negative"
+            )
+    friction = Friction(fit.model, with_linear_parameters(fit.model, fit.params, values))
+    drive = dataclasses.replace(joint.drive, torque_constant=float(kt), friction=friction)
+    stats = _CurrentStats(
+        torque_constant_std=float(kt_std),
+        friction_std={name: float(s) for name, s in zip(names, value_std, strict=True)},
+        condition_current=fit.cond,
+    )
+    return dataclasses.replace(joint, drive=drive), stats
+
+
+def _current_step(
+    staged: Robot,
+    rotor: Array,
+    logs: Sequence[IdentData],
+    problems: dict[int, str],
+    options: tuple[str | None, str | bool],
+    warnings: list[str],
+) -> tuple[Robot, list[_CurrentStats], tuple[float | None, ...]]:
+    """Torque constants and friction of every identifiable motor from the currents (eqs 17-18);
+    ``options`` = (friction model or None, hold). Returns the robot, each joint's statistics and
+    the friction fraction held through standstill (None where not fitted)."""
+    friction, hold = options
+    signals = _motor_signals(staged, rotor, logs)
+    holdings = HOLDINGS if hold == "auto" else ((1.0,) if hold else (0.0,))
+    joints: list[Joint] = []
+    stats: list[_CurrentStats] = []
+    held: list[float | None] = []
+    for m, joint in enumerate(staged.joints):
+        if m in problems:
+            joints.append(joint)
+            stats.append(_CurrentStats())
+            held.append(None)
+            continue
+        model = friction or joint.drive.friction.model
+        standstill = STILL_SPEED * abs(joint.drive.gear_ratio)
+        tau_load, wm, dwm, current = (s[:, m] for s in signals)
+        fit = _best_hold(joint, model, standstill, (tau_load, wm, dwm, current), holdings)
+        held.append(float(fit.params.get("holding", 0.0)))
+        new, stat = _apply_current_fit(m, joint, fit, warnings)
+        joints.append(new)
+        stats.append(stat)
+    return staged.with_joints(joints), stats, tuple(held)
+
+
+# ---------------------------------------------------------------------------------------------
+# The method
+
+
+def _sources(robot: Robot, has_ref: bool, has_current: bool) -> dict[str, Source]:
+    """The robot's sources with the identified groups marked."""
+    sources = dict(robot.sources)
+    if has_ref:
+        sources["drive_inertia"] = Source(
+            "identified", "kinergy identify (sequential, UR5e eqs 7-9)"
+        )
+    if has_current:
+        ref = "kinergy identify (sequential, UR5e eqs 17-18)"
+        sources["torque_constant"] = Source("identified", ref)
+        sources["friction"] = Source("identified", ref)
+    return sources
+
+
+def _joints(
+    identified: Robot,
+    rotor: tuple[Array, Array],
+    problems: dict[int, str],
+    stats: Sequence[_CurrentStats],
+) -> tuple[SequentialJoint, ...]:
+    """Per joint: the identified drive with ``rotor`` = (inertias, standard errors)."""
+    inertia, std = rotor
+    return tuple(
+        SequentialJoint(
+            name=joint.name,
+            rotor_inertia=float(joint.drive.motor_inertia + joint.drive.reducer_inertia)
+            if inertia[j] >= joint.drive.reducer_inertia
+            else float(inertia[j]),
+            rotor_inertia_std=None if np.isnan(std[j]) else float(std[j]),
+            motor_inertia=joint.drive.motor_inertia,
+            torque_constant=joint.drive.torque_constant,
+            friction=friction_entry(joint),
+            identified=j not in problems,
+            problem=problems.get(j),
+            **vars(stats[j]),
+        )
+        for j, joint in enumerate(identified.joints)
+    )
 
 
 def identify_sequential(
@@ -211,6 +429,8 @@ def identify_sequential(
     Returns
     -------
     IdentificationResult
+        ``method = "sequential"``, joints of :class:`SequentialJoint`, fit a
+        :class:`SequentialFit`.
 
     Raises
     ------
@@ -221,190 +441,38 @@ def identify_sequential(
     if not datas:
         raise KinergyError("no log to identify from")
     problems = _diagnose_motion(robot, datas)
-    active = [j for j in range(robot.n) if j not in problems]
     warnings: list[str] = [f"{text}; kept the model's values" for text in problems.values()]
-    n = robot.n
     ref_logs = [d for d in datas if d.tau_ref is not None]
     current_logs = [d for d in datas if d.current is not None]
-    has_ref, has_current = bool(ref_logs), bool(current_logs)
-    if not (has_ref or has_current):
+    if not (ref_logs or current_logs):
         raise KinergyError(
             "identification needs target_moment (rotor inertia) or actual_current (torque "
             "constant and friction); the logs have neither"
         )
-    fit: dict[str, Any] = {
-        "samples": int(sum(len(d) for d in datas)),
-        "logs": [d.path for d in datas],
-    }
-    fit["lag"] = [d.lag for d in datas]
-    rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
-    rotor_std = np.full(n, np.nan)
-    if has_ref:
-        rotor, rotor_std, cond = rotor_inertias(robot, ref_logs, active)
-        fit["condition_rotor_inertia"] = cond
-        if cond > MAX_CONDITION:
-            raise KinergyError(
-                f"rotor inertia regression is singular (condition {cond:.3g}): too little acceleration"
-            )
-    else:
-        warnings.append("the logs have no target_moment: rotor inertias kept from the model")
-    for j, joint in enumerate(robot.joints):
-        if rotor[j] <= 0:
-            warnings.append(
-                f"joint {j + 1} ({joint.name}): identified rotor inertia {rotor[j]:.3g} kg m^2 is not positive"
-            )
-    joints = [
-        dataclasses.replace(
-            joint,
-            drive=dataclasses.replace(
-                joint.drive,
-                motor_inertia=max(float(rotor[j]) - joint.drive.reducer_inertia, 0.0),
-            ),
+    active = [j for j in range(robot.n) if j not in problems]
+    rotor, rotor_std, cond = _rotor_step(robot, ref_logs, active, warnings)
+    staged = _with_rotor_inertias(robot, rotor, warnings)
+    stats: list[_CurrentStats] = [_CurrentStats() for _ in range(robot.n)]
+    held = None
+    if current_logs:
+        options = (friction, hold)
+        staged, stats, held = _current_step(
+            staged, rotor, current_logs, problems, options, warnings
         )
-        for j, joint in enumerate(robot.joints)
-    ]
-    for j, joint in enumerate(robot.joints):
-        if rotor[j] < joint.drive.reducer_inertia:
-            warnings.append(
-                f"joint {j + 1} ({joint.name}): rotor inertia {rotor[j]:.3g} is below the model's "
-                f"reducer inertia {joint.drive.reducer_inertia:.3g}; motor inertia set to 0"
-            )
-    staged = robot.with_joints(joints)
-    per_joint: list[dict[str, Any]] = []
-    if has_current:
-        q, qd, qdd = (
-            _stack(current_logs, "q"),
-            _stack(current_logs, "qd"),
-            _stack(current_logs, "qdd"),
-        )
-        current = _stack(current_logs, "current")
-        n_mat = transmission_matrix(staged)
-        tau_sim = rnea(staged, q, qd, qdd) + qdd @ (n_mat.T @ (rotor[:, None] * n_mat)).T
-        tau_load = np.asarray(np.linalg.solve(n_mat.T, tau_sim.T).T, dtype=float)
-        wm = qd @ n_mat.T
-        dwm = qdd @ n_mat.T
-        ratios = np.abs(np.array([j.drive.gear_ratio for j in staged.joints]))
-        holdings = HOLDINGS if hold == "auto" else ((1.0,) if hold else (0.0,))
-        chosen: list[Any] = []
-        for m, joint in enumerate(staged.joints):
-            if m in problems:
-                chosen.append(None)
-                continue
-            model = friction or joint.drive.friction.model
-            best: tuple[float, Any] | None = None
-            for holding in holdings:
-                params = start_parameters(
-                    model, joint.drive.friction.model, joint.drive.friction.params
-                )
-                params.pop("standstill", None)
-                params.pop("holding", None)
-                if holding > 0.0:
-                    params["standstill"] = STILL_SPEED * ratios[m]
-                    params["holding"] = holding
-                x, std, cond, sse, fixed = _current_fit(
-                    model,
-                    params,
-                    tau_load[:, m],
-                    wm[:, m],
-                    dwm[:, m],
-                    current[:, m],
-                    joint.drive.torque_constant,
-                )
-                if best is None or sse < best[0] * (1.0 - MIN_GAIN):
-                    best = (sse, (model, params, x, std, cond, fixed))
-            assert best is not None
-            chosen.append(best[1])
-        fit["friction_holding"] = [
-            None if c is None else float(c[1].get("holding", 0.0)) for c in chosen
-        ]
-        new_joints = []
-        for m, choice in enumerate(chosen):
-            joint = staged.joints[m]
-            if choice is None:
-                new_joints.append(joint)
-                per_joint.append({})
-                continue
-            model, params, x, std, cond, fixed = choice
-            if fixed:
-                warnings.append(
-                    f"joint {m + 1} ({joint.name}): the logs do not pin the torque constant down "
-                    "(too little load torque against friction and noise); kept the model's "
-                    f"{joint.drive.torque_constant:.4g} N m/A"
-                )
-            if cond > MAX_CONDITION:
-                raise KinergyError(
-                    f"joint {m + 1} ({joint.name}): the current regression is singular (condition "
-                    f"{cond:.3g}): the log does not excite every friction term of model {model!r}"
-                )
-            kt = 1.0 / x[0]
-            values = x[1:] * kt
-            kt_std = std[0] / x[0] ** 2
-            value_std = np.sqrt((std[1:] * kt) ** 2 + (x[1:] * kt_std * kt) ** 2)
-            new_params = with_linear_parameters(model, params, values)
-            for name, value in zip(get_model(model).linear, values, strict=True):
-                if value < 0 and name not in ("gamma1",):
-                    warnings.append(
-                        f"joint {m + 1} ({joint.name}): friction {name} = {value:.3g} is negative"
-                    )
-            new_joints.append(
-                dataclasses.replace(
-                    joint,
-                    drive=dataclasses.replace(
-                        joint.drive, torque_constant=float(kt), friction=Friction(model, new_params)
-                    ),
-                )
-            )
-            per_joint.append(
-                {
-                    "torque_constant_std": float(kt_std),
-                    "friction_std": {
-                        name: float(s)
-                        for name, s in zip(get_model(model).linear, value_std, strict=True)
-                    },
-                    "condition_current": cond,
-                }
-            )
-        staged = staged.with_joints(new_joints)
     else:
         warnings.append(
             "the logs have no actual_current: torque constants and friction kept from the model"
         )
-        per_joint = [{} for _ in range(n)]
-    sources = dict(staged.sources)
-    if has_ref:
-        sources["drive_inertia"] = Source(
-            "identified", "kinergy identify (sequential, UR5e eqs 7-9)"
-        )
-    if has_current:
-        sources["torque_constant"] = Source(
-            "identified", "kinergy identify (sequential, UR5e eqs 17-18)"
-        )
-        sources["friction"] = Source("identified", "kinergy identify (sequential, UR5e eqs 17-18)")
+    sources = _sources(staged, bool(ref_logs), bool(current_logs))
     identified = dataclasses.replace(staged, sources=sources)
-    joints_out = tuple(
-        SequentialJoint(
-            name=joint.name,
-            rotor_inertia=float(joint.drive.motor_inertia + joint.drive.reducer_inertia)
-            if rotor[j] >= joint.drive.reducer_inertia
-            else float(rotor[j]),
-            rotor_inertia_std=None if np.isnan(rotor_std[j]) else float(rotor_std[j]),
-            motor_inertia=joint.drive.motor_inertia,
-            torque_constant=joint.drive.torque_constant,
-            friction=friction_entry(joint),
-            identified=j not in problems,
-            problem=problems.get(j),
-            **per_joint[j],
-        )
-        for j, joint in enumerate(identified.joints)
-    )
-    validation = validation_metrics(identified, datas)
-    result_fit = SequentialFit(
-        **vars(validation),
-        samples=fit["samples"],
-        logs=tuple(fit["logs"]),
-        lag=tuple(fit["lag"]),
+    fit = SequentialFit(
+        **vars(validation_metrics(identified, datas)),
+        samples=int(sum(len(d) for d in datas)),
+        logs=tuple(d.path for d in datas),
+        lag=tuple(d.lag for d in datas),
         warnings=tuple(warnings),
-        condition_rotor_inertia=fit.get("condition_rotor_inertia"),
-        friction_holding=tuple(fit["friction_holding"]) if "friction_holding" in fit else None,
+        condition_rotor_inertia=cond,
+        friction_holding=held,
     )
-    return IdentificationResult(identified, "sequential", joints_out, result_fit)
+    joints = _joints(identified, (rotor, rotor_std), problems, stats)
+    return IdentificationResult(identified, "sequential", joints, fit)
