@@ -90,6 +90,7 @@ class MakkarFit:
 
 
 def _check_points(speeds: ArrayLike, friction: ArrayLike) -> tuple[Array, Array]:
+    """The points as flat arrays (M,): at least 6, of equal count, finite, speeds not all 0."""
     v = np.asarray(speeds, dtype=float).reshape(-1)
     f = np.asarray(friction, dtype=float).reshape(-1)
     if v.shape != f.shape or v.size < 6:
@@ -133,6 +134,7 @@ def _gains(rates: Array, v: Array, f: Array, positive: bool = True) -> tuple[Arr
 
 
 def _assemble(gains: Array, rates: Array) -> Array:
+    """``gamma`` (P, 6) from the gains ``gamma1, gamma4, gamma6`` and rates (each (P, 3))."""
     g = np.empty((rates.shape[0], 6))
     g[:, list(_GAINS)] = gains
     g[:, list(_RATES)] = rates
@@ -140,6 +142,7 @@ def _assemble(gains: Array, rates: Array) -> Array:
 
 
 def _fit_result(gamma: Array, v: Array, f: Array, method: str, history: Array) -> MakkarFit:
+    """The canonical ``gamma`` with its R^2 and RMSE against the points ``v``, ``f``."""
     g = _canonical(gamma)
     pred = makkar(g, v)
     return MakkarFit(
