@@ -491,14 +491,12 @@ def identify_nursing(
 ) -> IdentificationResult:
     """The nursing doc's identification (sections 4.1-4.2) from prepared logs.
 
-    Logs in which one joint moves (the others stay below a tenth of its peak speed) with
-    back-and-forth constant-speed runs are friction runs
-    (:func:`kinergy.experiments.friction_runs.back_and_forth_motion`); the others are excitation
-    runs. The four steps of the module docstring; motors without runs keep the model's friction.
-    Excitation logs are low-pass filtered (``cutoff`` Hz; the doc's 15 Hz) and averaged over
-    their periods (``period`` s, found by :func:`kinergy.identify.cycles.find_period` when None);
-    several are joined in order, each reduced to one averaged period when it repeats. The first
-    ``split`` in time trains the ridge regression, the rest tests.
+    The four steps of the module docstring. Logs in which one joint moves (the others below a
+    tenth of its peak speed) at back-and-forth constant speeds are friction runs; motors without
+    runs keep the model's friction. The other (excitation) logs are low-pass filtered (``cutoff``
+    Hz; None: not filtered), each averaged over its periods (``period`` s, else
+    :func:`find_period`) and joined in order; the first ``split`` in time trains the ridge
+    regression on the weights ``alphas`` (:func:`~kinergy.identify.ridge.ridge_minimal`).
 
     Parameters
     ----------
@@ -509,14 +507,9 @@ def identify_nursing(
     eta : float
         Eq 21's efficiency (the twin: 1; the doc's robot: 0.82).
     fit : {"lsq", "pso"}
-        Makkar fit (:func:`kinergy.identify.makkar_fit.fit_makkar_lsq` or ``fit_makkar_pso``).
-    period, cutoff, split, alphas :
-        See above; ``cutoff=None`` skips the filter; ``alphas``: the ridge weights to choose
-        from (:func:`kinergy.identify.ridge.ridge_minimal`).
+        Makkar fit: :func:`fit_makkar_lsq` or :func:`fit_makkar_pso` (seeded by ``seed``).
     trim : int
         Samples dropped at each end of a constant-speed run.
-    seed : int
-        Seed of the swarm (``fit="pso"``).
 
     Returns
     -------
@@ -546,7 +539,7 @@ def identify_nursing(
         warnings.append(
             "no excitation log (every log moves one joint): link data kept from the model"
         )
-    links = rf is not None and kept is not None and len(kept) < robot.n
+    links = kept is not None and len(kept) < robot.n
     identified = _sources(identified, friction=bool(new_friction), links=links)
     fit_out = NursingFit(
         **vars(validation_metrics(identified, datas)),
