@@ -14,9 +14,9 @@ import pytest
 from conftest import random_state
 
 import kinergy
+from kinergy.drives.coupled import coupled_joint_dynamics
 from kinergy.drives.electrics import electrical_power
 from kinergy.drives.transmission import (
-    coupled_joint_dynamics,
     joint_torque,
     motor_speed,
     motor_torque,

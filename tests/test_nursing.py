@@ -14,12 +14,29 @@ from click.testing import CliRunner
 
 import kinergy
 from kinergy.cli import nursing as nursing_cmd
+from kinergy.drives.coupled import (
+    coupled_torques,
+    joint_friction,
+    joint_kind,
+    joint_torques_from_current,
+    makkar_joint_side,
+    makkar_motor_side,
+    torque_from_current,
+)
 from kinergy.drives.transmission import joint_torque, motor_speed, transmission_matrix
 from kinergy.dynamics.regressor import base_parameters, inertial_parameters, regressor
 from kinergy.errors import KinergyError
+from kinergy.experiments.friction_runs import back_and_forth_motion
+from kinergy.experiments.nursing_doc import BASE_FREQUENCY, DOC_EQ21
+from kinergy.experiments.nursing_excitation import table6_motion
+from kinergy.friction.makkar import makkar
 from kinergy.identify import nursing as nu
+from kinergy.identify.cycles import cycle_average, find_period
+from kinergy.identify.friction_points import constant_speed_runs, friction_points, odd_even_friction
+from kinergy.identify.makkar_fit import fit_makkar_lsq, fit_makkar_pso
 from kinergy.identify.preprocess import prepare
 from kinergy.identify.pso import constriction, particle_swarm
+from kinergy.identify.ridge import ridge_minimal
 from kinergy.io.log import Log
 from kinergy.model import load_robot, save_robot
 from kinergy.model.robot import Limits
@@ -89,7 +106,7 @@ def test_swarm_stays_in_its_box() -> None:
 
 
 def test_eq21_with_the_docs_constants() -> None:
-    assert nu.torque_from_current(2.0, **nu.DOC_EQ21) == pytest.approx(2 * 3060 * 0.82 * 0.0293)
+    assert torque_from_current(2.0, **DOC_EQ21) == pytest.approx(2 * 3060 * 0.82 * 0.0293)
 
 
 def test_currents_to_joint_torques_follow_the_coupling_by_power_balance(arm) -> None:
@@ -97,39 +114,37 @@ def test_currents_to_joint_torques_follow_the_coupling_by_power_balance(arm) -> 
     current = rng.normal(size=(5, 6))
     kt = np.array([j.drive.torque_constant for j in arm.joints])
     ratios = np.array([j.drive.gear_ratio for j in arm.joints])
-    tau = nu.joint_torques_from_current(arm, current)
+    tau = joint_torques_from_current(arm, current)
     # eta = 1: the drives' own joint_torque of k_t I
     np.testing.assert_allclose(tau, joint_torque(arm, kt * current), rtol=1e-12)
-    np.testing.assert_allclose(nu.joint_torques_from_current(arm, current, eta=0.82), 0.82 * tau)
+    np.testing.assert_allclose(joint_torques_from_current(arm, current, eta=0.82), 0.82 * tau)
     # per pair (pitch, rotation) = (T1 + T2, T1 - T2) with T = n K_m I (eq 21)
-    t_in = nu.torque_from_current(current, n=ratios, eta=1.0, km=kt)
+    t_in = torque_from_current(current, n=ratios, eta=1.0, km=kt)
     for p in (0, 2, 4):
-        pitch, rot = nu.coupled_torques(t_in[:, p], t_in[:, p + 1])
+        pitch, rot = coupled_torques(t_in[:, p], t_in[:, p + 1])
         np.testing.assert_allclose(tau[:, p], pitch)
         np.testing.assert_allclose(tau[:, p + 1], rot)
-        assert nu.joint_kind(arm, p) == "pitch" and nu.joint_kind(arm, p + 1) == "rotation"
+        assert joint_kind(arm, p) == "pitch" and joint_kind(arm, p + 1) == "rotation"
     # power: joint torques times joint speeds == motor torques times motor speeds
     qd = rng.normal(size=(5, 6))
     wm = motor_speed(arm, qd)
     np.testing.assert_allclose(np.sum(tau * qd, axis=1), np.sum(kt * current * wm, axis=1))
     # the doc's eqs 17-18 print the mirrored pairing: pitch T1 - T2, rotation T1 + T2
-    pitch_m, rot_m = nu.coupled_torques(3.0, 1.0, mirrored=True)
+    pitch_m, rot_m = coupled_torques(3.0, 1.0, mirrored=True)
     assert (float(pitch_m), float(rot_m)) == (2.0, 4.0)
 
 
 def test_makkar_side_conversion_matches_the_robot_file(arm) -> None:
     motor = np.array([arm.joints[0].drive.friction.params[f"gamma{k}"] for k in range(1, 7)])
-    joint = nu.makkar_joint_side(motor, 3060.0, 2)
+    joint = makkar_joint_side(motor, 3060.0, 2)
     np.testing.assert_allclose(joint, TWIN_GAMMA, rtol=2e-4)  # the header's rounded values
-    np.testing.assert_allclose(nu.makkar_motor_side(joint, 3060.0, 2), motor, rtol=1e-12)
+    np.testing.assert_allclose(makkar_motor_side(joint, 3060.0, 2), motor, rtol=1e-12)
     # moving one joint of a pair: N^T f(N qd) is the joint-side Makkar curve
     v = np.geomspace(0.005, 0.5, 9)
     for j in range(6):
         qd = np.zeros((v.size, 6))
         qd[:, j] = v
-        np.testing.assert_allclose(
-            nu.joint_friction(arm, qd)[:, j], nu.makkar(joint, v), rtol=1e-10
-        )
+        np.testing.assert_allclose(joint_friction(arm, qd)[:, j], makkar(joint, v), rtol=1e-10)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -141,21 +156,21 @@ def test_odd_even_split_recovers_a_hand_built_friction_and_error() -> None:
     friction = 3.0 * np.tanh(40 * v) + 0.8 * v  # odd
     error = 0.4 + 0.2 * v**2  # even: depends on |v| only
     gravity = -1.7  # same both ways
-    f, e = nu.odd_even_friction(v, friction + error + gravity, -friction + error + gravity)
+    f, e = odd_even_friction(v, friction + error + gravity, -friction + error + gravity)
     np.testing.assert_allclose(f, friction, rtol=1e-14)
     np.testing.assert_allclose(e, error + gravity, rtol=1e-14)
     with pytest.raises(KinergyError, match="> 0"):
-        nu.odd_even_friction(-v, f, f)
+        odd_even_friction(-v, f, f)
 
 
 def test_friction_points_cancel_a_position_dependent_torque(arm) -> None:
-    run = nu.back_and_forth_motion(arm, 2, [0.05, 0.2], pose=np.zeros(6))
+    run = back_and_forth_motion(arm, 2, [0.05, 0.2], pose=np.zeros(6))
     q = run.motion.q[:, 2]
     qd = run.motion.qd[:, 2]
-    tau = 5.0 * np.sin(q) + nu.makkar(TWIN_GAMMA, qd)  # gravity-like plus friction
-    pts = nu.friction_points(q, tau, run.speeds, run.forward, run.backward)
-    np.testing.assert_allclose(pts.friction, nu.makkar(TWIN_GAMMA, run.speeds), rtol=1e-9)
-    np.testing.assert_allclose(pts.sample_friction, nu.makkar(TWIN_GAMMA, pts.sample_speeds))
+    tau = 5.0 * np.sin(q) + makkar(TWIN_GAMMA, qd)  # gravity-like plus friction
+    pts = friction_points(q, tau, run.speeds, run.forward, run.backward)
+    np.testing.assert_allclose(pts.friction, makkar(TWIN_GAMMA, run.speeds), rtol=1e-9)
+    np.testing.assert_allclose(pts.sample_friction, makkar(TWIN_GAMMA, pts.sample_speeds))
 
 
 @pytest.fixture(scope="module")
@@ -163,13 +178,13 @@ def elbow_runs(arm):
     """The doc's forearm (elbow) pair, pitch and rotation runs on the exact twin."""
     out = {}
     for j in (2, 3):
-        run = nu.back_and_forth_motion(arm, j)
+        run = back_and_forth_motion(arm, j)
         data = _twin_data(arm, run.motion, TwinSettings.exact(), f"elbow-{j}")
-        tau = nu.joint_torques_from_current(arm, data.current)
+        tau = joint_torques_from_current(arm, data.current)
         out[j] = (
             run,
             data,
-            nu.friction_points(data.q[:, j], tau[:, j], run.speeds, run.forward, run.backward),
+            friction_points(data.q[:, j], tau[:, j], run.speeds, run.forward, run.backward),
         )
     return out
 
@@ -189,7 +204,7 @@ def test_friction_runs_are_constant_speed_in_a_gravity_free_pose(arm, elbow_runs
         # the even part (gravity and modelling error) is zero on the exact twin
         np.testing.assert_allclose(pts.error, 0.0, atol=1e-9)
         # the runs are found again in the log alone
-        speeds, fwd, _ = nu.constant_speed_runs(data.qd_cmd[:, j], data.qdd_cmd[:, j])
+        speeds, fwd, _ = constant_speed_runs(data.qd_cmd[:, j], data.qdd_cmd[:, j])
         np.testing.assert_allclose(speeds, run.speeds)
         assert np.all(fwd[:, 0] >= run.forward[:, 0]) and np.all(fwd[:, 1] <= run.forward[:, 1])
 
@@ -197,34 +212,32 @@ def test_friction_runs_are_constant_speed_in_a_gravity_free_pose(arm, elbow_runs
 def test_makkar_fits_recover_the_twin_noise_free(elbow_runs) -> None:
     for _, _, pts in elbow_runs.values():
         # the odd part is the twin's joint-side curve, exactly
-        np.testing.assert_allclose(pts.friction, nu.makkar(TWIN_GAMMA, pts.speeds), rtol=2e-4)
-        lsq = nu.fit_makkar_lsq(pts.speeds, pts.friction)
+        np.testing.assert_allclose(pts.friction, makkar(TWIN_GAMMA, pts.speeds), rtol=2e-4)
+        lsq = fit_makkar_lsq(pts.speeds, pts.friction)
         assert lsq.r2 >= 0.99
         np.testing.assert_allclose(lsq.gamma, TWIN_GAMMA, rtol=2e-4)  # the parameters
-        pso = nu.fit_makkar_pso(pts.speeds, pts.friction, rng=0)
+        pso = fit_makkar_pso(pts.speeds, pts.friction, rng=0)
         assert pso.r2 >= 0.99
         # the swarm finds the curve (within 1 % of its peak), not each parameter: Makkar's
         # model has flat valleys; the polish pins the parameters down
         v = np.linspace(0.0, pts.speeds.max(), 200)
-        peak = np.max(np.abs(nu.makkar(TWIN_GAMMA, v)))
-        assert np.max(np.abs(nu.makkar(pso.gamma, v) - nu.makkar(TWIN_GAMMA, v))) < 0.01 * peak
+        peak = np.max(np.abs(makkar(TWIN_GAMMA, v)))
+        assert np.max(np.abs(makkar(pso.gamma, v) - makkar(TWIN_GAMMA, v))) < 0.01 * peak
         assert np.all(np.diff(pso.history) <= 0)
-        polished = nu.fit_makkar_pso(pts.speeds, pts.friction, rng=0, polish=True)
+        polished = fit_makkar_pso(pts.speeds, pts.friction, rng=0, polish=True)
         np.testing.assert_allclose(polished.gamma, TWIN_GAMMA, rtol=2e-4)
 
 
 def test_six_dimensional_swarm_as_the_doc_fits_the_curve(elbow_runs) -> None:
     _, _, pts = elbow_runs[2]
-    fit = nu.fit_makkar_pso(
-        pts.speeds, pts.friction, variable_projection=False, particles=60, rng=2
-    )
+    fit = fit_makkar_pso(pts.speeds, pts.friction, variable_projection=False, particles=60, rng=2)
     assert fit.r2 >= 0.99
     assert np.all(fit.gamma >= 0.0) and fit.gamma[1] >= fit.gamma[2]
 
 
 def test_makkar_fit_rejects_too_few_points() -> None:
     with pytest.raises(KinergyError, match="at least 6"):
-        nu.fit_makkar_lsq([0.1, 0.2], [1.0, 2.0])
+        fit_makkar_lsq([0.1, 0.2], [1.0, 2.0])
 
 
 # ---------------------------------------------------------------------------------------------
@@ -238,18 +251,18 @@ def test_cycle_averaging_cuts_noise_by_the_root_of_the_cycles() -> None:
     clean = np.column_stack([np.sin(2 * np.pi * t / period), np.cos(6 * np.pi * t / period)])
     sigma = 0.3
     noisy = clean + sigma * rng.standard_normal(clean.shape)
-    t1, avg = nu.cycle_average(t, noisy, period)
+    t1, avg = cycle_average(t, noisy, period)
     assert t1.shape == (200,) and avg.shape == (200, 2)
     residual = np.std(avg - clean[:200], axis=0)
     np.testing.assert_allclose(residual, sigma / np.sqrt(cycles), rtol=0.15)
     # 16 whole periods of samples without the closing sample: the same 16 cycles
-    np.testing.assert_array_equal(nu.cycle_average(t[:-1], noisy[:-1], period)[1], avg)
-    _, as_dict = nu.cycle_average(t, {"x": noisy}, period)
+    np.testing.assert_array_equal(cycle_average(t[:-1], noisy[:-1], period)[1], avg)
+    _, as_dict = cycle_average(t, {"x": noisy}, period)
     np.testing.assert_array_equal(as_dict["x"], avg)
     # a period that is not a whole number of samples: interpolated onto a grid that is
     odd_period = 2.005
     wave = np.sin(2 * np.pi * t / odd_period)
-    t2, avg2 = nu.cycle_average(t, wave, odd_period)
+    t2, avg2 = cycle_average(t, wave, odd_period)
     assert t2[-1] < odd_period
     np.testing.assert_allclose(avg2, np.sin(2 * np.pi * t2 / odd_period), atol=2e-3)
 
@@ -259,16 +272,16 @@ def test_find_period_of_a_fourier_excitation() -> None:
         [0.1, -0.2],
         [[0.2, 0.1, 0.0], [0.0, 0.3, 0.1]],
         [[0.1, 0.0, 0.2], [0.2, 0.0, 0.0]],
-        base_frequency=nu.BASE_FREQUENCY,
+        base_frequency=BASE_FREQUENCY,
         periods=3,
         dt=0.01,
     )
-    assert nu.find_period(m.t, m.q) == pytest.approx(10.0, abs=0.011)
-    assert nu.find_period(m.t[:700], m.q[:700]) is None  # fewer than two periods
+    assert find_period(m.t, m.q) == pytest.approx(10.0, abs=0.011)
+    assert find_period(m.t[:700], m.q[:700]) is None  # fewer than two periods
 
 
 def test_table6_fits_the_nursing_arm_and_is_scaled_for_tighter_limits(arm) -> None:
-    motion, scale, notes = nu.table6_motion(arm, periods=1, dt=0.01)
+    motion, scale, notes = table6_motion(arm, periods=1, dt=0.01)
     np.testing.assert_array_equal(scale, 1.0)
     assert notes == []
     assert motion.duration == pytest.approx(10.0)
@@ -279,7 +292,7 @@ def test_table6_fits_the_nursing_arm_and_is_scaled_for_tighter_limits(arm) -> No
             for j in arm.joints
         ]
     )
-    motion, scale, notes = nu.table6_motion(slow, periods=1, dt=0.01)
+    motion, scale, notes = table6_motion(slow, periods=1, dt=0.01)
     assert scale[0] < 1.0 and len(notes) >= 1 and "scaled" in notes[0]
     assert np.max(np.abs(motion.qd)) <= 0.25
 
@@ -293,7 +306,7 @@ def test_ridge_tends_to_least_squares_as_alpha_vanishes(arm) -> None:
     true = base.project(inertial_parameters(arm))
     y_b = base.regressor(regressor(arm, q, qd, qdd))
     tau = y_b @ true + 0.01 * rng.standard_normal((n, 6))
-    fit = nu.ridge_minimal(arm, q, qd, qdd, tau, alphas=[0.0], base=base)
+    fit = ridge_minimal(arm, q, qd, qdd, tau, alphas=[0.0], base=base)
     # the same regression by ordinary least squares with an intercept, on the training part
     x = y_b[: fit.split].reshape(-1, base.size)
     ols = np.linalg.lstsq(
@@ -302,23 +315,23 @@ def test_ridge_tends_to_least_squares_as_alpha_vanishes(arm) -> None:
     np.testing.assert_allclose(fit.coef, ols[:-1], rtol=1e-6, atol=1e-9)
     assert fit.intercept == pytest.approx(ols[-1], abs=1e-9)
     # exact data, no intercept: the model's base parameters
-    exact = nu.ridge_minimal(arm, q, qd, qdd, y_b @ true, alphas=[0.0], base=base, center=False)
+    exact = ridge_minimal(arm, q, qd, qdd, y_b @ true, alphas=[0.0], base=base, center=False)
     np.testing.assert_allclose(exact.coef, true, rtol=1e-6, atol=1e-9)
     # a strong ridge shrinks the standardised coefficients
-    strong = nu.ridge_minimal(arm, q, qd, qdd, tau, alphas=[10.0], base=base)
+    strong = ridge_minimal(arm, q, qd, qdd, tau, alphas=[10.0], base=base)
     assert np.linalg.norm(strong.coef * x.std(axis=0)) < np.linalg.norm(fit.coef * x.std(axis=0))
 
 
 def test_identify_nursing_on_a_noise_free_excitation(arm, tmp_path) -> None:
-    motion, _, _ = nu.table6_motion(arm, periods=2, dt=0.004)
+    motion, _, _ = table6_motion(arm, periods=2, dt=0.004)
     data = _twin_data(arm, motion, TwinSettings.exact(), "excitation")
     result = nu.identify_nursing(arm, [data])
     ridge = result.fit.ridge
     assert result.method == "nursing"
     assert len(result.fit.base_parameters) == 36  # the doc's Table 3
-    assert ridge["logs"][0]["period"] == pytest.approx(10.0, abs=0.005)
-    assert np.all(np.isfinite(ridge["rmse_test"]))
-    assert max(ridge["rmse_test"]) < 5e-3  # N m, on torques of 0.1-0.5 N m spread
+    assert ridge.logs[0].period == pytest.approx(10.0, abs=0.005)
+    assert np.all(np.isfinite(ridge.rmse_test))
+    assert max(ridge.rmse_test) < 5e-3  # N m, on torques of 0.1-0.5 N m spread
     assert max(m.rms for m in result.fit.current) < 1e-3  # A
     # no friction runs: the motors keep the model's friction, and say so
     assert any("no friction run" in w for w in result.warnings)
@@ -328,7 +341,7 @@ def test_identify_nursing_on_a_noise_free_excitation(arm, tmp_path) -> None:
 
 
 def test_identify_nursing_rejects_logs_without_current(arm) -> None:
-    motion, _, _ = nu.table6_motion(arm, periods=1, dt=0.01)
+    motion, _, _ = table6_motion(arm, periods=1, dt=0.01)
     twin = simulate(arm, motion, TwinSettings.exact())
     t, sig = twin.t, dict(twin.signals)
     sig.pop("actual_current")

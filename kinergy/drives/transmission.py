@@ -13,7 +13,9 @@ Power balance gives the torques: ``tau^T qd = tau_m^T wm`` for every ``qd``, so 
 For a UR arm (``coupling = I``) this is UR5e eq 2's ``wm = i qd``, ``tau = i tau_m``. The motor
 and reducer inertias (motor side) reflect to the joint side as ``N^T diag(J_m + J_r) N``: UR5e
 eq 2's ``i^2 (J_m + J_r)`` on the diagonal, and nursing eq 4's ``J11 = J1 + J2, J12 = J1 - J2,
-J22 = J1 + J2`` (motor-to-bevel-gear parts) for a differential joint.
+J22 = J1 + J2`` (motor-to-bevel-gear parts) for a differential joint. What is particular to
+differential joints (their internal dynamics, currents to torques, Makkar's friction on either
+side) is in :mod:`kinergy.drives.coupled`.
 """
 
 from __future__ import annotations
@@ -24,7 +26,6 @@ from numpy.typing import ArrayLike, NDArray
 from kinergy.model.robot import Robot
 
 __all__ = [
-    "coupled_joint_dynamics",
     "joint_torque",
     "motor_speed",
     "motor_torque",
@@ -71,46 +72,3 @@ def reflected_inertia(robot: Robot) -> Array:
     """
     n_mat = transmission_matrix(robot)
     return n_mat.T @ (rotor_inertia(robot)[:, None] * n_mat)
-
-
-def coupled_joint_dynamics(
-    q2: ArrayLike,
-    qdd: ArrayLike,
-    *,
-    j1: float,
-    j2: float,
-    j3: float,
-    jh: float,
-    m3: float,
-    r_h: float,
-    m_he: float,
-    r_he: float,
-    g: float = 9.81,
-) -> Array:
-    """Generalised forces of one differential joint on its own (nursing eqs 4-11).
-
-    ``Q = J qdd + G`` with ``J = [[J11, J12], [J12, J22]]``, ``J11 = J1 + J2 + J3``,
-    ``J12 = J1 - J2``, ``J22 = J1 + J2 + J_H + m3 r_H^2`` and ``G = [0, m_He g r_He sin q2]``.
-
-    Parameters
-    ----------
-    q2 : array_like, shape (N,)
-        Pitch angle, rad.
-    qdd : array_like, shape (N, 2)
-        ``[q1'', q2'']`` (rotation, pitch), rad/s^2.
-    j1, j2, j3, jh : float
-        Inertias of the two input branches, bevel gear 3 and the rod H, kg m^2 (nursing Table 2).
-    m3, r_h, m_he, r_he : float
-        Mass of bevel gear 3 (kg) and its radius about the rod axis (m); mass of the rotating
-        parts (kg) and the distance of their centroid (m).
-
-    Returns
-    -------
-    ndarray, shape (N, 2)
-        ``[Q1, Q2]``, N m.
-    """
-    j = np.array([[j1 + j2 + j3, j1 - j2], [j1 - j2, j1 + j2 + jh + m3 * r_h**2]])
-    qdd = np.asarray(qdd, dtype=float)
-    out = qdd @ j.T
-    out[..., 1] += m_he * g * r_he * np.sin(np.asarray(q2, dtype=float))
-    return out

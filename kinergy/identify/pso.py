@@ -74,6 +74,44 @@ class SwarmResult:
     nfev: int
 
 
+def _check_box(
+    lower: ArrayLike, upper: ArrayLike, particles: int, iterations: int
+) -> tuple[Array, Array]:
+    """The search box as arrays (d,), checked, and the swarm's size."""
+    lo = np.asarray(lower, dtype=float)
+    hi = np.asarray(upper, dtype=float)
+    if lo.ndim != 1 or lo.shape != hi.shape or not (np.all(np.isfinite(lo)) and np.all(hi > lo)):
+        raise KinergyError("particle swarm bounds: need finite lower < upper of equal shape (d,)")
+    if particles < 2 or iterations < 0:
+        raise KinergyError(f"particle swarm: need >= 2 particles, got {particles}")
+    return lo, hi
+
+
+def _evaluate(fun: Callable[[Array], ArrayLike], x: Array) -> Array:
+    """``fun(x)`` for the swarm ``x`` (P, d), shape (P,), non-finite values as +inf."""
+    f = np.asarray(fun(x), dtype=float).reshape(-1)
+    if f.shape != (x.shape[0],):
+        raise KinergyError(
+            f"particle swarm objective returned shape {f.shape}, expected ({x.shape[0]},)"
+        )
+    return np.where(np.isfinite(f), f, np.inf)
+
+
+def _step(
+    x: Array, v: Array, own: Array, social: Array, chi: float, lo: Array, hi: Array
+) -> tuple[Array, Array]:
+    """One move of the swarm (P, d): ``v <- chi (v + own + social)`` clamped to the box's width,
+    ``x <- x + v``; a particle leaving the box stops at its wall with that velocity set to 0."""
+    width = hi - lo
+    v = chi * (v + own + social)
+    v = np.clip(v, -width, width)
+    x = x + v
+    outside = (x < lo) | (x > hi)
+    x = np.clip(x, lo, hi)
+    v[outside] = 0.0
+    return x, v
+
+
 def particle_swarm(
     fun: Callable[[Array], ArrayLike],
     lower: ArrayLike,
@@ -115,43 +153,25 @@ def particle_swarm(
     >>> bool(res.fun < 1e-12)
     True
     """
-    lo = np.asarray(lower, dtype=float)
-    hi = np.asarray(upper, dtype=float)
-    if lo.ndim != 1 or lo.shape != hi.shape or not (np.all(np.isfinite(lo)) and np.all(hi > lo)):
-        raise KinergyError("particle swarm bounds: need finite lower < upper of equal shape (d,)")
-    if particles < 2 or iterations < 0:
-        raise KinergyError(f"particle swarm: need >= 2 particles, got {particles}")
+    lo, hi = _check_box(lower, upper, particles, iterations)
     chi = constriction(c1, c2)
     gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
     d = lo.size
     width = hi - lo
-
-    def evaluate(x: Array) -> Array:
-        f = np.asarray(fun(x), dtype=float).reshape(-1)
-        if f.shape != (x.shape[0],):
-            raise KinergyError(
-                f"particle swarm objective returned shape {f.shape}, expected ({x.shape[0]},)"
-            )
-        return np.where(np.isfinite(f), f, np.inf)
 
     x = lo + gen.random((particles, d)) * width
     if init is not None:
         seeds = np.clip(np.atleast_2d(np.asarray(init, dtype=float)), lo, hi)[:particles]
         x[: seeds.shape[0]] = seeds
     v = (gen.random((particles, d)) - 0.5) * width
-    f = evaluate(x)
+    f = _evaluate(fun, x)
     best_x, best_f = x.copy(), f.copy()
     g = int(np.argmin(best_f))
     history = [float(best_f[g])]
     for _ in range(iterations):
         r1, r2 = gen.random((particles, d)), gen.random((particles, d))
-        v = chi * (v + c1 * r1 * (best_x - x) + c2 * r2 * (best_x[g] - x))
-        v = np.clip(v, -width, width)
-        x = x + v
-        outside = (x < lo) | (x > hi)
-        x = np.clip(x, lo, hi)
-        v[outside] = 0.0
-        f = evaluate(x)
+        x, v = _step(x, v, c1 * r1 * (best_x - x), c2 * r2 * (best_x[g] - x), chi, lo, hi)
+        f = _evaluate(fun, x)
         better = f < best_f
         best_x[better], best_f[better] = x[better], f[better]
         g = int(np.argmin(best_f))
