@@ -25,7 +25,7 @@ Array = NDArray[np.float64]
 __all__ = ["regressor_kernel", "rnea_kernel"]
 
 
-@njit(cache=True, fastmath=True, inline="always")
+@njit(cache=True, fastmath=False, inline="always")
 def _cross(a: Array, b: Array, out: Array) -> None:
     x = a[1] * b[2] - a[2] * b[1]
     y = a[2] * b[0] - a[0] * b[2]
@@ -33,7 +33,7 @@ def _cross(a: Array, b: Array, out: Array) -> None:
     out[0], out[1], out[2] = x, y, z
 
 
-@njit(cache=True, fastmath=True, inline="always")
+@njit(cache=True, fastmath=False, inline="always")
 def _motion_pass(
     geo: tuple[Array, Array, Array, Array, Array, Array, Array, Array],
     g0: Array,
@@ -119,7 +119,7 @@ def _motion_pass(
             acl[i, r] = ac[r] + t1[r]
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True, fastmath=False)
 def _rnea_chunk(
     lo: int,
     hi: int,
@@ -235,7 +235,7 @@ def _rnea_chunk(
                     moment[i - 1, r] += t2[r] + iw[r]
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True, fastmath=False)
 def _regressor_chunk(
     lo: int,
     hi: int,
