@@ -19,7 +19,7 @@ from kinergy.errors import KinergyError
 from kinergy.io.task import load_task
 from kinergy.io.urscript import movej_program, write_script
 from kinergy.model import Drive, Friction, Joint, Limits, Link, Robot
-from kinergy.optimize.timing import (
+from kinergy.optimize import (
     limit_violations,
     optimize_timing,
     pareto_front,
