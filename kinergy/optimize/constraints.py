@@ -97,7 +97,7 @@ def limit_violations(
     motion : Motion
         Joint angles, speeds, accelerations, shape (N, n).
     state : DriveState
-        The drive model over ``motion`` (:func:`kinergy.drives.electrics.drive_state`); the joint
+        The drive model over ``motion`` (:func:`kinergy.predict.drive_state`); the joint
         torque is the motor torque reflected to the joint, ``N^T tau_m``
         (:func:`kinergy.drives.transmission.joint_torque`), friction included.
     speed_cap, acceleration_cap : float, optional
