@@ -18,7 +18,7 @@ import statistics
 import time
 
 import kinergy
-from kinergy.optimize.timing import optimize_timing, pareto_front, timing_problem
+from kinergy.optimize import optimize_timing, pareto_front, timing_problem
 from kinergy.trajectory.programs import paper_waypoints
 
 

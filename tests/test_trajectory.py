@@ -11,7 +11,13 @@ import pytest
 from kinergy.errors import KinergyError
 from kinergy.io.rtde import read_log
 from kinergy.trajectory.fourier import fourier_motion, fourier_series
-from kinergy.trajectory.movej import movej, plan_movej
+from kinergy.trajectory.movej import (
+    blend_starts,
+    movej,
+    plan_movej,
+    sample_moves,
+    trapezoid_timing,
+)
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared" / "datasets"
 MOVEJ_LOG = DATASETS / "ur3e-aurt" / "AllJoints_MoveJ_Target.csv"
@@ -85,6 +91,28 @@ def test_movej_per_move_speeds() -> None:
     way = np.array([[0.0], [1.0], [0.0]])
     plan = plan_movej(way, speed=[1.0, 0.5], acceleration=[2.0, 1.0])
     np.testing.assert_allclose(plan.duration, [1.0 + 0.5, 2.0 + 0.5])
+
+
+def test_movej_batched_over_programs_is_each_plan_on_its_own() -> None:
+    # the optimiser plans and samples many candidate programs in one call: row b of the batch
+    # must be exactly plan_movej/sample of row b's settings
+    rng = np.random.default_rng(7)
+    way = rng.uniform(-2.0, 2.0, (5, 3))
+    way[2] = way[1]  # a move that does not move
+    travel = np.max(np.abs(np.diff(way, axis=0)), axis=1)
+    blend = np.array([0.1, 0.0, 0.2, 0.0])
+    v = rng.uniform(0.3, 3.0, (6, 4))
+    a = rng.uniform(0.5, 10.0, (6, 4))
+    duration, ramp, peak = trapezoid_timing(travel, v, a)
+    start = blend_starts(travel, blend, duration, a, ramp)
+    t = np.sort(rng.uniform(0.0, 12.0, (6, 50)), axis=1)
+    q, qd, qdd = sample_moves(way, t, start, duration, ramp, peak, a)
+    for b in range(6):
+        plan = plan_movej(way, speed=v[b], acceleration=a[b], blend=blend)
+        assert np.array_equal(plan.start, start[b]) and np.array_equal(plan.duration, duration[b])
+        one = plan.sample(t[b])
+        for got, want in zip((q[b], qd[b], qdd[b]), one, strict=True):
+            assert np.array_equal(got, want)
 
 
 @pytest.mark.parametrize(

@@ -111,6 +111,34 @@ def _angles(value: Any, what: str, scale: float, n: int | None) -> Array:
     return np.array(out)
 
 
+def _move(
+    move: dict[str, Any],
+    where: str,
+    scale: float,
+    n: int | None,
+    defaults: tuple[float | None, float | None],
+) -> tuple[Array, float, float, float, float]:
+    """One ``[[move]]`` table: its target (rad) and ``v``, ``a`` (NaN: not given), ``r``,
+    ``ur_r``; ``defaults`` are the task's ``speed`` and ``acceleration``."""
+    extra = sorted(set(move) - _MOVE_KEYS)
+    if extra:
+        raise KinergyError(
+            f"{where}: unknown field {extra[0]!r} (known: {', '.join(sorted(_MOVE_KEYS))})"
+        )
+    if "q" not in move:
+        raise KinergyError(f"{where}.q: missing (the move's joint targets)")
+    q = _angles(move["q"], f"{where}.q", scale, n)
+    v = move.get("v", defaults[0])
+    a = move.get("a", defaults[1])
+    return (
+        q,
+        math.nan if v is None else _number(v, f"{where}.v", low=0.0, strict=True),
+        math.nan if a is None else _number(a, f"{where}.a", low=0.0, strict=True),
+        _number(move.get("r", 0.0), f"{where}.r", low=0.0, strict=False),
+        _number(move.get("ur_r", 0.0), f"{where}.ur_r", low=0.0, strict=False),
+    )
+
+
 def task_from_dict(
     data: dict[str, Any], *, name: str = "task", n_joints: int | None = None
 ) -> Task:
@@ -151,35 +179,22 @@ def task_from_dict(
         raise KinergyError("move: expected [[move]] tables")
     if not moves:
         raise KinergyError("no [[move]] entries: a task needs at least one move")
+    rows = []
     n = n_joints
-    targets, speeds, accels, blends, ur_blends = [], [], [], [], []
     for k, move in enumerate(moves):
-        where = f"move[{k + 1}]"
-        extra = sorted(set(move) - _MOVE_KEYS)
-        if extra:
-            raise KinergyError(
-                f"{where}: unknown field {extra[0]!r} (known: {', '.join(sorted(_MOVE_KEYS))})"
-            )
-        if "q" not in move:
-            raise KinergyError(f"{where}.q: missing (the move's joint targets)")
-        q = _angles(move["q"], f"{where}.q", scale, n)
-        n = q.size
-        targets.append(q)
-        v = move.get("v", speed)
-        a = move.get("a", acc)
-        speeds.append(math.nan if v is None else _number(v, f"{where}.v", low=0.0, strict=True))
-        accels.append(math.nan if a is None else _number(a, f"{where}.a", low=0.0, strict=True))
-        blends.append(_number(move.get("r", 0.0), f"{where}.r", low=0.0, strict=False))
-        ur_blends.append(_number(move.get("ur_r", 0.0), f"{where}.ur_r", low=0.0, strict=False))
+        rows.append(_move(move, f"move[{k + 1}]", scale, n, (speed, acc)))
+        n = rows[-1][0].size
+    targets = [row[0] for row in rows]
+    settings = np.array([row[1:] for row in rows])  # (K, 4): v, a, r, ur_r
     start = _angles(data["start"], "start", scale, n) if "start" in data else targets[-1].copy()
     return Task(
         name=str(data.get("name", name)),
         robot=robot,
         waypoints=np.vstack([start, *targets]),
-        speeds=np.array(speeds),
-        accels=np.array(accels),
-        blends=np.array(blends),
-        ur_blends=np.array(ur_blends),
+        speeds=settings[:, 0].copy(),
+        accels=settings[:, 1].copy(),
+        blends=settings[:, 2].copy(),
+        ur_blends=settings[:, 3].copy(),
     )
 
 

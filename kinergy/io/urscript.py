@@ -19,12 +19,15 @@ from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
+from kinergy.trajectory.movej import check_waypoints, per_move
 
-__all__ = ["movej_program", "write_script"]
+__all__ = ["SERVO_PERIOD", "movej_program", "servoj_program", "write_script"]
+
+Array = NDArray[np.float64]
 
 
 def _num(x: float) -> str:
@@ -50,6 +53,53 @@ def _name(name: str) -> str:
             "with a digit"
         )
     return name
+
+
+def _vector(q: ArrayLike) -> str:
+    """A joint vector, rad, in plain decimals: ``[q0, q1, ...]``."""
+    return "[" + ", ".join(_decimal(x) for x in np.asarray(q, dtype=float)) + "]"
+
+
+def _program(name: str, header: Sequence[str], body: Sequence[str]) -> str:
+    """``def name():``, the header as comments (one per line of each entry), the body lines
+    (indented), ``end``; newline-terminated."""
+    lines = [f"def {_name(name)}():"]
+    lines.extend(f"  # {line}" for text in header for line in str(text).splitlines())
+    lines.extend(f"  {line}" for line in body)
+    lines.append("end")
+    return "\n".join(lines) + "\n"
+
+
+def _move_settings(speeds: ArrayLike, accels: ArrayLike, blends: ArrayLike, moves: int) -> Array:
+    """Each move's ``v``, ``a`` (> 0) and ``r`` (>= 0) as rows, shape (3, K)."""
+    rows = []
+    for key, value, positive in (("v", speeds, True), ("a", accels, True), ("r", blends, False)):
+        arr = per_move(value, moves, key)
+        bad = ~np.isfinite(arr) | ((arr <= 0.0) if positive else (arr < 0.0))
+        if np.any(bad):
+            k = int(np.argmax(bad))
+            raise KinergyError(
+                f"{key} of move {k + 1}: must be {'> 0' if positive else '>= 0'}, got {arr[k]}"
+            )
+        rows.append(arr)
+    return np.array(rows)
+
+
+def _movej_header(
+    blended: bool, cycle_time: float | None, energy: float | None, comments: Sequence[str]
+) -> list[str]:
+    header = ["written by kinergy: a movej program, joint angles in rad"]
+    if cycle_time is not None:
+        header.append(f"predicted cycle time: {cycle_time:.3f} s")
+    if energy is not None:
+        header.append(f"predicted electrical energy per cycle: {energy:.1f} J")
+    header.append(
+        "r is UR's blend radius at the tool (m), as the task gives it"
+        if blended
+        else "r is UR's blend radius at the tool (m); kinergy's joint-space blends are not "
+        "written (r=0: each move stops at its target)"
+    )
+    return header + [str(c) for c in comments]
 
 
 def movej_program(
@@ -94,57 +144,18 @@ def movej_program(
     >>> text.splitlines()[-2].strip()
     'movej([0.5, 0, 0, 0, 0, 0], a=2, v=1, r=0)'
     """
-    w = np.asarray(waypoints, dtype=float)
-    if w.ndim != 2 or w.shape[0] < 2:
-        raise KinergyError(f"waypoints: expected shape (K + 1, n) with K >= 1, got {w.shape}")
-    if not np.all(np.isfinite(w)):
-        raise KinergyError("waypoints: not finite")
+    w = check_waypoints(waypoints)
     moves = w.shape[0] - 1
-    settings = {}
-    for key, value, positive in (
-        ("v", speeds, True),
-        ("a", accels, True),
-        ("r", 0.0 if blends is None else blends, False),
-    ):
-        arr = np.asarray(value, dtype=float)
-        arr = np.full(moves, float(arr)) if arr.ndim == 0 else arr
-        if arr.shape != (moves,):
-            raise KinergyError(f"{key}: expected one value or {moves}, got shape {arr.shape}")
-        bad = ~np.isfinite(arr) | ((arr <= 0.0) if positive else (arr < 0.0))
-        if np.any(bad):
-            k = int(np.argmax(bad))
-            raise KinergyError(
-                f"{key} of move {k + 1}: must be {'> 0' if positive else '>= 0'}, got {arr[k]}"
-            )
-        settings[key] = arr
-    lines = [f"def {_name(name)}():"]
-    header = ["written by kinergy: a movej program, joint angles in rad"]
-    if cycle_time is not None:
-        header.append(f"predicted cycle time: {cycle_time:.3f} s")
-    if energy is not None:
-        header.append(f"predicted electrical energy per cycle: {energy:.1f} J")
-    header.append(
-        "r is UR's blend radius at the tool (m); kinergy's joint-space blends are not written "
-        "(r=0: each move stops at its target)"
-        if blends is None
-        else "r is UR's blend radius at the tool (m), as the task gives it"
-    )
-    header.extend(str(c) for c in comments)
-    lines.extend(f"  # {line}" for text in header for line in text.splitlines())
-
-    def vec(q: Any) -> str:
-        return "[" + ", ".join(_decimal(x) for x in q) + "]"
-
-    lines.append("  # the start pose (not part of the cycle)")
-    lines.append(f"  movej({vec(w[0])}, a=1.4, v=1.05)")
+    v, a, r = _move_settings(speeds, accels, 0.0 if blends is None else blends, moves)
+    body = ["# the start pose (not part of the cycle)", f"movej({_vector(w[0])}, a=1.4, v=1.05)"]
     for k in range(moves):
-        lines.append(f"  # move {k + 1}")
-        lines.append(
-            f"  movej({vec(w[k + 1])}, a={_decimal(settings['a'][k])}, "
-            f"v={_decimal(settings['v'][k])}, r={_decimal(settings['r'][k])})"
+        body.append(f"# move {k + 1}")
+        body.append(
+            f"movej({_vector(w[k + 1])}, a={_decimal(a[k])}, v={_decimal(v[k])}, "
+            f"r={_decimal(r[k])})"
         )
-    lines.append("end")
-    return "\n".join(lines) + "\n"
+    header = _movej_header(blends is not None, cycle_time, energy, comments)
+    return _program(name, header, body)
 
 
 def write_script(path: str | os.PathLike[str], text: str) -> Path:
@@ -165,16 +176,48 @@ def write_script(path: str | os.PathLike[str], text: str) -> Path:
 # ---------------------------------------------------------------------------------------------
 # servoj: a sampled trajectory streamed at the controller's rate
 
-__all__ += ["servoj_program"]
-
 #: the controller's cycle, s (e-Series: 500 Hz)
 SERVO_PERIOD = 0.002
 
 
-def _fixed(x: float) -> str:
-    """A joint angle (rad) in plain decimal notation, 1e-9 rad resolution (no exponent)."""
-    text = f"{float(x):.9f}".rstrip("0").rstrip(".")
-    return "0" if text in ("", "-0") else text
+def _servo_steps(t: ArrayLike, q: ArrayLike) -> tuple[Array, Array, float]:
+    """The sample times (N,), joint angles (N, 6) and their uniform step, s (at least the
+    controller's cycle)."""
+    times = np.asarray(t, dtype=float)
+    angles = np.asarray(q, dtype=float)
+    if times.ndim != 1 or times.size < 2:
+        raise KinergyError(f"t: expected shape (N,) with N >= 2, got {times.shape}")
+    if angles.shape != (times.size, 6):
+        raise KinergyError(
+            f"q: expected shape ({times.size}, 6) (URScript joint vectors have 6 entries), "
+            f"got {angles.shape}"
+        )
+    if not (np.all(np.isfinite(times)) and np.all(np.isfinite(angles))):
+        raise KinergyError("t and q must be finite")
+    steps = np.diff(times)
+    dt = float(np.mean(steps))
+    if np.any(np.abs(steps - dt) > 1e-6):
+        k = int(np.argmax(np.abs(steps - dt)))
+        raise KinergyError(
+            f"t: servoj needs uniform steps; step {k + 1} is {steps[k]:.6g} s, the mean {dt:.6g} s"
+        )
+    if dt < SERVO_PERIOD - 1e-9:
+        raise KinergyError(
+            f"t: steps of {dt:.6g} s are shorter than the controller's cycle ({SERVO_PERIOD} s)"
+        )
+    return times, angles, dt
+
+
+def _check_servo(
+    start_speed: float, start_acceleration: float, lookahead_time: float, gain: float
+) -> None:
+    for label, value in (("start_speed", start_speed), ("start_acceleration", start_acceleration)):
+        if not (np.isfinite(value) and value > 0.0):
+            raise KinergyError(f"{label}: must be > 0, got {value}")
+    if not 0.03 <= lookahead_time <= 0.2:
+        raise KinergyError(f"lookahead_time: must be in [0.03, 0.2] s, got {lookahead_time}")
+    if not 100.0 <= gain <= 2000.0:
+        raise KinergyError(f"gain: must be in [100, 2000], got {gain}")
 
 
 def servoj_program(
@@ -236,39 +279,8 @@ def servoj_program(
     >>> text.splitlines()[-3].strip()
     'servoj([0.001, 0, 0, 0, 0, 0], 0, 0, 0.002, 0.1, 300)'
     """
-    times = np.asarray(t, dtype=float)
-    angles = np.asarray(q, dtype=float)
-    if times.ndim != 1 or times.size < 2:
-        raise KinergyError(f"t: expected shape (N,) with N >= 2, got {times.shape}")
-    if angles.shape != (times.size, 6):
-        raise KinergyError(
-            f"q: expected shape ({times.size}, 6) (URScript joint vectors have 6 entries), "
-            f"got {angles.shape}"
-        )
-    if not (np.all(np.isfinite(times)) and np.all(np.isfinite(angles))):
-        raise KinergyError("t and q must be finite")
-    steps = np.diff(times)
-    dt = float(np.mean(steps))
-    if np.any(np.abs(steps - dt) > 1e-6):
-        k = int(np.argmax(np.abs(steps - dt)))
-        raise KinergyError(
-            f"t: servoj needs uniform steps; step {k + 1} is {steps[k]:.6g} s, the mean {dt:.6g} s"
-        )
-    if dt < SERVO_PERIOD - 1e-9:
-        raise KinergyError(
-            f"t: steps of {dt:.6g} s are shorter than the controller's cycle ({SERVO_PERIOD} s)"
-        )
-    for label, value in (("start_speed", start_speed), ("start_acceleration", start_acceleration)):
-        if not (np.isfinite(value) and value > 0.0):
-            raise KinergyError(f"{label}: must be > 0, got {value}")
-    if not 0.03 <= lookahead_time <= 0.2:
-        raise KinergyError(f"lookahead_time: must be in [0.03, 0.2] s, got {lookahead_time}")
-    if not 100.0 <= gain <= 2000.0:
-        raise KinergyError(f"gain: must be in [100, 2000], got {gain}")
-
-    def vec(row: Any) -> str:
-        return "[" + ", ".join(_fixed(x) for x in row) + "]"
-
+    times, angles, dt = _servo_steps(t, q)
+    _check_servo(start_speed, start_acceleration, lookahead_time, gain)
     tail = f", 0, 0, {_num(dt)}, {_num(lookahead_time)}, {_num(gain)})"
     header = [
         "written by kinergy: a servoj program, joint angles in rad",
@@ -276,12 +288,11 @@ def servoj_program(
         "servoj(q, a, v, t, lookahead_time, gain): a and v are unused by the controller",
         *(str(c) for c in comments),
     ]
-    lines = [f"def {_name(name)}():"]
-    lines.extend(f"  # {line}" for text in header for line in text.splitlines())
-    lines.append("  # the start pose (not part of the timed motion)")
-    lines.append(f"  movej({vec(angles[0])}, a={_num(start_acceleration)}, v={_num(start_speed)})")
-    lines.append("  # the motion: sample k at time k * t")
-    lines.extend(f"  servoj({vec(row)}{tail}" for row in angles)
-    lines.append(f"  stopj({_num(start_acceleration)})")
-    lines.append("end")
-    return "\n".join(lines) + "\n"
+    body = [
+        "# the start pose (not part of the timed motion)",
+        f"movej({_vector(angles[0])}, a={_num(start_acceleration)}, v={_num(start_speed)})",
+        "# the motion: sample k at time k * t",
+        *(f"servoj({_vector(row)}{tail}" for row in angles),
+        f"stopj({_num(start_acceleration)})",
+    ]
+    return _program(name, header, body)

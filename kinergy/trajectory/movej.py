@@ -14,6 +14,12 @@ current one has stopped, when the current move's leading joint is within ``r`` o
 the two profiles are added, so position and speed stay continuous. The overlap is capped at the
 current move's deceleration and the next move's acceleration phase, so speeds never exceed the
 larger of the two moves' speeds.
+
+This module is the one place that plans the profile. Its building blocks broadcast over leading
+axes, so the optimiser (:mod:`kinergy.optimize`) plans and samples many candidate programs in
+one call: :func:`trapezoid_timing` (a move's duration, ramp and peak speed), :func:`blend_starts`
+(when each move starts), :func:`trapezoid` (one profile at given times) and
+:func:`sample_moves` (the joint motion of whole programs).
 """
 
 from __future__ import annotations
@@ -26,7 +32,17 @@ from numpy.typing import ArrayLike, NDArray
 from kinergy.errors import KinergyError
 from kinergy.trajectory.motion import Motion
 
-__all__ = ["MovejPlan", "movej", "plan_movej"]
+__all__ = [
+    "MovejPlan",
+    "blend_starts",
+    "check_waypoints",
+    "movej",
+    "per_move",
+    "plan_movej",
+    "sample_moves",
+    "trapezoid",
+    "trapezoid_timing",
+]
 
 Array = NDArray[np.float64]
 
@@ -71,56 +87,192 @@ class MovejPlan:
         Returns three arrays of shape (len(t), n).
         """
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        w = self.waypoints
-        q = np.broadcast_to(w[0], (t.size, w.shape[1])).copy()
-        qd = np.zeros_like(q)
-        qdd = np.zeros_like(q)
-        for k in range(self.start.size):
-            delta = w[k + 1] - w[k]
-            travel = float(np.max(np.abs(delta)))
-            if travel == 0.0:
-                continue
-            s, sd, sdd = _trapezoid(
-                t - self.start[k],
-                self.duration[k],
-                self.ramp[k],
-                self.peak[k],
-                self.acceleration[k],
-            )
-            scale = delta / travel
-            q += s[:, None] * scale
-            qd += sd[:, None] * scale
-            qdd += sdd[:, None] * scale
-        return q, qd, qdd
+        q, qd, qdd = sample_moves(
+            self.waypoints,
+            t[None, :],
+            self.start[None, :],
+            self.duration[None, :],
+            self.ramp[None, :],
+            self.peak[None, :],
+            self.acceleration[None, :],
+        )
+        return q[0], qd[0], qdd[0]
 
 
-def _trapezoid(
-    tau: Array, duration: float, ramp: float, peak: float, acc: float
+def trapezoid(
+    tau: ArrayLike, duration: ArrayLike, ramp: ArrayLike, peak: ArrayLike, acc: ArrayLike
 ) -> tuple[Array, Array, Array]:
-    """Distance, speed and acceleration of a trapezoidal profile at local times ``tau``."""
+    """Distance, speed and acceleration of trapezoidal profiles at local times ``tau``.
+
+    Parameters
+    ----------
+    tau : array_like
+        Time since the move's start, s; clipped to ``[0, duration]`` (at rest before and after).
+    duration, ramp, peak, acc : array_like
+        The profile (:func:`trapezoid_timing`): s, s, rad/s, rad/s^2; broadcast against ``tau``.
+
+    Returns
+    -------
+    s, sd, sdd : ndarray
+        rad, rad/s, rad/s^2 of the leading joint, the broadcast shape.
+    """
+    duration = np.asarray(duration, dtype=float)
+    ramp = np.asarray(ramp, dtype=float)
+    peak = np.asarray(peak, dtype=float)
+    acc = np.asarray(acc, dtype=float)
     tau = np.clip(tau, 0.0, duration)
-    s = np.empty_like(tau)
-    sd = np.empty_like(tau)
-    sdd = np.zeros_like(tau)
     up = tau < ramp
     down = tau > duration - ramp
-    mid = ~(up | down)
-    s[up] = 0.5 * acc * tau[up] ** 2
-    sd[up] = acc * tau[up]
-    sdd[up] = acc
-    s[mid] = 0.5 * acc * ramp**2 + peak * (tau[mid] - ramp)
-    sd[mid] = peak
-    rest = duration - tau[down]
-    travel = peak * (duration - ramp)
-    s[down] = travel - 0.5 * acc * rest**2
-    sd[down] = acc * rest
-    sdd[down] = -acc
-    # at rest before the start and after the end
-    sdd[(tau <= 0.0) | (tau >= duration)] = 0.0
+    rest = duration - tau
+    s = np.where(
+        up,
+        0.5 * acc * tau**2,
+        np.where(
+            down,
+            peak * (duration - ramp) - 0.5 * acc * rest**2,
+            0.5 * acc * ramp**2 + peak * (tau - ramp),
+        ),
+    )
+    sd = np.where(up, acc * tau, np.where(down, acc * rest, peak))
+    sdd = np.where(up, acc, np.where(down, -acc, 0.0))
+    sdd = np.where((tau <= 0.0) | (tau >= duration), 0.0, sdd)
     return s, sd, sdd
 
 
-def _per_move(value: ArrayLike, moves: int, name: str) -> Array:
+def trapezoid_timing(
+    travel: ArrayLike, speed: ArrayLike, acceleration: ArrayLike
+) -> tuple[Array, Array, Array]:
+    """Duration, ramp time and peak speed of moves of leading-joint ``travel`` at URScript's
+    ``v`` and ``a`` (broadcast): a trapezoid, or a triangle when ``D < v^2 / a``.
+
+    Parameters
+    ----------
+    travel : array_like
+        Leading-joint travel ``D``, rad; a move of zero travel lasts 0 s.
+    speed, acceleration : array_like
+        ``v`` (rad/s) and ``a`` (rad/s^2).
+
+    Returns
+    -------
+    duration, ramp, peak : ndarray
+        ``D / v + v / a`` (trapezoid) or ``2 sqrt(D / a)`` (triangle), s; ``peak / a``, s;
+        ``v`` or ``sqrt(a D)``, rad/s.
+    """
+    travel = np.asarray(travel, dtype=float)
+    v = np.asarray(speed, dtype=float)
+    a = np.asarray(acceleration, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        triangle = travel < v**2 / a
+        peak = np.where(triangle, np.sqrt(a * travel), v)
+        ramp = peak / a
+        duration = np.where(travel > 0.0, np.where(triangle, 2.0 * ramp, travel / v + v / a), 0.0)
+    return duration, ramp, peak
+
+
+def blend_starts(
+    travel: Array, blend: Array, duration: Array, acceleration: Array, ramp: Array
+) -> Array:
+    """Start time of every move (s) under kinergy's blending rule (see the module docstring).
+
+    Parameters
+    ----------
+    travel, blend : ndarray, shape (K,)
+        Leading-joint travel and blend radius of each move, rad.
+    duration, acceleration, ramp : ndarray, shape (..., K)
+        Each move's profile (:func:`trapezoid_timing`), s, rad/s^2, s; leading axes are
+        independent programs.
+
+    Returns
+    -------
+    ndarray, shape (..., K)
+        The next move starts when the current one's leading joint is within ``r`` of its target,
+        at most the shorter of the two ramps before the current move's end.
+    """
+    start = np.zeros_like(duration)
+    for k in range(1, duration.shape[-1]):
+        overlap = np.zeros(duration.shape[:-1])
+        if blend[k - 1] > 0.0 and travel[k - 1] > 0.0 and travel[k] > 0.0:
+            overlap = np.minimum(
+                np.minimum(
+                    np.sqrt(2.0 * blend[k - 1] / acceleration[..., k - 1]), ramp[..., k - 1]
+                ),
+                ramp[..., k],
+            )
+        start[..., k] = start[..., k - 1] + duration[..., k - 1] - overlap
+    return start
+
+
+def sample_moves(
+    waypoints: Array,
+    t: Array,
+    start: Array,
+    duration: Array,
+    ramp: Array,
+    peak: Array,
+    acceleration: Array,
+) -> tuple[Array, Array, Array]:
+    """Joint motion of B movej programs through the same waypoints, each at its own times.
+
+    Parameters
+    ----------
+    waypoints : ndarray, shape (K + 1, n)
+        rad.
+    t : ndarray, shape (B, M)
+        Sample times of each program, s from its start.
+    start, duration, ramp, peak, acceleration : ndarray, shape (B, K)
+        Each program's moves (:func:`trapezoid_timing`, :func:`blend_starts`).
+
+    Returns
+    -------
+    q, qd, qdd : ndarray, shape (B, M, n)
+        rad, rad/s, rad/s^2: the sum of every move's profile along its direction.
+    """
+    delta = np.diff(waypoints, axis=0)
+    travel = np.max(np.abs(delta), axis=1)
+    q = np.broadcast_to(waypoints[0], (*t.shape, waypoints.shape[1])).copy()
+    qd = np.zeros_like(q)
+    qdd = np.zeros_like(q)
+    for k in range(travel.size):
+        if travel[k] == 0.0:
+            continue
+        s, sd, sdd = trapezoid(
+            t - start[:, k : k + 1],
+            duration[:, k : k + 1],
+            ramp[:, k : k + 1],
+            peak[:, k : k + 1],
+            acceleration[:, k : k + 1],
+        )
+        unit = delta[k] / travel[k]
+        q += s[..., None] * unit
+        qd += sd[..., None] * unit
+        qdd += sdd[..., None] * unit
+    return q, qd, qdd
+
+
+def check_waypoints(waypoints: ArrayLike) -> Array:
+    """``waypoints`` as a finite float array of shape (K + 1, n) with K >= 1, rad.
+
+    Raises
+    ------
+    KinergyError
+        Another shape, or values that are not finite.
+    """
+    w = np.asarray(waypoints, dtype=float)
+    if w.ndim != 2 or w.shape[0] < 2:
+        raise KinergyError(f"waypoints: expected shape (K + 1, n) with K >= 1, got {w.shape}")
+    if not np.all(np.isfinite(w)):
+        raise KinergyError("waypoints: not finite")
+    return w
+
+
+def per_move(value: ArrayLike, moves: int, name: str) -> Array:
+    """One setting per move: a scalar repeated ``moves`` times or an array of shape (K,).
+
+    Raises
+    ------
+    KinergyError
+        Any other shape.
+    """
     arr = np.asarray(value, dtype=float)
     if arr.ndim == 0:
         arr = np.full(moves, float(arr))
@@ -128,6 +280,12 @@ def _per_move(value: ArrayLike, moves: int, name: str) -> Array:
         raise KinergyError(
             f"{name}: expected one value or {moves} (one per move), got shape {arr.shape}"
         )
+    return arr
+
+
+def _setting(value: ArrayLike, moves: int, name: str) -> Array:
+    """A per-move setting of the planner: finite, > 0 (``blend``: >= 0)."""
+    arr = per_move(value, moves, name)
     if name == "blend":
         if np.any(arr < 0.0) or not np.all(np.isfinite(arr)):
             raise KinergyError(f"blend: must be finite and >= 0, got {arr.tolist()}")
@@ -159,27 +317,14 @@ def plan_movej(
     -------
     MovejPlan
     """
-    w = np.asarray(waypoints, dtype=float)
-    if w.ndim != 2 or w.shape[0] < 2:
-        raise KinergyError(f"waypoints: expected shape (K + 1, n) with K >= 1, got {w.shape}")
-    if not np.all(np.isfinite(w)):
-        raise KinergyError("waypoints: not finite")
+    w = check_waypoints(waypoints)
     moves = w.shape[0] - 1
-    v = _per_move(speed, moves, "speed")
-    a = _per_move(acceleration, moves, "acceleration")
-    r = _per_move(blend, moves, "blend")
+    v = _setting(speed, moves, "speed")
+    a = _setting(acceleration, moves, "acceleration")
+    r = _setting(blend, moves, "blend")
     travel = np.max(np.abs(np.diff(w, axis=0)), axis=1)
-    triangle = travel < v**2 / a
-    peak = np.where(triangle, np.sqrt(a * travel), v)
-    ramp = peak / a
-    duration = np.where(travel > 0.0, np.where(triangle, 2.0 * ramp, travel / v + v / a), 0.0)
-    start = np.zeros(moves)
-    for k in range(1, moves):
-        overlap = 0.0
-        if r[k - 1] > 0.0 and travel[k - 1] > 0.0 and travel[k] > 0.0:
-            # time before the end at which the leading joint is r from the waypoint (deceleration)
-            overlap = min(np.sqrt(2.0 * r[k - 1] / a[k - 1]), ramp[k - 1], ramp[k])
-        start[k] = start[k - 1] + duration[k - 1] - overlap
+    duration, ramp, peak = trapezoid_timing(travel, v, a)
+    start = blend_starts(travel, r, duration, a, ramp)
     return MovejPlan(w, start, duration, ramp, peak, a)
 
 

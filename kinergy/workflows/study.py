@@ -16,7 +16,7 @@ from kinergy.identify.result import IdentificationResult, predict
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.task import Task
 from kinergy.model.robot import Robot
-from kinergy.optimize.timing import optimize_timing, pareto_front, timing_problem
+from kinergy.optimize import optimize_timing, pareto_front, timing_problem
 from kinergy.report.html import Table, write_report
 from kinergy.report.study import Comparison, Study, Timing, study_sections
 from kinergy.trajectory.motion import Motion
