@@ -7,7 +7,6 @@ import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
 
 from kinergy.energy.accounting import energy
 from kinergy.identify.metrics import fit_metrics
@@ -16,11 +15,11 @@ from kinergy.identify.result import IdentificationResult, predict
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.task import Task
 from kinergy.model.robot import Robot
-from kinergy.optimize import optimize_timing, pareto_front, timing_problem
 from kinergy.report.html import Table, write_report
 from kinergy.report.study import Comparison, Study, Timing, study_sections
 from kinergy.trajectory.motion import Motion
 from kinergy.workflows.logs import prepared_logs, read_motion
+from kinergy.workflows.optimize import optimize_task
 
 __all__ = ["optimal_timing", "run_study", "study_report", "write_study"]
 
@@ -47,15 +46,7 @@ def _comparisons(
 
 def optimal_timing(model: Robot, task: Task, *, points: int = 6) -> Timing:
     """The energy-optimal timing of ``task`` at its own cycle time and the Pareto front."""
-    problem = timing_problem(model, task.waypoints, blends=task.blends)
-    common: dict[str, Any] = {
-        "speeds": task.speeds,
-        "accels": task.accels,
-        "blends": task.blends,
-        "problem": problem,
-    }
-    result = optimize_timing(model, task.waypoints, **common)
-    front = pareto_front(model, task.waypoints, points=points, **common)
+    result, front = optimize_task(model, task, points=points)
     return Timing(task.name, result, front)
 
 
