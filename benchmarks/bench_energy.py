@@ -1,7 +1,7 @@
 """Time the energy accounting of a 30 s, 500 Hz motion on the UR5e (issue bar: under 50 ms).
 
 The motion is a Fourier-series excitation (nursing eq 22) of 30 s sampled at 500 Hz (15,001
-samples) on all six joints; ``kinergy.energy.accounting.energy`` runs the whole drive model on it
+samples) on all six joints; ``kinergy.accounting.energy.energy`` runs the whole drive model on it
 (RNEA, reflected rotor inertia, power-flow friction, currents, voltages, eq 23 power) and integrates
 per joint with the four-way breakdown. Warm-up first (numba kernels), then min and median of
 ``--repeats`` runs.
@@ -18,7 +18,7 @@ import time
 import numpy as np
 
 import kinergy
-from kinergy.energy.accounting import energy
+from kinergy.accounting.energy import energy
 from kinergy.trajectory.fourier import fourier_motion
 
 

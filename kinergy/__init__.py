@@ -8,29 +8,43 @@ The public API at the top level::
     Y @ kinergy.inertial_parameters(robot)          # == tau
     motion = kinergy.movej(waypoints, speed=3.0, acceleration=6.0, dt=0.002)
     kinergy.energy(robot, motion).total_e_elec      # J
+
+Names are imported on first use, so ``import kinergy`` stays quick and a command loads only what
+it needs.
 """
 
-from kinergy.dynamics import (
-    BaseParameters,
-    base_parameters,
-    flange_pose,
-    forward_dynamics,
-    gravity_torque,
-    inertial_parameters,
-    jacobian,
-    link_poses,
-    mass_matrix,
-    parameter_names,
-    regressor,
-    rnea,
-)
-from kinergy.energy.accounting import EnergyReport, energy
-from kinergy.errors import KinergyError
-from kinergy.model import Payload, Robot, library_names, load_robot, save_robot
-from kinergy.trajectory.motion import Motion
-from kinergy.trajectory.movej import movej
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
+
+#: public name -> module that defines it
+_API = {
+    "BaseParameters": "kinergy.dynamics.regressor",
+    "base_parameters": "kinergy.dynamics.regressor",
+    "inertial_parameters": "kinergy.dynamics.regressor",
+    "parameter_names": "kinergy.dynamics.regressor",
+    "regressor": "kinergy.dynamics.regressor",
+    "flange_pose": "kinergy.dynamics.kinematics",
+    "jacobian": "kinergy.dynamics.kinematics",
+    "link_poses": "kinergy.dynamics.kinematics",
+    "forward_dynamics": "kinergy.dynamics.rnea",
+    "gravity_torque": "kinergy.dynamics.rnea",
+    "mass_matrix": "kinergy.dynamics.rnea",
+    "rnea": "kinergy.dynamics.rnea",
+    "EnergyReport": "kinergy.accounting.energy",
+    "energy": "kinergy.accounting.energy",
+    "KinergyError": "kinergy.errors",
+    "Payload": "kinergy.model.robot",
+    "Robot": "kinergy.model.robot",
+    "library_names": "kinergy.model.library",
+    "load_robot": "kinergy.model.library",
+    "save_robot": "kinergy.model.toml",
+    "Motion": "kinergy.trajectory.motion",
+    "movej": "kinergy.trajectory.movej",
+}
 
 __all__ = [
     "BaseParameters",
@@ -57,3 +71,35 @@ __all__ = [
     "rnea",
     "save_robot",
 ]
+
+if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
+    from kinergy.accounting.energy import EnergyReport, energy
+    from kinergy.dynamics.kinematics import flange_pose, jacobian, link_poses
+    from kinergy.dynamics.regressor import (
+        BaseParameters,
+        base_parameters,
+        inertial_parameters,
+        parameter_names,
+        regressor,
+    )
+    from kinergy.dynamics.rnea import forward_dynamics, gravity_torque, mass_matrix, rnea
+    from kinergy.errors import KinergyError
+    from kinergy.model.library import library_names, load_robot
+    from kinergy.model.robot import Payload, Robot
+    from kinergy.model.toml import save_robot
+    from kinergy.trajectory.motion import Motion
+    from kinergy.trajectory.movej import movej
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name's module on first use (PEP 562)."""
+    module = _API.get(name)
+    if module is None:
+        raise AttributeError(f"module 'kinergy' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

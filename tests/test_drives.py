@@ -14,6 +14,7 @@ import pytest
 from conftest import random_state
 
 import kinergy
+from kinergy.accounting.energy import energy
 from kinergy.drives.coupled import coupled_joint_dynamics
 from kinergy.drives.electrics import electrical_power
 from kinergy.drives.transmission import (
@@ -22,7 +23,6 @@ from kinergy.drives.transmission import (
     motor_torque,
     reflected_inertia,
 )
-from kinergy.energy.accounting import energy
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import MODELS, friction_torque
 from kinergy.model import Drive, Friction, Joint, Limits, Link, Robot

@@ -49,7 +49,7 @@ def test_the_package_keeps_its_layers(copy: Path) -> None:
 @pytest.mark.parametrize(
     ("module", "upward"),
     [
-        ("kinergy/dynamics/rnea.py", "kinergy.energy.accounting"),  # dynamics -> energy
+        ("kinergy/dynamics/rnea.py", "kinergy.accounting.energy"),  # dynamics -> energy
         ("kinergy/model/robot.py", "kinergy.cli.app"),  # model -> cli
         ("kinergy/report/html.py", "kinergy.workflows.demo"),  # report -> workflows
     ],

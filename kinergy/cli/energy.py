@@ -6,8 +6,8 @@ from typing import Any
 
 import click
 
+from kinergy.accounting.energy import energy as account
 from kinergy.cli.common import columns_option, load, payload_option, table
-from kinergy.energy.accounting import energy as account
 from kinergy.jsonable import dumps
 from kinergy.workflows.logs import read_motion
 

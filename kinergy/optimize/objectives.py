@@ -15,7 +15,7 @@ and of order one to a few thousand in its unit (the solver scales it by its valu
 on the DC bus: ``int sum_j W_elec,j dt`` with ``W_elec = tau_m^2 / k_m^2 + (k_b/k_t) wm tau_m``
 (:func:`kinergy.predict.drive_state`), braking energy returned to the bus (signed, as the seed)
 or, without recovery, the summed bus power clipped at 0 (the supply takes nothing back), as
-:func:`kinergy.energy.accounting.energy` counts the total.
+:func:`kinergy.accounting.energy.energy` counts the total.
 """
 
 from __future__ import annotations

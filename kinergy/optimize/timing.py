@@ -6,7 +6,7 @@ how fast each move runs: URScript's ``movej(q, a=..., v=...)`` per move. For a c
 moves) that minimise the electrical energy the model predicts (UR5e eq 26, summed over the
 motors), within the joints' speed, acceleration, torque and position limits, and verifies every
 result by re-simulating the movej at the controller's 500 Hz with
-:func:`kinergy.energy.accounting.energy` and :func:`limit_violations`.
+:func:`kinergy.accounting.energy.energy` and :func:`limit_violations`.
 
 Physics: what the timing can and cannot change
 ----------------------------------------------

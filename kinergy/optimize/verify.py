@@ -2,7 +2,7 @@
 
 Every program the optimiser compares (as written, uniformly scaled, optimised) is re-simulated
 with :func:`kinergy.trajectory.movej.movej` every :data:`VERIFY_DT` and accounted with
-:func:`kinergy.energy.accounting.energy` (the one forward path, UR5e eqs 23-26): the energy
+:func:`kinergy.accounting.energy.energy` (the one forward path, UR5e eqs 23-26): the energy
 reported is this re-simulation's, not the optimiser's quadrature (which agrees within about
 0.1 %), and every limit is checked at every one of its samples
 (:func:`kinergy.optimize.constraints.limit_violations`).
@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import cumulative_trapezoid
 
-from kinergy.energy.accounting import energy
+from kinergy.accounting.energy import energy
 from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import LimitCheck, limit_violations
 from kinergy.optimize.objectives import Objective

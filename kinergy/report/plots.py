@@ -392,7 +392,7 @@ def energy_breakdown(t: ArrayLike, parts: Mapping[str, ArrayLike]) -> Figure:
     drawn as a line; the total, the sum of the parts, is the thick black line, as in framework
     Fig. 4. Lines rather than stacked areas, because a part can be negative (gravity while the
     arm comes down, inertia while it brakes). With the parts of
-    :func:`kinergy.energy.accounting.energy` (``inertial``, ``gravity``, ``friction``,
+    :func:`kinergy.accounting.energy.energy` (``inertial``, ``gravity``, ``friction``,
     ``copper``) the total is the electrical energy of UR5e eq 26.
 
     Parameters

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from kinergy.energy.accounting import EnergyReport
+from kinergy.accounting.energy import EnergyReport
 from kinergy.identify.metrics import JointMetrics
 from kinergy.identify.result import IdentificationResult
 from kinergy.model.robot import Robot

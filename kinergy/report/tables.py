@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from kinergy.energy.accounting import EnergyReport
+from kinergy.accounting.energy import EnergyReport
 from kinergy.identify.metrics import JointMetrics
 from kinergy.model.robot import Robot
 from kinergy.report import seed

@@ -8,7 +8,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-from kinergy.energy.accounting import energy
+from kinergy.accounting.energy import energy
 from kinergy.identify.metrics import fit_metrics
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult, predict

@@ -1,0 +1,1 @@
+"""Energy accounting: what a motion costs per joint and in total, and where the energy goes."""
