@@ -132,7 +132,7 @@ def test_any_unknowns_meet_the_boundary_conditions(problem: ExcitationProblem, s
     np.testing.assert_allclose(qd, 0.0, atol=1e-12)
     np.testing.assert_allclose(qdd, 0.0, atol=1e-12)
     # the problem's own states are nursing eq 22 with these coefficients
-    q, qd, qdd = fourier_series(problem.t, q0, a, b, problem.base_frequency)
+    q, qd, qdd = fourier_series(problem.grid.t, q0, a, b, problem.base_frequency)
     for mine, eq22 in zip(problem.states(z), (q, qd, qdd), strict=True):
         np.testing.assert_allclose(mine, eq22, atol=1e-12)
 

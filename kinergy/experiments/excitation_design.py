@@ -134,7 +134,7 @@ def _excitation(
         a=a,
         b=b,
         period=problem.period,
-        start=problem.start.copy(),
+        start=problem.limits.start.copy(),
         criterion=criterion,
         condition=condition,
         d_criterion=d_criterion,

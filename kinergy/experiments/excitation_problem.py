@@ -88,7 +88,7 @@ class ExcitationProblem:
     regression : ExcitationRegression
         The columns of the regression matrix ``W``.
     grid : SeriesGrid
-        One period's grid the criterion is evaluated on.
+        One period's grid the criterion is evaluated on (``samples`` points).
     constraint_grid : SeriesGrid
         The grid the constraints are evaluated on (twice as fine).
     sample_grid : SeriesGrid
@@ -109,15 +109,6 @@ class ExcitationProblem:
     _last: dict[bytes, float] = field(default_factory=dict, init=False, repr=False)
 
     @property
-    def n(self) -> int:
-        return self.robot.n
-
-    @property
-    def harmonics(self) -> int:
-        """``L``."""
-        return self.series.harmonics
-
-    @property
     def period(self) -> float:
         """``T``, s."""
         return self.series.period
@@ -128,19 +119,9 @@ class ExcitationProblem:
         return self.series.base_frequency
 
     @property
-    def start(self) -> Array:
-        """Start (and end) pose, rad, shape (n,)."""
-        return self.limits.start
-
-    @property
-    def t(self) -> Array:
-        """The criterion's grid of one period, s, shape (samples,)."""
-        return self.grid.t
-
-    @property
     def size(self) -> int:
         """Number of unknowns, ``(2L - 2) n``."""
-        return self.series.free * self.n
+        return self.series.free * self.robot.n
 
     @property
     def columns(self) -> int:
@@ -155,7 +136,7 @@ class ExcitationProblem:
 
     def states(self, z: ArrayLike) -> tuple[Array, Array, Array]:
         """``q``, ``qd``, ``qdd`` on the grid ``t``, (samples, n) each."""
-        return self.grid.states(self.start, self.series.unknowns(z))
+        return self.grid.states(self.limits.start, self.series.unknowns(z))
 
     def motion(self, z: ArrayLike) -> Motion:
         """One period of the excitation sampled every ``dt`` (:func:`fourier_motion`)."""

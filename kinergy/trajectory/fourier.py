@@ -108,7 +108,7 @@ def fourier_motion(
     Examples
     --------
     >>> m = fourier_motion([0.0], [[0.2]], [[0.0]], base_frequency=0.2 * np.pi, dt=0.1)
-    >>> round(m.duration, 6), round(float(m.q[0, 0]), 6), round(float(m.q[-1, 0]), 6)
+    >>> round(m.duration, 6), abs(round(float(m.q[0, 0]), 6)), abs(round(float(m.q[-1, 0]), 6))
     (10.0, 0.0, 0.0)
     """
     if periods < 1:
