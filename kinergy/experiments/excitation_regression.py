@@ -7,8 +7,8 @@ The regression the full identification solves (:mod:`kinergy.identify.full`)::
 
 stacked over a grid of samples gives ``W`` (samples x n rows). Its columns are the link base
 columns ``Y_b`` (:func:`kinergy.dynamics.regressor.base_parameters`) and, with the drives, every
-motor's rotor-inertia column (``N[m, j] (N qdd)_m``, UR5e eq 2, through
-:func:`kinergy.drives.transmission.transmission_matrix`) and its friction columns: the registry's
+motor's rotor-inertia column (``N[m, j] (N qdd)_m``, UR5e eq 2; ``N`` and ``wm = N qd`` from
+:mod:`kinergy.drives.transmission`) and its friction columns: the registry's
 ``viscous_coulomb`` columns (:func:`kinergy.friction.registry.friction_columns`; viscous ``wm``,
 Coulomb ``tanh(wm / (|i| * 0.05 rad/s))``, a smooth sign), reflected to the joints by ``N^T``.
 A drive column that is a combination of the link base columns for every motion (on a UR arm
@@ -36,7 +36,7 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
-from kinergy.drives.transmission import transmission_matrix
+from kinergy.drives.transmission import motor_speed, transmission_matrix
 from kinergy.dynamics.regressor import BaseParameters, base_parameters, regressor
 from kinergy.friction.registry import friction_columns
 from kinergy.linalg import column_scale, pivoted_rank
@@ -65,26 +65,25 @@ _DEPENDENT_TOL = 1e-8
 _FD_STEP = 1e-6
 
 
-def _drive_columns(n_mat: Array, smoothing: Array, qd: Array, qdd: Array) -> Array:
+def _drive_columns(robot: Robot, smoothing: Array, qd: Array, qdd: Array) -> Array:
     """Rotor-inertia, viscous and Coulomb columns of every motor, joint side, (N, n, 3 n).
 
     Motor ``m`` reaches joint ``j`` through ``N[m, j]``: ``N[m, j] (N qdd)_m`` and
     ``N[m, j] F_m(wm_m)``, ``F_m`` the registry's viscous and Coulomb columns at smoothing
     ``smoothing[m]`` (rad/s, motor side).
     """
-    wm = qd @ n_mat.T
+    wm, dwm = motor_speed(robot, qd), motor_speed(robot, qdd)  # rad/s, rad/s^2
     friction = [
         friction_columns(_FRICTION, {"viscous": 0.0, "coulomb": 0.0, "smoothing": s}, wm[:, m])
         for m, s in enumerate(smoothing)
     ]  # each (N, 2): viscous, Coulomb
-    motor = np.concatenate(
-        [qdd @ n_mat.T, *(np.column_stack([f[:, k] for f in friction]) for k in range(2))], axis=1
-    )  # (N, 3 n): [rotor | viscous | Coulomb] by motor
-    return np.tile(n_mat.T, 3)[None, :, :] * motor[:, None, :]  # [s, j, k m] = N[m, j] motor
+    motor = np.concatenate([dwm[:, None, :], np.stack(friction, axis=2)], axis=1)  # (N, 3, n)
+    reach = np.tile(transmission_matrix(robot).T, 3)  # [j, k n + m] = N[m, j]
+    return reach[None, :, :] * motor.reshape(len(wm), 1, -1)
 
 
 def _independent_drive_columns(
-    robot: Robot, base: BaseParameters, n_mat: Array, smoothing: Array
+    robot: Robot, base: BaseParameters, smoothing: Array
 ) -> NDArray[np.intp]:
     """Indices (into the 3 n drive columns) not in the span of the link base columns and of each
     other (Gautier's pivoted QR rank), on seeded random states (the states
@@ -96,7 +95,7 @@ def _independent_drive_columns(
     qd = rng.standard_normal((300, robot.n))
     qdd = rng.standard_normal((300, robot.n))
     link = base.regressor(regressor(robot, q, qd, qdd)).reshape(-1, base.size)
-    extra = _drive_columns(n_mat, smoothing, qd, qdd).reshape(-1, 3 * robot.n)
+    extra = _drive_columns(robot, smoothing, qd, qdd).reshape(-1, 3 * robot.n)
     basis, _ = scipy.linalg.qr(link / column_scale(link), mode="economic")
     extra = extra / column_scale(extra)
     rest = extra - basis @ (basis.T @ extra)
@@ -114,8 +113,6 @@ class ExcitationRegression:
         The link base parameters.
     drive_columns : ndarray of int
         The drive columns in ``W``, indices into [rotor inertia, viscous, Coulomb] x motors.
-    n_mat : ndarray, shape (n, n)
-        Transmission matrix, ``wm = N qd``.
     smoothing : ndarray, shape (n,)
         Each motor's Coulomb smoothing speed, rad/s, motor side.
     """
@@ -123,7 +120,6 @@ class ExcitationRegression:
     robot: Robot
     base: BaseParameters = field(repr=False)
     drive_columns: NDArray[np.intp]
-    n_mat: Array = field(repr=False)
     smoothing: Array = field(repr=False)
 
     @property
@@ -136,7 +132,7 @@ class ExcitationRegression:
         link = self.base.regressor(regressor(self.robot, q, qd, qdd))
         if self.drive_columns.size == 0:
             return link
-        drives = _drive_columns(self.n_mat, self.smoothing, qd, qdd)[..., self.drive_columns]
+        drives = _drive_columns(self.robot, self.smoothing, qd, qdd)[..., self.drive_columns]
         return np.concatenate([link, drives], axis=2)
 
     def flat(self, q: Array, qd: Array, qdd: Array) -> Array:
@@ -171,16 +167,15 @@ class ExcitationRegression:
 def excitation_regression(robot: Robot, *, include_drives: bool = True) -> ExcitationRegression:
     """The columns of ``W`` for ``robot``: its link base parameters and, with ``include_drives``,
     the rotor-inertia and friction columns no trajectory confounds with them."""
-    n_mat = transmission_matrix(robot)
-    smoothing = np.abs(np.diag(n_mat)) * COULOMB_SMOOTHING
+    smoothing = np.abs(np.diag(transmission_matrix(robot))) * COULOMB_SMOOTHING
     smoothing = np.where(smoothing > 0, smoothing, COULOMB_SMOOTHING)
     base = base_parameters(robot)
     drives = (
-        _independent_drive_columns(robot, base, n_mat, smoothing)
+        _independent_drive_columns(robot, base, smoothing)
         if include_drives
         else np.zeros(0, dtype=np.intp)
     )
-    return ExcitationRegression(robot, base, drives, n_mat, smoothing)
+    return ExcitationRegression(robot, base, drives, smoothing)
 
 
 def criterion(w: Array, kind: str) -> tuple[float, Array, float]:
