@@ -31,6 +31,7 @@ __all__ = [
     "Terminated",
     "atomic_folder",
     "atomic_write",
+    "check_folder",
     "check_output",
     "check_outputs",
     "read_toml",
@@ -186,11 +187,29 @@ def atomic_write(
 
 def _replaceable(folder: Path) -> bool:
     """A folder kinergy may replace: missing, empty, or one it wrote itself (:data:`MARKER`)."""
+    if folder.is_symlink():
+        return False
     if not folder.exists():
         return True
-    if folder.is_symlink() or not folder.is_dir():
+    if not folder.is_dir():
         return False
     return not any(folder.iterdir()) or (folder / MARKER).is_file()
+
+
+def check_folder(path: PathLike) -> Path:
+    """``path`` as a folder of outputs (:func:`atomic_folder`): refused, before any work, when it
+    is a file, a link, or a folder holding files kinergy did not write.
+
+    Returns the path. Raises KinergyError, one line naming it.
+    """
+    target = Path(path)
+    if not _replaceable(target):
+        raise KinergyError(
+            f"{target}: exists and holds files kinergy did not write; give an empty or new folder"
+        )
+    if target.parent.exists() and not target.parent.is_dir():
+        raise KinergyError(f"{target}: {target.parent} is not a folder")
+    return target
 
 
 @contextlib.contextmanager
@@ -206,11 +225,7 @@ def atomic_folder(path: PathLike) -> Iterator[Path]:
     KinergyError
         ``path`` is a file, a link, or a folder with other content (one line naming it).
     """
-    target = Path(path)
-    if not _replaceable(target):
-        raise KinergyError(
-            f"{target}: exists and holds files kinergy did not write; give an empty or new folder"
-        )
+    target = check_folder(path)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
         building = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))

@@ -4,13 +4,16 @@ Commands are loaded when invoked (:class:`LazyGroup`), so ``kinergy --help`` and
 needs little do not import the whole scientific stack.
 
 Every user error (bad file, unknown robot, malformed input) ends as one line on stderr,
-``kinergy: error: ...``, and exit status 1; usage errors exit with 2 (click's convention).
-No traceback is shown for either.
+``kinergy: error: ...``, and exit status 1; usage errors (a bad flag value, a missing argument)
+are one line too and exit with 2 (click's convention). No traceback is shown for either, and
+control characters in a message (a NUL byte from a file) are shown escaped, never sent to the
+terminal.
 """
 
 from __future__ import annotations
 
 import importlib
+import re
 import sys
 from collections.abc import Sequence
 
@@ -19,7 +22,10 @@ import click
 from kinergy.errors import KinergyError
 from kinergy.files import Terminated, terminate_on_signals
 
-__all__ = ["COMMANDS", "LazyGroup", "cli", "main", "run"]
+__all__ = ["COMMANDS", "QUIET", "LazyGroup", "cli", "main", "one_line", "run"]
+
+#: key in click's ``ctx.meta``: the global ``--quiet`` was given (no progress on stderr)
+QUIET = "kinergy.quiet"
 
 #: command name -> "module:attribute" of its click command, in the order ``--help`` lists them
 COMMANDS = {
@@ -54,8 +60,23 @@ class LazyGroup(click.Group):
 
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="kinergy")
-def cli() -> None:
-    """Electro-mechanical models of robot arms from controller logs."""
+@click.option("--quiet", "-q", is_flag=True, help="No progress display on stderr.")
+@click.pass_context
+def cli(ctx: click.Context, quiet: bool) -> None:
+    """Electro-mechanical models of robot arms from controller logs.
+
+    Long steps show their progress on stderr when it is a terminal (not with --quiet).
+    """
+    ctx.meta[QUIET] = quiet
+
+
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")
+
+
+def one_line(message: str) -> str:
+    """``message`` on one line: line breaks as spaces, other control characters escaped."""
+    flat = " ".join(message.splitlines())
+    return _CONTROL.sub(lambda m: repr(m.group())[1:-1], flat)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -68,7 +89,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 standalone_mode=False,
             )
     except KinergyError as exc:
-        click.echo(f"kinergy: error: {exc}", err=True)
+        click.echo(f"kinergy: error: {one_line(str(exc))}", err=True)
         return 1
     except (click.exceptions.Abort, KeyboardInterrupt):
         click.echo("kinergy: interrupted; no output was left half-written", err=True)
@@ -76,8 +97,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Terminated:
         click.echo("kinergy: terminated; no output was left half-written", err=True)
         return 143
+    except click.UsageError as exc:
+        click.echo(f"kinergy: error: {one_line(exc.format_message())}", err=True)
+        return exc.exit_code
     except click.ClickException as exc:
-        exc.show()
+        click.echo(f"kinergy: error: {one_line(exc.format_message())}", err=True)
         return exc.exit_code
     except click.exceptions.Exit as exc:
         return exc.exit_code

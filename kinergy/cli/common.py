@@ -1,14 +1,21 @@
-"""What every command shares: the text table, number formats, the common options, progress."""
+"""What every command shares: the text table, number formats, the common options, the files a
+command writes (:func:`writes`), progress."""
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+import contextlib
+import functools
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from pathlib import Path
+from typing import Any, TypeVar
 
 import click
 import numpy as np
+from rich.console import Console
+from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElapsedColumn
 
+from kinergy.cli.app import QUIET
+from kinergy.files import check_folder, check_output, check_outputs
 from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
@@ -16,12 +23,17 @@ __all__ = [
     "fmt",
     "fmt_vector",
     "load",
+    "note",
     "payload_option",
     "print_tables",
     "progress",
     "repair_option",
+    "seed_option",
     "table",
+    "writes",
 ]
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 
 def table(headers: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
@@ -65,14 +77,99 @@ repair_option = click.option(
 )
 
 
-def progress() -> Callable[[str], None]:
-    """A progress callback: each message on stderr with the seconds since it was made."""
-    start = time.perf_counter()
+seed_option = click.option(
+    "--seed",
+    type=click.IntRange(0, 2**32 - 1),
+    default=0,
+    show_default=True,
+    help="Seed of the random generator (0 to 2^32-1).",
+)
 
-    def say(message: str) -> None:
-        click.echo(f"[{time.perf_counter() - start:5.1f} s] {message}", err=True)
 
-    return say
+def _flag(command: click.Command, name: str) -> str:
+    """The flag (``--out``) or metavar (``LOG...``) of the parameter called ``name``."""
+    for param in command.params:
+        if param.name == name:
+            if isinstance(param, click.Option):
+                return max(param.opts, key=len)
+            return param.human_readable_name
+    raise KeyError(name)  # a command declared a parameter it does not have: a programming error
+
+
+def _given(value: Any) -> list[str]:
+    """A parameter's value as a list of the paths it names (None: none; a tuple: several)."""
+    if value is None:
+        return []
+    return [str(v) for v in value] if isinstance(value, tuple | list) else [str(value)]
+
+
+def writes(
+    *,
+    files: Sequence[str] = (),
+    folders: Sequence[str] = (),
+    into: Sequence[str] = (),
+    inputs: Sequence[str] = (),
+) -> Callable[[F], F]:
+    """Declare what a command writes and reads, by parameter name; before the command does any
+    work, refuse (one line naming the flag) an output that is an input or another output, an
+    existing output that is not a regular file (:func:`kinergy.files.check_output`) and a folder
+    of outputs holding files kinergy did not write (:func:`kinergy.files.check_folder`).
+    ``into``: folders the command adds files to (only checked against the inputs and outputs).
+
+    Inputs that are not existing files (built-in names such as ``ur5e``, ``test-a``) are skipped.
+    Put it right above the function, below the click options.
+    """
+
+    def decorate(command: F) -> F:
+        @functools.wraps(command)
+        def checked(**kwargs: Any) -> Any:
+            cmd = click.get_current_context().command
+            outputs = [
+                (_flag(cmd, name), path)
+                for name in (*files, *folders, *into)
+                for path in _given(kwargs[name])
+            ]
+            for name in files:
+                for path in _given(kwargs[name]):
+                    check_output(path)
+            for name in folders:
+                for path in _given(kwargs[name]):
+                    check_folder(path)
+            sources = [p for name in inputs for p in _given(kwargs[name]) if Path(p).is_file()]
+            check_outputs(outputs, sources)
+            return command(**kwargs)
+
+        return checked  # type: ignore[return-value]
+
+    return decorate
+
+
+@contextlib.contextmanager
+def progress(*, quiet: bool = False) -> Iterator[Callable[[str], None]]:
+    """A progress display on stderr for the steps of a long command: ``say(message)`` starts a
+    step (a spinner and its running time) and ends the one before.
+
+    Silent when stderr is not a terminal, with ``quiet``, or with the global ``--quiet``.
+    """
+    ctx = click.get_current_context(silent=True)
+    console = Console(stderr=True)
+    if quiet or (ctx is not None and ctx.meta.get(QUIET)) or not console.is_terminal:
+        yield lambda _message: None
+        return
+    columns = (SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn())
+    with Progress(*columns, console=console) as bar:
+        current: list[TaskID] = []
+
+        def say(message: str) -> None:
+            if current:
+                bar.update(current[-1], completed=1)
+            current.append(bar.add_task(message, total=1))
+
+        try:
+            yield say
+        finally:
+            if current:
+                bar.update(current[-1], completed=1)
 
 
 def note(message: str) -> None:

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from kinergy.cli.common import print_tables, progress
+from kinergy.cli.common import print_tables, progress, writes
 from kinergy.workflows.demo import run_demo
 
 __all__ = ["demo"]
@@ -17,13 +17,15 @@ __all__ = ["demo"]
     "--out",
     "out",
     type=click.Path(file_okay=False),
-    default="kinergy-demo",
-    show_default=True,
-    help="Folder for the logs, figures and report.html.",
+    default=None,
+    help="Folder for the logs, figures and report.html [a new folder in the system's temporary "
+    "folder; its path is printed].",
 )
-def demo(out: str) -> None:
+@writes(folders=("out",))
+def demo(out: str | None) -> None:
     """The UR5e study on the built-in twin: simulate tests A and B, identify on A, validate on A
     and B, compute the energy, print UR5e Tables IV-VIII and write an HTML report."""
-    tables, report, seconds = run_demo(Path(out), progress())
+    with progress() as say:
+        tables, report, seconds = run_demo(None if out is None else Path(out), say)
     print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown", "timing"])
     click.echo(f"\nreport: {report} ({seconds:.1f} s)")

@@ -18,7 +18,7 @@ from typing import Any
 import click
 import numpy as np
 
-from kinergy.cli.common import progress
+from kinergy.cli.common import progress, seed_option, writes
 from kinergy.errors import KinergyError
 from kinergy.experiments.excitation_regression import CRITERIA
 from kinergy.jsonable import dumps
@@ -27,10 +27,23 @@ from kinergy.workflows.excite import ExciteOptions, ExciteRun, run_excite
 
 __all__ = ["excite", "excite_options", "excite_text"]
 
-#: flags that count something, and the least each may be
-_AT_LEAST = {"periods": 1, "starts": 1, "maxiter": 1, "compare": 0}
-#: flags that must be > 0 when given
-_POSITIVE = ("period", "range_deg", "speed", "acceleration")
+#: flags that count something, and the least and most each may be (the most: sizes that fit in
+#: memory and finish in minutes)
+_COUNTS = {
+    "harmonics": (0, 50),
+    "periods": (1, 100),
+    "starts": (1, 1000),
+    "maxiter": (1, 100_000),
+    "samples": (1, 20_000),
+    "compare": (0, 10_000),
+}
+#: flags that must be > 0 when given, with their least and most values (s, deg, rad/s, rad/s^2)
+_POSITIVE = {
+    "period": (1e-2, 600.0),
+    "range_deg": (1e-3, 360.0),
+    "speed": (1e-3, 100.0),
+    "acceleration": (1e-3, 1e4),
+}
 
 
 def _flag(name: str) -> str:
@@ -54,14 +67,18 @@ def _degrees(option: str, text: str | None, n: int) -> tuple[float, ...] | None:
 
 def _check_flags(robot: Robot, flags: Mapping[str, Any]) -> None:
     """Counts, positive numbers, a finite floor, URScript only for a 6-joint arm."""
-    for name, least in _AT_LEAST.items():
+    for name, (least, most) in _COUNTS.items():
         if flags[name] < least:
             raise KinergyError(f"{_flag(name)}: must be >= {least}, got {flags[name]}")
-    for name in _POSITIVE:
+        if flags[name] > most:
+            raise KinergyError(f"{_flag(name)}: must be at most {most}, got {flags[name]}")
+    for name, (low, high) in _POSITIVE.items():
         value = flags[name]
         if value is not None and not (math.isfinite(value) and value > 0.0):
             raise KinergyError(f"{_flag(name)}: must be > 0, got {value:g}")
-    if not math.isfinite(flags["floor"]):
+        if value is not None and not low <= value <= high:
+            raise KinergyError(f"{_flag(name)}: must be from {low:g} to {high:g}, got {value:g}")
+    if not math.isfinite(flags["floor"]) or abs(flags["floor"]) > 100.0:
         raise KinergyError(f"--floor: must be a height in m, got {flags['floor']}")
     if flags["urscript"] is not None and robot.n != 6:
         raise KinergyError(f"--urscript: URScript runs 6-joint UR arms; {robot.name} has {robot.n}")
@@ -165,7 +182,7 @@ def excite_text(run: ExciteRun) -> str:
     show_default=True,
     help="Minimise the condition number or -log det (D-optimality) of the scaled regressor.",
 )
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the random starts.")
+@seed_option
 @click.option(
     "--starts", type=int, default=4, show_default=True, help="Random feasible starting points."
 )
@@ -228,6 +245,7 @@ def excite_text(run: ExciteRun) -> str:
     help="Also draw N random feasible trajectories of the same size and report their median.",
 )
 @click.option("--quiet", is_flag=True, help="No progress on stderr.")
+@writes(files=("out", "urscript"), inputs=("robot_name",))
 def excite(robot_name: str, as_json: bool, quiet: bool, **flags: Any) -> None:
     """Design an excitation trajectory for identification (nursing eqs 22-23) and write it.
 
@@ -238,5 +256,6 @@ def excite(robot_name: str, as_json: bool, quiet: bool, **flags: Any) -> None:
     """
     robot = load_robot(robot_name)
     options = excite_options(robot, flags)
-    run = run_excite(robot, options, progress=None if quiet else progress())
+    with progress(quiet=quiet) as say:
+        run = run_excite(robot, options, progress=say)
     click.echo(dumps(run.to_dict()) if as_json else excite_text(run))

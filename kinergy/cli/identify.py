@@ -4,8 +4,18 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import columns_option, fmt, fmt_vector, note, repair_option, table
+from kinergy.cli.common import (
+    columns_option,
+    fmt,
+    fmt_vector,
+    note,
+    progress,
+    repair_option,
+    table,
+    writes,
+)
 from kinergy.cli.validate import validation_text
+from kinergy.friction.registry import MODELS
 from kinergy.identify.payload import PayloadEstimate
 from kinergy.identify.result import IdentificationResult
 from kinergy.jsonable import dumps
@@ -80,8 +90,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 @click.option(
     "--friction",
     "friction",
+    type=click.Choice(sorted(MODELS)),
     default=None,
-    metavar="MODEL",
     help="Friction model for every joint (default: the model's own).",
 )
 @click.option(
@@ -101,7 +111,7 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 @click.option(
     "--ridge",
     "ridge",
-    type=float,
+    type=click.FloatRange(0.0, 1e12),
     default=0.0,
     show_default=True,
     help="Full method: ridge weight.",
@@ -113,11 +123,12 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 )
 @click.option(
     "--cutoff",
-    type=float,
+    type=click.FloatRange(0.0, 1e6, min_open=True),
     default=None,
     help="Low-pass cutoff for measured speeds, Hz [min(10, fs/5)].",
 )
 @repair_option
+@writes(files=("out",), inputs=("logs", "robot_name"))
 def identify(
     logs: tuple[str, ...],
     robot_name: str,
@@ -140,15 +151,27 @@ def identify(
     actual_current; the full method regresses the base inertial parameters too.
     """
     r = load_robot(robot_name)
-    datas = prepared_logs(
-        logs, n_joints=r.n, columns=columns, repair=repair, cutoff=cutoff, note=note
-    )
+    with progress() as say:
+        say(f"reading {len(logs)} log(s)")
+        datas = prepared_logs(
+            logs, n_joints=r.n, columns=columns, repair=repair, cutoff=cutoff, note=note
+        )
+        say("identifying the payload" if payload_only else f"identifying ({method} method)")
+        if payload_only:
+            _, report = identify_payload_model(r, datas, out)
+        else:
+            result = identify_model(
+                r,
+                datas,
+                out,
+                method=method,
+                friction=friction,
+                target=target,
+                solver=solver,
+                ridge=ridge,
+            )
     if payload_only:
-        _, report = identify_payload_model(r, datas, out)
         summary = {"robot": r.name, "method": "payload", "payload": report}
         click.echo(dumps(summary) if as_json else _payload_text(report, out))
         return
-    result = identify_model(
-        r, datas, out, method=method, friction=friction, target=target, solver=solver, ridge=ridge
-    )
     click.echo(dumps(result.to_dict()) if as_json else _result_text(result, len(logs), out))

@@ -10,7 +10,8 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from kinergy.cli.common import table
+from kinergy.cli.common import progress, seed_option, table, writes
+from kinergy.files import atomic_write
 from kinergy.jsonable import dumps
 from kinergy.model import load_robot
 from kinergy.workflows.nursing import NursingStudy, nursing_study
@@ -123,8 +124,17 @@ def study_text(study: NursingStudy) -> str:
     show_default=True,
     help="The twin's default lag and noise, or exact signals.",
 )
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the noise and swarm.")
-def nursing(robot_name: str, as_json: bool, noise: bool, seed: int) -> None:
+@seed_option
+@click.option(
+    "--out",
+    "out",
+    type=click.Path(dir_okay=False),
+    default=None,
+    metavar="STUDY.json",
+    help="Also write the study (the --json output) to this file.",
+)
+@writes(files=("out",), inputs=("robot_name",))
+def nursing(robot_name: str, as_json: bool, noise: bool, seed: int, out: str | None) -> None:
     """Run the nursing doc's identification (friction runs, PSO Makkar fit, ridge) on the twin.
 
     ROBOT is a built-in name or a model file (default nursing-arm). Prints the Makkar parameters
@@ -132,10 +142,10 @@ def nursing(robot_name: str, as_json: bool, noise: bool, seed: int) -> None:
     per-joint torque RMSE next to Table 8.
     """
     robot = load_robot(robot_name)
-
-    def say(message: str) -> None:
-        if not as_json:
-            click.echo(f"... {message}", err=True)
-
-    study = nursing_study(robot, noise=noise, seed=seed, progress=say)
+    with progress() as say:
+        study = nursing_study(robot, noise=noise, seed=seed, progress=say)
+    if out is not None:
+        atomic_write(out, lambda fh: fh.write(dumps(study) + "\n"))
     click.echo(dumps(study) if as_json else study_text(study))
+    if out is not None and not as_json:
+        click.echo(f"wrote {out}")

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import click
 
-from kinergy.cli.common import load, payload_option, table
+from kinergy.cli.common import load, payload_option, progress, table, writes
 from kinergy.errors import KinergyError
 from kinergy.jsonable import dumps
 from kinergy.optimize import ParetoPoint, ProgramResult, TimingResult
@@ -21,6 +21,10 @@ from kinergy.workflows.optimize import OptimizeRun, run_optimize
 __all__ = ["optimize", "optimize_text"]
 
 _PARTS = ("friction", "copper", "inertial", "gravity")
+#: the longest cycle time optimised, s (each is re-simulated at 500 Hz, Pareto points and all)
+MAX_CYCLE_TIME = 600.0
+#: the largest speed (rad/s) and acceleration (rad/s^2) caps taken
+_MAX_CAP = {"--v-max": 100.0, "--a-max": 1e4}
 
 
 def _cycle_time(text: str) -> float | None:
@@ -31,14 +35,16 @@ def _cycle_time(text: str) -> float | None:
         value = float(text)
     except ValueError:
         raise KinergyError(f"--cycle-time: expected seconds or 'same', got {text!r}") from None
-    if not (math.isfinite(value) and value > 0.0):
-        raise KinergyError(f"--cycle-time: must be > 0 s, got {text!r}")
+    if not (math.isfinite(value) and 0.0 < value <= MAX_CYCLE_TIME):
+        raise KinergyError(
+            f"--cycle-time: must be > 0 and at most {MAX_CYCLE_TIME:g} s, got {text!r}"
+        )
     return value
 
 
-def _positive(name: str, value: float | None) -> None:
-    if value is not None and not (math.isfinite(value) and value > 0.0):
-        raise KinergyError(f"{name}: must be > 0, got {value}")
+def _cap(name: str, value: float | None) -> None:
+    if value is not None and not (math.isfinite(value) and 0.0 < value <= _MAX_CAP[name]):
+        raise KinergyError(f"{name}: must be > 0 and at most {_MAX_CAP[name]:g}, got {value:g}")
 
 
 def _moves_table(prog: ProgramResult, opt: ProgramResult) -> str:
@@ -184,7 +190,7 @@ def optimize_text(run: OptimizeRun) -> str:
 @click.option(
     "--pareto-points",
     "points",
-    type=click.IntRange(min=0),
+    type=click.IntRange(0, 50),
     default=8,
     show_default=True,
     help="Cycle times on the Pareto front (0: none).",
@@ -194,6 +200,7 @@ def optimize_text(run: OptimizeRun) -> str:
     is_flag=True,
     help="Keep each move's share of the cycle time; choose only speeds and accelerations.",
 )
+@writes(files=("urscript", "plot"), inputs=("model", "task_name"))
 def optimize(
     model: str,
     task_name: str,
@@ -215,21 +222,27 @@ def optimize(
     with every speed, acceleration, torque and position limit checked at every sample.
     """
     budget = _cycle_time(cycle_time)
-    _positive("--v-max", v_max)
-    _positive("--a-max", a_max)
+    _cap("--v-max", v_max)
+    _cap("--a-max", a_max)
     if plot is not None and points < 2:
         raise KinergyError("--plot: needs a Pareto front (--pareto-points of at least 2)")
-    run = run_optimize(
-        load(model, payload),
-        task_name,
-        cycle_time=budget,
-        v_max=v_max,
-        a_max=a_max,
-        points=points,
-        share_budget=not fixed_shares,
-        urscript=urscript,
-        plot=plot,
-    )
+    robot = load(model, payload)
+    with progress() as say:
+        say(
+            f"optimising the timing of {task_name}"
+            + (f" and {points} Pareto points" if points else "")
+        )
+        run = run_optimize(
+            robot,
+            task_name,
+            cycle_time=budget,
+            v_max=v_max,
+            a_max=a_max,
+            points=points,
+            share_budget=not fixed_shares,
+            urscript=urscript,
+            plot=plot,
+        )
     if as_json:
         click.echo(dumps(run.to_dict()))
         return

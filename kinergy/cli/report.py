@@ -12,6 +12,7 @@ from kinergy.cli.common import (
     print_tables,
     progress,
     repair_option,
+    writes,
 )
 from kinergy.errors import KinergyError
 from kinergy.workflows.study import study_report
@@ -46,19 +47,20 @@ __all__ = ["report"]
     "--out",
     "out",
     type=click.Path(file_okay=False),
-    default="kinergy-report",
-    show_default=True,
-    help="Folder for the figures and report.html.",
+    default=None,
+    help="Folder for the figures and report.html [a new folder in the system's temporary "
+    "folder; its path is printed].",
 )
 @columns_option
 @payload_option
 @repair_option
+@writes(folders=("out",), inputs=("model", "identify_logs", "validate_logs", "energy_logs"))
 def report(
     model: str,
     identify_logs: tuple[str, ...],
     validate_logs: tuple[str, ...],
     energy_logs: tuple[str, ...],
-    out: str,
+    out: str | None,
     columns: str | None,
     payload: str | None,
     repair: bool,
@@ -66,17 +68,18 @@ def report(
     """Build the study report (tables, figures, report.html) from your own model and logs."""
     if not (identify_logs or validate_logs or energy_logs):
         raise KinergyError("report: give logs with --identify, --validate or --energy")
-    path, tables = study_report(
-        load(model, payload),
-        out,
-        identify_logs=identify_logs,
-        validate_logs=validate_logs,
-        energy_logs=energy_logs,
-        columns=columns,
-        repair=repair,
-        model_name=model,
-        progress=progress(),
-        note=note,
-    )
+    with progress() as say:
+        path, tables = study_report(
+            load(model, payload),
+            out,
+            identify_logs=identify_logs,
+            validate_logs=validate_logs,
+            energy_logs=energy_logs,
+            columns=columns,
+            repair=repair,
+            model_name=model,
+            progress=say,
+            note=note,
+        )
     print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown"])
     click.echo(f"\nreport: {path}")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import columns_option, load, payload_option
+from kinergy.cli.common import columns_option, load, payload_option, seed_option, writes
 from kinergy.simulate import TwinSettings
 from kinergy.workflows.twin import simulate_to_file
 
@@ -21,16 +21,23 @@ __all__ = ["simulate"]
 )
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Log to write.")
 @click.option("--exact", is_flag=True, help="No lag and no noise: the model's equations exactly.")
-@click.option("--lag", type=float, default=None, help="Real motion behind the target, s [0.004].")
 @click.option(
-    "--speed-noise", type=float, default=None, help="Measured speed noise std, rad/s [0.01]."
+    "--lag", type=click.FloatRange(0.0, 1.0), help="Real motion behind the target, s [0.004]."
 )
 @click.option(
-    "--current-noise", type=float, default=None, help="Measured current noise std, A [0.04]."
+    "--speed-noise",
+    type=click.FloatRange(0.0, 10.0),
+    help="Measured speed noise std, rad/s [0.01].",
 )
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the noise.")
+@click.option(
+    "--current-noise",
+    type=click.FloatRange(0.0, 100.0),
+    help="Measured current noise std, A [0.04].",
+)
+@seed_option
 @payload_option
 @columns_option
+@writes(files=("out",), inputs=("robot_name", "trajectory"))
 def simulate(
     robot_name: str,
     trajectory: str,

@@ -6,7 +6,15 @@ from collections.abc import Sequence
 
 import click
 
-from kinergy.cli.common import columns_option, load, note, payload_option, repair_option, table
+from kinergy.cli.common import (
+    columns_option,
+    load,
+    note,
+    payload_option,
+    repair_option,
+    table,
+    writes,
+)
 from kinergy.identify.metrics import JointMetrics
 from kinergy.identify.result import Validation
 from kinergy.jsonable import dumps
@@ -51,9 +59,14 @@ def validation_text(report: Validation, names: Sequence[str]) -> str:
     default=None,
     help="Write plots (measured vs predicted, error box plots) to this folder.",
 )
-@click.option("--cutoff", type=float, default=None, help="Low-pass cutoff for measured speeds, Hz.")
+@click.option(
+    "--cutoff",
+    type=click.FloatRange(0.0, 1e6, min_open=True),
+    help="Low-pass cutoff for measured speeds, Hz.",
+)
 @payload_option
 @repair_option
+@writes(into=("plots",), inputs=("model", "logs"))
 def validate(
     model: str,
     logs: tuple[str, ...],

@@ -12,10 +12,13 @@
 from __future__ import annotations
 
 import dataclasses
+import shutil
+import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
 
+from kinergy.files import atomic_folder
 from kinergy.identify.preprocess import prepare
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.motion import motion_from_log
@@ -49,9 +52,12 @@ def nominal_drives(robot: Robot) -> Robot:
 
 
 def run_demo(
-    out: Path, progress: Callable[[str], None] | None = None
+    out: Path | None = None, progress: Callable[[str], None] | None = None
 ) -> tuple[dict[str, list[Table]], Path, float]:
-    """Run the demo into folder ``out``.
+    """Run the demo into folder ``out``, built beside it and renamed into place at the end
+    (:func:`kinergy.files.atomic_folder`: a failure or an interruption leaves no half-written
+    folder). ``out`` None: a new folder ``kinergy-demo-*`` in the system's temporary folder
+    (nothing is written to the current folder unless asked).
 
     Returns
     -------
@@ -63,8 +69,21 @@ def run_demo(
     seconds : float
         Wall time.
     """
-    say = progress or (lambda _msg: None)
     start = time.perf_counter()
+    fresh = out is None
+    out = Path(tempfile.mkdtemp(prefix="kinergy-demo-")) if out is None else out
+    try:
+        with atomic_folder(out) as folder:
+            tables = _demo(folder, progress or (lambda _msg: None))
+    except BaseException:
+        if fresh:
+            shutil.rmtree(out, ignore_errors=True)  # the empty folder made above
+        raise
+    return tables, out / "report.html", time.perf_counter() - start
+
+
+def _demo(out: Path, say: Callable[[str], None]) -> dict[str, list[Table]]:
+    """The demo's steps, writing into folder ``out``; returns the report's tables."""
     truth = load_robot("ur5e")
     logs = out / "logs"
     logs.mkdir(parents=True, exist_ok=True)
@@ -91,7 +110,7 @@ def run_demo(
         progress=say,
     )
     say("writing the report")
-    report, tables = write_study(
+    _, tables = write_study(
         study,
         out,
         title="kinergy demo: the UR5e study on the digital twin",
@@ -104,4 +123,4 @@ def run_demo(
             "logs": ", ".join(str(p.relative_to(out)) for p in sorted(logs.glob("*.csv"))),
         },
     )
-    return tables, report, time.perf_counter() - start
+    return tables

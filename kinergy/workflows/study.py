@@ -4,11 +4,14 @@ report (tables, figures, ``report.html``). ``kinergy report`` and ``kinergy demo
 from __future__ import annotations
 
 import os
+import shutil
+import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 from kinergy.accounting.energy import energy
+from kinergy.files import atomic_folder
 from kinergy.identify.metrics import fit_metrics
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult, predict
@@ -112,7 +115,7 @@ def write_study(
 
 def study_report(
     robot: Robot,
-    out: str | os.PathLike[str],
+    out: str | os.PathLike[str] | None,
     *,
     identify_logs: Sequence[str] = (),
     validate_logs: Sequence[str] = (),
@@ -124,7 +127,12 @@ def study_report(
     note: Callable[[str], None] | None = None,
 ) -> tuple[Path, dict[str, list[Table]]]:
     """``kinergy report``: identify (sequential method) on ``identify_logs`` if any, validate on
-    ``validate_logs``, account the energy of ``energy_logs``, and write ``out/report.html``."""
+    ``validate_logs``, account the energy of ``energy_logs``, and write ``out/report.html``.
+
+    The folder is built beside ``out`` and renamed into place at the end
+    (:func:`kinergy.files.atomic_folder`); ``out`` None: a new folder ``kinergy-report-*`` in the
+    system's temporary folder. Returns the path of ``report.html`` and the tables.
+    """
     say = progress or (lambda _msg: None)
     result = None
     if identify_logs:
@@ -150,13 +158,22 @@ def study_report(
     study = run_study(
         robot, validation=validation, motions=motions, result=result, progress=progress
     )
-    return write_study(
-        study,
-        out,
-        title=f"kinergy report: {robot.name}",
-        subtitle="Model parameters, accuracy on logs and energy of motions",
-        meta={
-            "model": model_name or robot.name,
-            "logs": ", ".join([*identify_logs, *validate_logs, *energy_logs]),
-        },
-    )
+    fresh = out is None
+    target = Path(tempfile.mkdtemp(prefix="kinergy-report-")) if out is None else Path(out)
+    try:
+        with atomic_folder(target) as folder:
+            _, tables = write_study(
+                study,
+                folder,
+                title=f"kinergy report: {robot.name}",
+                subtitle="Model parameters, accuracy on logs and energy of motions",
+                meta={
+                    "model": model_name or robot.name,
+                    "logs": ", ".join([*identify_logs, *validate_logs, *energy_logs]),
+                },
+            )
+    except BaseException:
+        if fresh:
+            shutil.rmtree(target, ignore_errors=True)  # the empty folder made above
+        raise
+    return target / "report.html", tables
