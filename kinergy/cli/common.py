@@ -15,6 +15,7 @@ from rich.console import Console
 from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElapsedColumn
 
 from kinergy.cli.app import QUIET
+from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_output, check_outputs
 from kinergy.model import Robot, load_robot, parse_payload
 
@@ -129,12 +130,14 @@ def writes(
                 for name in (*files, *folders, *into)
                 for path in _given(kwargs[name])
             ]
-            for name in files:
+            for name, check in [(n, check_output) for n in files] + [
+                (n, check_folder) for n in folders
+            ]:
                 for path in _given(kwargs[name]):
-                    check_output(path)
-            for name in folders:
-                for path in _given(kwargs[name]):
-                    check_folder(path)
+                    try:
+                        check(path)
+                    except KinergyError as exc:
+                        raise exc.prefixed(_flag(cmd, name)) from None
             sources = [p for name in inputs for p in _given(kwargs[name]) if Path(p).is_file()]
             check_outputs(outputs, sources)
             return command(**kwargs)

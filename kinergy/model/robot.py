@@ -26,6 +26,7 @@ from kinergy.friction.registry import check_friction
 
 __all__ = [
     "CONVENTIONS",
+    "MAGNITUDES",
     "SOURCE_CATEGORIES",
     "SOURCE_STATUSES",
     "Drive",
@@ -62,6 +63,45 @@ SOURCE_CATEGORIES = (
 SOURCE_STATUSES = ("published", "seed", "identified", "nominal", "user")
 
 
+#: the largest magnitude each parameter may have (SI units): far beyond any real arm, small enough
+#: that the dynamics stay finite; a file with ``gravity = [0, 0, 1e308]`` is refused, not run
+MAGNITUDES = {
+    "mass": 1e4,  # kg
+    "payload mass": 1e4,
+    "com": 100.0,  # m
+    "payload com": 100.0,
+    "inertia": 1e5,  # kg m^2
+    "payload inertia": 1e5,
+    "d": 100.0,  # m
+    "a": 100.0,
+    "alpha": 100.0,  # rad
+    "offset": 100.0,
+    "gear_ratio": 1e6,
+    "motor_inertia": 1e3,  # kg m^2
+    "reducer_inertia": 1e3,
+    "torque_constant": 1e3,  # N m/A
+    "motor_constant": 1e3,  # N m/sqrt(W)
+    "kt_over_kb": 100.0,
+    "winding_resistance": 1e6,  # ohm
+    "limits.position": 1e3,  # rad
+    "limits.speed": 1e3,  # rad/s
+    "limits.torque": 1e7,  # N m
+    "limits.acceleration": 1e6,  # rad/s^2
+    "gravity": 100.0,  # m/s^2, about 10 g
+    "standby_power": 1e6,  # W
+    "bus_voltage": 1e4,  # V
+}
+
+
+def _bounded(x: Any, what: str) -> None:
+    """Refuse a number or vector larger than :data:`MAGNITUDES` allows for ``what``."""
+    most = MAGNITUDES.get(what)
+    size = float(np.max(np.abs(x))) if np.size(x) else 0.0
+    if most is not None and size > most:
+        shown = f"{x:g}" if np.ndim(x) == 0 else str(np.asarray(x).tolist())
+        raise KinergyError(f"{what} must be at most {most:g} in size, got {shown}")
+
+
 def _vector(value: Any, length: int, what: str) -> Array:
     try:
         arr = np.array(value, dtype=float)
@@ -71,6 +111,7 @@ def _vector(value: Any, length: int, what: str) -> Array:
         raise KinergyError(f"{what} must be {length} numbers, got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise KinergyError(f"{what} must be finite, got {arr.tolist()}")
+    _bounded(arr, what)
     arr.setflags(write=False)
     return arr
 
@@ -83,6 +124,7 @@ def _number(value: Any, what: str, *, low: float | None = None, strict: bool = T
         raise KinergyError(f"{what} must be finite, got {value!r}")
     if low is not None and ((strict and x <= low) or (not strict and x < low)):
         raise KinergyError(f"{what} must be {'>' if strict else '>='} {low:g}, got {x:g}")
+    _bounded(x, what)
     return x
 
 

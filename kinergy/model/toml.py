@@ -108,6 +108,22 @@ _DRIVE_KEYS = {
     "winding_resistance",
 }
 _LIMIT_KEYS = {"position", "speed", "torque", "acceleration"}
+#: friction parameters a file may not make negative: each is a friction (it opposes the motion)
+#: or a rate (Makkar's gamma2, gamma3, gamma5; nursing eq 13); gamma1 may take either sign
+_NON_NEGATIVE_FRICTION = {
+    "viscous",
+    "coulomb",
+    "coulomb_direct",
+    "coulomb_reverse",
+    "static",
+    "motor_viscous",
+    "motor_coulomb",
+    "reducer_coulomb",
+    *(f"gamma{k}" for k in range(2, 7)),
+}
+#: the largest magnitude of a friction parameter in a file (N m, N m s/rad, s/rad: far above any
+#: motor's, small enough that the torques stay finite)
+_FRICTION_MAX = 1e6
 
 
 def _at(where: str, build: Callable[[], T]) -> T:
@@ -139,6 +155,21 @@ def _no_unknown(data: Mapping[str, Any], allowed: set[str], where: str) -> None:
         )
 
 
+def _check_friction_values(params: Mapping[str, Any], where: str) -> None:
+    """Signs and sizes a friction model's numbers may have in a robot file (names the field)."""
+    for name, value in params.items():
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            continue  # Friction() names the wrong type
+        if name in _NON_NEGATIVE_FRICTION and value < 0.0:
+            raise KinergyError(
+                f"{where}.{name}: must be >= 0 (friction opposes motion), got {value:g}"
+            )
+        if abs(value) > _FRICTION_MAX:
+            raise KinergyError(
+                f"{where}.{name}: must be at most {_FRICTION_MAX:g} in size, got {value:g}"
+            )
+
+
 def _joint_from_dict(data: Any, index: int) -> Joint:
     where = f"joints[{index}]"
     data = _table(data, where)
@@ -162,6 +193,7 @@ def _joint_from_dict(data: Any, index: int) -> Joint:
     model = fric_data.pop("model", None)
     if model is None:
         raise KinergyError(f"{fwhere}: missing field 'model'")
+    _check_friction_values(fric_data, fwhere)
     friction = _at(fwhere, lambda: Friction(model=model, params=fric_data))
     drive = _at(
         dwhere,
