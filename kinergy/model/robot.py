@@ -67,11 +67,8 @@ SOURCE_STATUSES = ("published", "seed", "identified", "nominal", "user")
 #: that the dynamics stay finite; a file with ``gravity = [0, 0, 1e308]`` is refused, not run
 MAGNITUDES = {
     "mass": 1e4,  # kg
-    "payload mass": 1e4,
     "com": 100.0,  # m
-    "payload com": 100.0,
     "inertia": 1e5,  # kg m^2
-    "payload inertia": 1e5,
     "d": 100.0,  # m
     "a": 100.0,
     "alpha": 100.0,  # rad
