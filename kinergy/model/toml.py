@@ -61,6 +61,7 @@ import tomli_w
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write, read_toml
 from kinergy.model.robot import (
+    MAGNITUDES,
     SOURCE_CATEGORIES,
     Drive,
     Friction,
@@ -435,6 +436,10 @@ def parse_payload(text: str) -> Payload:
     if len(values) not in (1, 4, 10):
         raise KinergyError(
             f"--payload: expected MASS, MASS,CX,CY,CZ or 10 numbers with the inertia; got {len(values)}"
+        )
+    if not 0.0 <= values[0] <= MAGNITUDES["mass"]:
+        raise KinergyError(
+            f"--payload: mass must be from 0 to {MAGNITUDES['mass']:g} kg, got {values[0]:g}"
         )
     com = values[1:4] if len(values) >= 4 else [0.0, 0.0, 0.0]
     inertia = values[4:10] if len(values) == 10 else [0.0] * 6
