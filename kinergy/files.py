@@ -34,6 +34,7 @@ __all__ = [
     "check_folder",
     "check_output",
     "check_outputs",
+    "output_folder",
     "read_toml",
     "terminate_on_signals",
 ]
@@ -244,6 +245,25 @@ def atomic_folder(path: PathLike) -> Iterator[Path]:
             shutil.rmtree(old, ignore_errors=True)
     except BaseException:
         shutil.rmtree(building, ignore_errors=True)
+        raise
+
+
+@contextlib.contextmanager
+def output_folder(path: PathLike | None, *, prefix: str) -> Iterator[tuple[Path, Path]]:
+    """:func:`atomic_folder` for ``path``, or with ``path`` None for a new folder
+    ``PREFIX-XXXXXXXX`` in the system's temporary folder (so nothing is written to the current
+    folder unless asked; a failure removes it again).
+
+    Yields ``(building, target)``: the folder to write into and where it ends up.
+    """
+    fresh = path is None
+    target = Path(tempfile.mkdtemp(prefix=f"{prefix}-")) if path is None else Path(path)
+    try:
+        with atomic_folder(target) as building:
+            yield building, target
+    except BaseException:
+        if fresh:
+            shutil.rmtree(target, ignore_errors=True)
         raise
 
 

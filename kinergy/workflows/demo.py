@@ -12,13 +12,11 @@
 from __future__ import annotations
 
 import dataclasses
-import shutil
-import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
 
-from kinergy.files import atomic_folder
+from kinergy.files import output_folder
 from kinergy.identify.preprocess import prepare
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.motion import motion_from_log
@@ -70,16 +68,9 @@ def run_demo(
         Wall time.
     """
     start = time.perf_counter()
-    fresh = out is None
-    out = Path(tempfile.mkdtemp(prefix="kinergy-demo-")) if out is None else out
-    try:
-        with atomic_folder(out) as folder:
-            tables = _demo(folder, progress or (lambda _msg: None))
-    except BaseException:
-        if fresh:
-            shutil.rmtree(out, ignore_errors=True)  # the empty folder made above
-        raise
-    return tables, out / "report.html", time.perf_counter() - start
+    with output_folder(out, prefix="kinergy-demo") as (folder, target):
+        tables = _demo(folder, progress or (lambda _msg: None))
+    return tables, target / "report.html", time.perf_counter() - start
 
 
 def _demo(out: Path, say: Callable[[str], None]) -> dict[str, list[Table]]:

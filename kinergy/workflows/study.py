@@ -4,14 +4,12 @@ report (tables, figures, ``report.html``). ``kinergy report`` and ``kinergy demo
 from __future__ import annotations
 
 import os
-import shutil
-import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 from kinergy.accounting.energy import energy
-from kinergy.files import atomic_folder
+from kinergy.files import output_folder
 from kinergy.identify.metrics import fit_metrics
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult, predict
@@ -158,22 +156,15 @@ def study_report(
     study = run_study(
         robot, validation=validation, motions=motions, result=result, progress=progress
     )
-    fresh = out is None
-    target = Path(tempfile.mkdtemp(prefix="kinergy-report-")) if out is None else Path(out)
-    try:
-        with atomic_folder(target) as folder:
-            _, tables = write_study(
-                study,
-                folder,
-                title=f"kinergy report: {robot.name}",
-                subtitle="Model parameters, accuracy on logs and energy of motions",
-                meta={
-                    "model": model_name or robot.name,
-                    "logs": ", ".join([*identify_logs, *validate_logs, *energy_logs]),
-                },
-            )
-    except BaseException:
-        if fresh:
-            shutil.rmtree(target, ignore_errors=True)  # the empty folder made above
-        raise
+    with output_folder(out, prefix="kinergy-report") as (folder, target):
+        _, tables = write_study(
+            study,
+            folder,
+            title=f"kinergy report: {robot.name}",
+            subtitle="Model parameters, accuracy on logs and energy of motions",
+            meta={
+                "model": model_name or robot.name,
+                "logs": ", ".join([*identify_logs, *validate_logs, *energy_logs]),
+            },
+        )
     return target / "report.html", tables
