@@ -46,7 +46,12 @@ class ElectricsFit:
 
 
 def fit_electrics(
-    current: ArrayLike, voltage: ArrayLike, wm: ArrayLike, *, weights: ArrayLike | None = None
+    current: ArrayLike,
+    voltage: ArrayLike,
+    wm: ArrayLike,
+    *,
+    weights: ArrayLike | None = None,
+    instrument: ArrayLike | None = None,
 ) -> ElectricsFit:
     """``R`` and ``k_b`` of one motor by least squares on UR5e eq 19, ``V = R I + k_b wm``.
 
@@ -56,6 +61,11 @@ def fit_electrics(
         Current (A), the equivalent DC motor's voltage (V, signed) and motor speed (rad/s).
     weights : array_like, shape (k,), optional
         Least-squares weights (``1 / |V|`` fits every point to the same relative accuracy).
+    instrument : array_like, shape (k,), optional
+        A noise-free stand-in for the current (a model's predicted current, A), used as the
+        instrumental variable of the current column: noise in a logged current biases
+        ordinary least squares' ``R`` low (errors in variables; 5 % on a UR wrist with 0.04 A
+        of noise), the instrument does not. Points and standard errors as without it.
 
     Raises
     ------
@@ -74,6 +84,9 @@ def fit_electrics(
             "the voltages cannot separate the winding resistance from the back-EMF constant "
             "(current and speed move together)"
         )
+    if instrument is not None:
+        z = np.column_stack([np.asarray(instrument, dtype=float).ravel(), w]) * wt[:, None]
+        x = np.linalg.solve(z.T @ (a * wt[:, None]), z.T @ (v * wt))
     rms = float(np.sqrt(np.mean((a @ x - v) ** 2)))
     return ElectricsFit(float(x[0]), float(x[1]), float(std[0]), float(std[1]), rms, int(i.size))
 

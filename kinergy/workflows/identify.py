@@ -21,6 +21,7 @@ from kinergy.identify.result import IdentificationResult
 from kinergy.identify.sequential import identify_sequential
 from kinergy.model import Payload, Robot, save_robot
 from kinergy.model.robot import Source
+from kinergy.predict import drive_state
 
 __all__ = [
     "METHODS",
@@ -85,6 +86,16 @@ def run_method(
     return measured_electrics(result, datas)
 
 
+def _motion(
+    logs: Sequence[IdentData],
+) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray | None]:
+    """The logs' real motion (q, qd, qdd), stacked, and their joint temperatures (None unless
+    every log has them)."""
+    q, qd, qdd = (np.vstack([getattr(d, k) for d in logs]) for k in ("q", "qd", "qdd"))
+    temps = [d.temperature for d in logs if d.temperature is not None]
+    return (q, qd, qdd), (np.vstack(temps) if len(temps) == len(logs) else None)
+
+
 def _electrics_fits(
     robot: Robot, logs: Sequence[IdentData], notes: list[str]
 ) -> list[ElectricsFit | None]:
@@ -93,11 +104,16 @@ def _electrics_fits(
     n_mat = transmission_matrix(robot)
     current = np.vstack([d.current for d in logs if d.current is not None])
     voltage = equivalent_voltage(np.vstack([d.voltage for d in logs if d.voltage is not None]))
-    wm = np.vstack([d.qd for d in logs]) @ n_mat.T
+    (q, qd, qdd), temperature = _motion(logs)
+    # the identified model's current, free of the log's noise: the instrument of the fit
+    predicted = drive_state(robot, q, qd, qdd, temperature=temperature).current
+    wm = qd @ n_mat.T
     fits: list[ElectricsFit | None] = []
     for m, joint in enumerate(robot.joints):
         try:
-            fits.append(fit_electrics(current[:, m], voltage[:, m], wm[:, m]))
+            fits.append(
+                fit_electrics(current[:, m], voltage[:, m], wm[:, m], instrument=predicted[:, m])
+            )
         except KinergyError as exc:
             notes.append(f"joint {m + 1} ({joint.name}): electrics kept from the model: {exc}")
             fits.append(None)
@@ -112,11 +128,9 @@ def _supply_power(data: IdentData) -> np.ndarray:
 
 def _standby(robot: Robot, logs: Sequence[IdentData]) -> float:
     """The standby power (W) that the logs' supply power leaves over the model's motors."""
-    q, qd, qdd = (np.vstack([getattr(d, k) for d in logs]) for k in ("q", "qd", "qdd"))
+    motion, temperature = _motion(logs)
     supply = np.concatenate([_supply_power(d) for d in logs])
-    temps = [d.temperature for d in logs if d.temperature is not None]
-    temperature = np.vstack(temps) if len(temps) == len(logs) else None
-    fit = fit_standby(robot, (q, qd, qdd), supply, temperature=temperature, dt=logs[0].dt)
+    fit = fit_standby(robot, motion, supply, temperature=temperature, dt=logs[0].dt)
     return max(fit.standby, 0.0)
 
 
