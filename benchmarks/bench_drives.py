@@ -22,7 +22,6 @@ Each part prints its figures and a markdown-ready line; ``--part`` runs one of t
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import glob
 import time
 from pathlib import Path
@@ -242,28 +241,17 @@ def warmup(folder: Path) -> None:
     held = _twin_log(truth, two, SEED + 1, folder / "warm2.csv", reuse=True)
     assert ident.temperature is not None and held.temperature is not None
     print(f"warm-up: joints warm by {np.ptp(ident.temperature, axis=0).round(1)} K over 30 min")
-    # the same model with and without its temperature term (the logs' temperatures hidden), and
-    # Coulomb + viscous with and without it
-    runs = {
-        "load power law": ("load_thermal_power_law", False),
-        "+ temperature": ("load_thermal_power_law", True),
-        "C+V": ("viscous_coulomb", True),
-        "C+V + temperature": ("thermal_viscous", True),
-    }
-    rms = {}
-    for name, (friction, warm) in runs.items():
-        fit_on, check_on = ident, held
-        if not warm:
-            fit_on = dataclasses.replace(ident, temperature=None)
-            check_on = dataclasses.replace(held, temperature=None)
-        result = run_method(model, [fit_on], friction=friction)
-        rms[name] = _current_rms(result.robot, check_on)
+    # Coulomb + viscous with and without its temperature term (the one difference), and the
+    # power law without, and with the load and temperature terms
+    runs = ("viscous_coulomb", "thermal_viscous", "power_law", "load_thermal_power_law")
+    rms = {f: _current_rms(run_method(model, [ident], friction=f).robot, held) for f in runs}
     print(
-        "| joint | " + " | ".join(f"{k} [A]" for k in runs) + " | lower by [%] | C+V lower by [%] |"
+        "| joint | "
+        + " | ".join(f"{k} [A]" for k in runs)
+        + " | C+V lower by [%] | power law lower by [%] |"
     )
     for j, name in enumerate(model.joint_names):
-        a, b = rms["load power law"][j], rms["+ temperature"][j]
-        c, d = rms["C+V"][j], rms["C+V + temperature"][j]
+        a, b, c, d = (rms[f][j] for f in runs)
         print(
             f"| {name} | {a:.4f} | {b:.4f} | {c:.4f} | {d:.4f} | {100 * (1 - b / a):.1f} "
             f"| {100 * (1 - d / c):.1f} |"
