@@ -100,3 +100,9 @@ def test_cli_simulate_mismatch_writes_the_truth(
     assert main([*argv, "--truth", str(out)]) == 1  # --truth may not overwrite --out
     assert main([*argv[:-2], "--out", str(tmp_path / "b.csv")]) == 0
     assert "mismatch none" in capsys.readouterr().out
+    model = tmp_path / "id.toml"
+    ident = ["identify", str(out), "--robot", "ur5e", "--friction", "auto", "--out", str(model)]
+    assert main(ident) == 0
+    text = capsys.readouterr().out
+    assert "Friction chosen per joint" in text and "vs Coulomb+viscous [%]" in text
+    assert "R = " in text and "standby power" in text
