@@ -29,11 +29,15 @@ from pathlib import Path
 import numpy as np
 
 import kinergy
+from kinergy.accounting.energy import energy
+from kinergy.drives.electrics import DQ_VOLTAGE_FACTOR, back_emf_constants, winding_resistances
 from kinergy.dynamics.regressor import base_parameters, inertial_parameters
+from kinergy.friction.registry import friction_torque
 from kinergy.identify.full import identify_full
 from kinergy.identify.preprocess import IdentData, prepare
 from kinergy.identify.result import predict
 from kinergy.io.rtde import read_log, write_log
+from kinergy.io.ur_calibration import read_ur_calibration
 from kinergy.model.robot import Robot
 from kinergy.predict import drive_state
 from kinergy.simulate import TwinSettings, realistic_truth, simulate
@@ -57,7 +61,8 @@ def _pct(a: float, b: float) -> float:
 
 
 def calibration() -> None:
-    """import-calibration on the UR5e file: worst errors per joint."""
+    """import-calibration on the UR5e file: worst errors per joint, then the electrical power
+    at the calibration's speed points."""
     result = import_calibration(
         kinergy.load_robot("ur5e"), DATA / "ur5e-calibration" / ("robot_calibration_summary.txt")
     )
@@ -74,6 +79,46 @@ def calibration() -> None:
             f"{np.max(np.abs(model - tau)):.4f}  C+V {np.max(np.abs(contrast / tau - 1)) * 100:6.1f}"
             f"  U {np.max(np.abs(u_model / u - 1)) * 100:5.2f}  within tolerance: {ok}"
         )
+    calibration_power(result.robot)
+
+
+def _point_power(robot: Robot, j: int, speed: np.ndarray) -> np.ndarray:
+    """The electrical power (W, UR5e eqs 19-23) ``robot``'s joint ``j`` draws turning at the
+    joint ``speed`` (rad/s) against its friction alone, the motor driving (power flows to the
+    load), as in a calibration run."""
+    joint = robot.joints[j]
+    wm = joint.drive.gear_ratio * speed
+    fr = joint.drive.friction
+    tau = friction_torque(fr.model, fr.params, wm, 1e-6 * np.sign(wm), temperature=None)
+    current = tau / joint.drive.torque_constant
+    return winding_resistances(robot)[j] * current**2 + back_emf_constants(robot)[j] * wm * current
+
+
+def calibration_power(calibrated: Robot) -> None:
+    """The power the UR5e's calibration measured at each speed point (1.5 U I: its U is the dq
+    voltage) against the built-in ur5e's and the calibrated robot's prediction."""
+    built_in = kinergy.load_robot("ur5e")
+    cal = read_ur_calibration(DATA / "ur5e-calibration" / "robot_calibration_summary.txt")
+    print(
+        "| joint | measured at 3.2 rad/s [W] | built-in ur5e | calibrated | mean abs error built-in / calibrated (|speed| >= 0.5) [%] |"
+    )
+    for j, joint in enumerate(cal.joints):
+        moving = np.abs(joint.speed) >= 0.5
+        speed = joint.speed[moving]
+        measured = DQ_VOLTAGE_FACTOR * joint.voltage[moving] * np.abs(joint.current[moving])
+        ours, theirs = (_point_power(r, j, speed) for r in (built_in, calibrated))
+        fast = int(np.argmax(speed))
+        err = [100 * np.mean(np.abs(x / measured - 1)) for x in (ours, theirs)]
+        print(
+            f"| {built_in.joints[j].name} | {measured[fast]:.1f} | {ours[fast]:.1f} | "
+            f"{theirs[fast]:.1f} | {err[0]:.0f} / {err[1]:.1f} |"
+        )
+    motion = paper_trajectory(built_in, "test-a")
+    e0 = energy(built_in, motion).total_e_elec
+    e1 = energy(calibrated, motion).total_e_elec
+    print(
+        f"test A electrical energy: built-in ur5e {e0:.0f} J, calibrated friction and motors {e1:.0f} J"
+    )
 
 
 def _ur10e_logs(pattern: str) -> list[IdentData]:
