@@ -70,9 +70,11 @@ SOURCE_STATUSES = ("published", "seed", "identified", "calibration", "nominal", 
 #: the largest magnitude each parameter may have (SI units): far beyond any real arm, small enough
 #: that the dynamics stay finite; a file with ``gravity = [0, 0, 1e308]`` is refused, not run
 MAGNITUDES = {
-    "mass": 1e4,  # kg
-    "com": 100.0,  # m
-    "inertia": 1e5,  # kg m^2
+    # links: loose, since a full identification may give a link that the logs cannot see
+    # (its base parameters unidentifiable) a mass of 1e8 kg; still far from overflow
+    "mass": 1e12,  # kg
+    "com": 1e6,  # m
+    "inertia": 1e15,  # kg m^2
     "d": 100.0,  # m
     "a": 100.0,
     "alpha": 100.0,  # rad

@@ -64,7 +64,6 @@ import tomli_w
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write, read_toml
 from kinergy.model.robot import (
-    MAGNITUDES,
     SOURCE_CATEGORIES,
     Drive,
     Friction,
@@ -130,6 +129,8 @@ _NON_NEGATIVE_FRICTION = {
 #: the largest magnitude of a friction parameter in a file (N m, N m s/rad, s/rad: far above any
 #: motor's, small enough that the torques stay finite)
 _FRICTION_MAX = 1e6
+#: the heaviest payload ``--payload`` takes, kg (the largest arms carry a few hundred)
+_PAYLOAD_MAX = 1e4
 
 
 def _at(where: str, build: Callable[[], T]) -> T:
@@ -462,9 +463,9 @@ def parse_payload(text: str) -> Payload:
         raise KinergyError(
             f"--payload: expected MASS, MASS,CX,CY,CZ or 10 numbers with the inertia; got {len(values)}"
         )
-    if not 0.0 <= values[0] <= MAGNITUDES["mass"]:
+    if not 0.0 <= values[0] <= _PAYLOAD_MAX:
         raise KinergyError(
-            f"--payload: mass must be from 0 to {MAGNITUDES['mass']:g} kg, got {values[0]:g}"
+            f"--payload: mass must be from 0 to {_PAYLOAD_MAX:g} kg, got {values[0]:g}"
         )
     com = values[1:4] if len(values) >= 4 else [0.0, 0.0, 0.0]
     inertia = values[4:10] if len(values) == 10 else [0.0] * 6
