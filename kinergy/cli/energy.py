@@ -87,6 +87,6 @@ def energy(
     with --columns) or a motion file.
     """
     r = load(model, payload)
-    motion = read_motion(motion_path, n_joints=r.n, columns=columns, source=source)
+    motion = read_motion(motion_path, n_joints=r.n, columns=columns, source=source, robot=r)
     report = account(r, motion, recovery=not no_recovery).to_dict()
     click.echo(dumps(report) if as_json else energy_text(report))

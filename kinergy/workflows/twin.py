@@ -27,7 +27,9 @@ def simulate_to_file(
     if trajectory in TEST_TRAJECTORIES:
         motion = paper_trajectory(robot, trajectory)
     else:
-        motion = read_motion(trajectory, n_joints=robot.n, columns=columns, source="target")
+        motion = read_motion(
+            trajectory, n_joints=robot.n, columns=columns, source="target", robot=robot
+        )
     twin = simulate(robot, motion, settings, name=os.fspath(out))
     write_log(out, twin.t, twin.signals)
     return twin
