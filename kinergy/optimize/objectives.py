@@ -16,6 +16,13 @@ on the DC bus: ``int sum_j W_elec,j dt`` with ``W_elec = tau_m^2 / k_m^2 + (k_b/
 (:func:`kinergy.predict.drive_state`), braking energy returned to the bus (signed, as the seed)
 or, without recovery, the summed bus power clipped at 0 (the supply takes nothing back), as
 :func:`kinergy.accounting.energy.energy` counts the total.
+
+:class:`SupplyEnergy` (what :func:`kinergy.optimize.programs.optimize_program` minimises) is the
+energy the arm draws from its supply: the joints' electrical powers summed on the DC bus, a
+braking surplus lost in the shunt (the bus power clipped at 0), plus the controller's standby
+power times the cycle time. It is :class:`ElectricalEnergy` without recovery plus standby until
+a DC-bus model of the drives replaces the bus sum (:data:`PROGRAM_OBJECTIVE` names the one the
+program optimiser uses: switching is that one line).
 """
 
 from __future__ import annotations
@@ -28,7 +35,7 @@ from numpy.typing import NDArray
 
 from kinergy.optimize.program import ProgramSamples
 
-__all__ = ["ElectricalEnergy", "Objective", "bus_power"]
+__all__ = ["PROGRAM_OBJECTIVE", "ElectricalEnergy", "Objective", "SupplyEnergy", "bus_power"]
 
 Array = NDArray[np.float64]
 
@@ -61,3 +68,25 @@ class ElectricalEnergy:
 
     def __call__(self, samples: ProgramSamples) -> tuple[Array, Array]:
         return samples.integrate(bus_power(samples, recovery=self.recovery))
+
+
+@dataclass(frozen=True)
+class SupplyEnergy:
+    """The energy the arm draws from its supply per program, J: ``int (max(sum_j W_elec,j, 0)
+    + P_standby) dt`` (UR5e eq 23 summed on the DC bus, braking surplus lost, standby power).
+
+    Parameters
+    ----------
+    standby : float
+        Power the controller and the arm draw whatever the motion, W (>= 0): adds
+        ``standby * cycle time``.
+    """
+
+    standby: float = 0.0
+
+    def __call__(self, samples: ProgramSamples) -> tuple[Array, Array]:
+        return samples.integrate(bus_power(samples, recovery=False) + self.standby)
+
+
+#: the objective of :func:`kinergy.optimize.programs.optimize_program`, given the standby power
+PROGRAM_OBJECTIVE = SupplyEnergy

@@ -71,21 +71,26 @@ def tool_segment(start: Array, end: Array) -> ToolSegment:
     return ToolSegment(start, end, shift, turn, length)
 
 
-def _skew_exp(axis: Array) -> Array:
+def _rotations(rotvec: Array) -> Array:
     """Rotation matrices of rotation vectors (..., 3) -> (..., 3, 3)."""
-    flat = axis.reshape(-1, 3)
-    return Rotation.from_rotvec(flat).as_matrix().reshape(*axis.shape[:-1], 3, 3)
+    flat = rotvec.reshape(-1, 3)
+    return Rotation.from_rotvec(flat).as_matrix().reshape(*rotvec.shape[:-1], 3, 3)
 
 
 def tool_motion(
-    segments: list[ToolSegment], s: Array, sd: Array, sdd: Array
+    start: Array, shift: Array, turn: Array, length: Array, s: Array, sd: Array, sdd: Array
 ) -> tuple[Array, Array, Array]:
-    """TCP pose, twist and its derivative of superposed tool segments.
+    """TCP pose, twist and its derivative of superposed straight tool segments.
 
     Parameters
     ----------
-    segments : list of ToolSegment, length G
-        Consecutive segments (each starts where the previous ends).
+    start : ndarray, shape (S, 4, 4) or (4, 4)
+        The first segment's start pose (per sample, or one for all).
+    shift, turn : ndarray, shape (S, G, 3) or (G, 3)
+        Each segment's position change (m) and rotation vector (in its start's frame, rad)
+        (:class:`ToolSegment`); consecutive: each starts where the previous ends.
+    length : ndarray, shape (S, G) or (G,)
+        Each segment's path length (:attr:`ToolSegment.length`).
     s, sd, sdd : ndarray, shape (S, G)
         Each segment's distance along its path (0 to ``length``), speed and acceleration at S
         samples (m, m/s, m/s^2 or rad, rad/s, rad/s^2).
@@ -98,24 +103,25 @@ def tool_motion(
     accel : ndarray, shape (S, 6)
         Their time derivatives.
     """
-    samples = s.shape[0]
-    rot = np.broadcast_to(segments[0].start[:3, :3], (samples, 3, 3)).copy()
-    pos = np.broadcast_to(segments[0].start[:3, 3], (samples, 3)).copy()
-    vel = np.zeros((samples, 3))
-    acc = np.zeros((samples, 3))
-    omega = np.zeros((samples, 3))
-    alpha = np.zeros((samples, 3))
-    for g, seg in enumerate(segments):
-        if seg.length <= 0.0:
-            continue
-        frac, fd, fdd = s[:, g] / seg.length, sd[:, g] / seg.length, sdd[:, g] / seg.length
-        pos += frac[:, None] * seg.shift
-        vel += fd[:, None] * seg.shift
-        acc += fdd[:, None] * seg.shift
-        axis = rot @ seg.turn  # this segment's axis in the base frame, (S, 3)
-        alpha += axis * fdd[:, None] + np.cross(omega, axis) * fd[:, None]
-        omega = omega + axis * fd[:, None]
-        rot = rot @ _skew_exp(frac[:, None] * seg.turn)
+    samples, groups = s.shape
+    start = np.broadcast_to(start, (samples, 4, 4))
+    shift = np.broadcast_to(shift, (samples, groups, 3))
+    turn = np.broadcast_to(turn, (samples, groups, 3))
+    length = np.broadcast_to(length, (samples, groups))
+    rot = start[:, :3, :3].copy()
+    pos = start[:, :3, 3].copy()
+    vel, acc, omega, alpha = (np.zeros((samples, 3)) for _ in range(4))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        scale = np.where(length > 0.0, 1.0 / length, 0.0)
+    for g in range(groups):
+        frac, fd, fdd = (np.nan_to_num(x[:, g] * scale[:, g])[:, None] for x in (s, sd, sdd))
+        pos += frac * shift[:, g]
+        vel += fd * shift[:, g]
+        acc += fdd * shift[:, g]
+        axis = np.einsum("sij,sj->si", rot, turn[:, g])  # the segment's axis, base frame
+        alpha += axis * fdd + np.cross(omega, axis) * fd
+        omega = omega + axis * fd
+        rot = rot @ _rotations(frac * turn[:, g])
     pose = np.zeros((samples, 4, 4))
     pose[:, :3, :3] = rot
     pose[:, :3, 3] = pos

@@ -24,7 +24,16 @@ from kinergy.trajectory.movej import blend_starts, trapezoid, trapezoid_timing
 from kinergy.trajectory.movel import ToolSegment, joints_on_path, tool_motion
 from kinergy.trajectory.program_path import ProgramPath
 
-__all__ = ["Schedule", "payload_index", "program_motion", "sample_path", "schedule", "tool_runs"]
+__all__ = [
+    "CONTROLLER_DT",
+    "Schedule",
+    "payload_index",
+    "program_motion",
+    "sample_path",
+    "schedule",
+    "schedule_profiles",
+    "tool_runs",
+]
 
 Array = NDArray[np.float64]
 
@@ -56,24 +65,41 @@ class Schedule:
     total: Array
 
 
+def schedule_profiles(
+    path: ProgramPath, duration: Array, ramp: Array, peak: Array, accel: Array
+) -> Schedule:
+    """Plan B programs on ``path`` from their moves' profiles, each of shape (B, K): duration
+    (s), ramp time (s), peak speed and acceleration (the move's unit per s and s^2)."""
+    start = blend_starts(
+        path.travel, path.blend, duration, accel, ramp, linked=path.linked, gaps=path.gaps
+    )
+    end = start + duration
+    rows = duration.shape[0]
+    event_start = np.zeros((rows, path.event_time.size))
+    clock: dict[int, Array] = {}
+    for e, (after, time) in enumerate(zip(path.event_after, path.event_time, strict=True)):
+        begin = clock.get(int(after), np.zeros(rows) if after < 0 else end[:, after])
+        event_start[:, e] = begin
+        clock[int(after)] = begin + time
+    total = end[:, -1] + path.tail
+    return Schedule(start, duration, ramp, peak, accel, event_start, total)
+
+
 def schedule(path: ProgramPath, speed: ArrayLike, accel: ArrayLike) -> Schedule:
-    """Plan B programs on ``path`` at per-move ``v`` and ``a``, shape (B, K) or (K,)."""
+    """Plan B programs on ``path`` at per-move ``v`` and ``a``, shape (B, K) or (K,)
+    (:func:`kinergy.trajectory.movej.trapezoid_timing`; a move that does not move lasts 0 s)."""
     v = np.atleast_2d(np.asarray(speed, dtype=float))
     a = np.atleast_2d(np.asarray(accel, dtype=float))
     v, a = np.broadcast_arrays(v, a)
     duration, ramp, peak = trapezoid_timing(path.travel, v, a)
-    start = blend_starts(
-        path.travel, path.blend, duration, a, ramp, linked=path.linked, gaps=path.gaps
+    still = path.travel <= 0.0
+    return schedule_profiles(
+        path,
+        duration,
+        np.where(still, 0.0, ramp),
+        np.where(still, 0.0, peak),
+        np.where(still, 0.0, np.asarray(a, dtype=float)),
     )
-    end = start + duration
-    event_start = np.zeros((v.shape[0], path.event_time.size))
-    clock: dict[int, Array] = {}
-    for e, (after, time) in enumerate(zip(path.event_after, path.event_time, strict=True)):
-        begin = clock.get(int(after), np.zeros(v.shape[0]) if after < 0 else end[:, after])
-        event_start[:, e] = begin
-        clock[int(after)] = begin + time
-    total = end[:, -1] + path.tail
-    return Schedule(start, duration, ramp, peak, np.asarray(a, dtype=float), event_start, total)
 
 
 def tool_runs(path: ProgramPath) -> list[list[int]]:
@@ -121,7 +147,15 @@ def _tool_run(
     profiles = [_profiles(sched, t, k) for k in run]
     s, sd, sdd = (np.stack([p[i][active] for p in profiles], axis=1) for i in range(3))
     segments: list[ToolSegment] = [seg for k in run if (seg := path.tool[k]) is not None]
-    pose, twist, acc = tool_motion(segments, s, sd, sdd)
+    pose, twist, acc = tool_motion(
+        segments[0].start,
+        np.array([seg.shift for seg in segments]),
+        np.array([seg.turn for seg in segments]),
+        np.array([seg.length for seg in segments]),
+        s,
+        sd,
+        sdd,
+    )
     ref = q_a + sum(
         (path.q_end[k] - path.q_start[k]) * (s[:, i] / max(path.travel[k], 1e-300))[:, None]
         for i, k in enumerate(run)
@@ -181,12 +215,10 @@ def payload_index(path: ProgramPath, sched: Schedule, t: ArrayLike) -> NDArray[n
     move or event started at or before it (in program order)."""
     times = np.atleast_2d(np.asarray(t, dtype=float))
     order: list[tuple[str, int]] = []
-    events = iter(range(path.event_time.size))
-    pending = list(events)
     for k in range(-1, path.moves):
         if k >= 0:
             order.append(("move", k))
-        order.extend(("event", e) for e in pending if path.event_after[e] == k)
+        order.extend(("event", int(e)) for e in np.flatnonzero(path.event_after == k))
     starts = np.stack(
         [sched.start[:, i] if kind == "move" else sched.event_start[:, i] for kind, i in order],
         axis=1,

@@ -11,8 +11,9 @@ controller does, from a start pose:
   branch it starts in; its end joints are where the line leads (followed at 64 points);
 - ``set_tcp`` and ``set_payload`` change the tool and the load from there on; every other event
   is time at rest;
-- a blend radius ``r`` (m, at the tool) joins two moves of the same kind (joint or tool space)
-  with no event between them; anywhere else the move stops at its target. A ``movej``'s radius
+- a blend radius ``r`` (m, at the tool) joins two moves with no event between them (of any kind:
+  :mod:`kinergy.trajectory.program_motion` adds their displacements); anywhere else the move
+  stops at its target. A ``movej``'s radius
   becomes the leading joint's distance to go when the tool enters the sphere of radius ``r``
   around its target (the joint-space line is fixed, so this does not depend on the timing).
 
@@ -45,7 +46,14 @@ from kinergy.trajectory.movel import ToolSegment, tool_motion, tool_segment
 from kinergy.trajectory.programs import UR_HOME
 from kinergy.trajectory.robot_program import Event, Move, RobotProgram
 
-__all__ = ["ProgramPath", "move_settings", "program_path", "tool_blend_radius"]
+__all__ = [
+    "ProgramPath",
+    "follow_line",
+    "line_joints",
+    "move_settings",
+    "program_path",
+    "tool_blend_radius",
+]
 
 Array = NDArray[np.float64]
 
@@ -169,14 +177,22 @@ def tool_blend_radius(robot: Robot, tcp: Array, q_a: Array, q_b: Array, r: float
     return float(travel * (1.0 - (s[i] + f * (s[i + 1] - s[i]))))
 
 
-def _follow_line(
+def follow_line(
     robot: Robot, g: URGeometry, tcp: Array, q_a: Array, segment: ToolSegment, branch: int
 ) -> Array:
     """Joints along a straight tool line from ``q_a`` (the branch it starts in), unwrapped
     continuously, shape (_LINE_POINTS, n)."""
     s = np.linspace(0.0, segment.length, _LINE_POINTS)[:, None]
     zero = np.zeros_like(s)
-    pose, _, _ = tool_motion([segment], s, zero, zero)
+    pose, _, _ = tool_motion(
+        segment.start,
+        segment.shift[None],
+        segment.turn[None],
+        np.array([segment.length]),
+        s,
+        zero,
+        zero,
+    )
     flange = pose @ np.linalg.inv(tcp)
     q = ik_branches(g, flange, hint6=np.full(_LINE_POINTS, q_a[5]))[:, branch]
     if np.any(np.isnan(q)):
@@ -187,6 +203,16 @@ def _follow_line(
     if np.any(jumps > 0.5):
         raise KinergyError("the straight line passes a singularity of the arm (a wrist flip)")
     return np.asarray(q)
+
+
+def line_joints(robot: Robot, path: ProgramPath, k: int) -> Array:
+    """Joints along tool move ``k``'s straight line (without blends), shape (64, n), rad."""
+    segment = path.tool[k]
+    if segment is None or path.geometry is None:
+        raise KinergyError(f"move {k + 1} is not a tool move")
+    return follow_line(
+        robot, path.geometry, path.tcp[k], path.q_start[k], segment, int(path.branch[k])
+    )
 
 
 def _check_limits(robot: Robot, q: Array) -> None:
@@ -230,7 +256,7 @@ class _Walk:
             end = self._target_pose(move)
             segment = tool_segment(start, end)
             branch = branch_of(self.g, q_a, start @ np.linalg.inv(self.tcp))
-            q_b = _follow_line(self.robot, self.g, self.tcp, q_a, segment, branch)[-1]
+            q_b = follow_line(self.robot, self.g, self.tcp, q_a, segment, branch)[-1]
             travel = segment.length
         else:
             segment = None
@@ -269,17 +295,16 @@ def _optional_geometry(robot: Robot) -> URGeometry | None:
         return None
 
 
-def _links(program: RobotProgram, path_tool: list[bool]) -> NDArray[np.bool_]:
-    """Whether each move blends into the next: ``r`` > 0, the next step is a move of the same
-    space (no event between), and it is not the last move."""
+def _links(program: RobotProgram) -> NDArray[np.bool_]:
+    """Whether each move blends into the next: ``r`` > 0, the next step is a move (no event
+    between), and it is not the last move."""
     steps = program.steps
     index = program.move_index
     out = np.zeros(len(index), dtype=bool)
     for k, i in enumerate(index[:-1]):
         move = steps[i]
         assert isinstance(move, Move)
-        follows = i + 1 < len(steps) and isinstance(steps[i + 1], Move)
-        out[k] = move.r > 0.0 and follows and path_tool[k] == path_tool[k + 1]
+        out[k] = move.r > 0.0 and isinstance(steps[i + 1], Move)
     return out
 
 
@@ -344,8 +369,7 @@ def program_path(
 
 def _path(robot: Robot, program: RobotProgram, walk: _Walk, q0: Array) -> ProgramPath:
     rows = walk.rows
-    tool = [row[1] is not None for row in rows]
-    linked = _links(program, tool)
+    linked = _links(program)
     q_end = np.array([row[0] for row in rows])
     q_start = np.vstack([q0, q_end[:-1]])
     blend = np.zeros(len(rows))
