@@ -190,7 +190,7 @@ def _tool_moves(
     try:
         q, qd, qdd = joints_on_path(robot, path.geometry, tcp, branch, pose, twist, acc, ref)
     except KinergyError:
-        return (np.full(shape, np.nan),) * 3 + (weights, duration)  # type: ignore[return-value]
+        return (np.full(shape, np.nan),) * 3 + (weights, duration)
     return q.reshape(shape), qd.reshape(shape), qdd.reshape(shape), weights, duration
 
 

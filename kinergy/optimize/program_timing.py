@@ -170,10 +170,11 @@ def scaled_to(
 
 
 def retime(
-    checks: PathChecks, budget: float, *, share_budget: bool = True
+    checks: PathChecks, budget: float, *, share_budget: bool = True, maxiter: int = 15
 ) -> tuple[ProgramResult, str, int]:
     """The verified energy-optimal timing at ``budget`` s (from the program uniformly scaled to
-    it): the result, the solver's message and its iterations.
+    it; at most ``maxiter`` SLSQP iterations per attempt): the result, the solver's message and its
+    iterations.
 
     Raises
     ------
@@ -192,4 +193,4 @@ def retime(
         )
     v0, a0 = scaled_to(problem, path, path.speed, path.accel, budget)
     uniform = checks.run(v0, a0, "uniform")
-    return best_verified(checks, budget, v0, a0, uniform, share_budget)
+    return best_verified(checks, budget, v0, a0, uniform, share_budget, maxiter)

@@ -245,7 +245,13 @@ def _tightened(problem: TimingProblem, over: dict[str, float]) -> TimingProblem:
 
 
 def _optimum(
-    checks: Checks, cycle_time: float, v0: Array, a0: Array, *, share_budget: bool
+    checks: Checks,
+    cycle_time: float,
+    v0: Array,
+    a0: Array,
+    *,
+    share_budget: bool,
+    maxiter: int = 150,
 ) -> tuple[ProgramResult, Solution | None, int]:
     """Solve, re-simulate at 500 Hz, and tighten the bounds by any excess found there (up to
     four attempts). Returns the verified program, the last solution (None at the fastest cycle
@@ -261,7 +267,13 @@ def _optimum(
     iterations = 0
     for _ in range(4):
         sol = solve_timing(
-            current, cycle_time, v0=v0, a0=a0, share_budget=share_budget, torque_margin=margin
+            current,
+            cycle_time,
+            v0=v0,
+            a0=a0,
+            share_budget=share_budget,
+            torque_margin=margin,
+            maxiter=maxiter,
         )
         iterations += sol.iterations
         result = checks.run(sol.v, sol.a, "optimized", sol.value)
@@ -310,12 +322,15 @@ def best_verified(
     a0: Array,
     uniform: ProgramResult,
     share_budget: bool,
+    maxiter: int = 150,
 ) -> tuple[ProgramResult, str, int]:
     """The verified optimum at ``cycle_time`` from ``(v0, a0)``: solved, re-simulated at 500 Hz
     and re-solved with the caps tightened by any excess found there (up to four attempts), or
     ``uniform`` should the solver end above it; the solver's message (and the fallback taken)
-    and its iterations."""
-    optimized, sol, iterations = _optimum(checks, cycle_time, v0, a0, share_budget=share_budget)
+    and its iterations (``maxiter``: SLSQP's limit per attempt)."""
+    optimized, sol, iterations = _optimum(
+        checks, cycle_time, v0, a0, share_budget=share_budget, maxiter=maxiter
+    )
     message = "fastest cycle time: every move at its limits" if sol is None else sol.message
     # uniform scaling to the budget is the program itself at the program's own cycle time
     if uniform_wins(uniform, optimized):
