@@ -17,20 +17,7 @@ from kinergy.trajectory.robot_program import Event, Move
 
 PROGRAMS = Path(__file__).parent.parent / "benchmarks" / "programs"
 
-SMALL = """def small():
-  set_tcp(p[0, 0, 0.12, 0, 0, 0])
-  set_payload(0.5)
-  home = [0.0, -1.75, 1.6, -1.4208, -1.5708, 0.0]
-  above = p[-0.34228, -0.36621, 0.25191, 2.52847, 1.86453, 0.0]
-  movej(home, a=1.4, v=1.05)
-  movej(above, a=1.4, v=1.05)
-  movel(p[-0.34228, -0.36621, 0.15191, 2.52847, 1.86453, 0.0], a=1.2, v=0.25)  # down
-  set_standard_digital_out(0, True)
-  sleep(0.25)
-  movel(above, a=1.2, v=0.25, r=0.02)
-  movej(home, a=1.4, v=1.05)
-end
-"""
+SMALL = (Path(__file__).parent / "programs" / "small.script").read_text()
 
 
 def test_reads_moves_events_and_variables() -> None:

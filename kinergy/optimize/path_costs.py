@@ -4,13 +4,14 @@ Each move's target can be reached in several joint configurations: the inverse-k
 (:mod:`kinergy.dynamics.ik`: eight for a pose target of a movej with ``--configurations free``;
 the program's own otherwise) and, for a tool symmetric about its z axis, any turn of the target
 about that axis (:data:`kinergy.optimize.program_verify.SYMMETRIES`: 180 or 90 degree steps, or
-every 30 degrees for ``z``). :func:`target_states` lists them per move, each as joints in
-``(-pi, pi]`` (the ``2 pi`` choice is made later, joint by joint).
+every 30 degrees for ``z``). :func:`target_states` lists them per move, each joint at the ``2 pi``
+choice nearest the program's own joints there (so a cycle of states is a cycle of joints: the
+program ends where it starts).
 
 :func:`move_costs` estimates the energy of every move from each state of its start target to
 each state of its end target: the move alone, from rest to rest, at the program's own ``v`` and
-``a`` (a movej along the joint-space line with the smaller ``2 pi`` turn of every joint; a tool
-move on its straight line, in the branch it starts in, and only to states of that branch), its
+``a`` (a movej along the joint-space line between the two states; a tool move on its straight
+line, in the branch it starts in, and only to the state where the line leads), its
 drive model at Gauss-Legendre nodes of its three phases with the load the program sets there, the
 bus power clipped at 0 plus standby; and the energy of holding the arm still at the end target
 during the events that follow it. Moves are evaluated in chunks, all states at once.
@@ -23,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from kinergy.dynamics.ik import ik_branches, joint_limits, wrap_choices
+from kinergy.dynamics.ik import ik_branches, joint_limits, wrap_choices, wrap_near
 from kinergy.dynamics.poses import rotation_about_z, tcp_pose
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
@@ -53,7 +54,7 @@ class TargetStates:
     Attributes
     ----------
     q : ndarray, shape (S, n)
-        Joints of each state, rad, in (-pi, pi].
+        Joints of each state, rad (the ``2 pi`` choice nearest the program's own).
     branch : ndarray of int, shape (S,)
     turn : ndarray, shape (S,)
         The target's turn about the tool z axis, rad.
@@ -103,7 +104,7 @@ def target_states(
         own_q = path.q_end[k]
         if geometry is None:
             pose = tcp_pose(robot, own_q, path.tcp[k])[None]
-            out.append(TargetStates(_wrap(own_q)[None], np.array([-1]), np.zeros(1), pose, 0))
+            out.append(TargetStates(own_q[None], np.array([-1]), np.zeros(1), pose, 0))
             continue
         base = tcp_pose(robot, own_q, path.tcp[k])
         poses = rotation_about_z(base, angles)  # (A, 4, 4)
@@ -114,13 +115,11 @@ def target_states(
             for b in range(8) if any_branch else [int(path.branch[k])]:
                 q = sols[a, b]
                 if not np.any(np.isnan(q)) and _fits(q, lo, hi):
-                    rows.append((q, b, angles[a], poses[a]))
+                    rows.append((wrap_near(q, own_q, lo, hi), b, angles[a], poses[a]))
         own = next(
             i
             for i, row in enumerate(rows)
-            if row[1] == path.branch[k]
-            and row[2] == 0.0
-            and np.allclose(_wrap(row[0] - own_q), 0.0, atol=1e-6)
+            if row[1] == path.branch[k] and row[2] == 0.0 and np.allclose(row[0], own_q, atol=1e-6)
         )
         out.append(
             TargetStates(
@@ -158,10 +157,11 @@ def _joint_moves(
 
 
 def _tool_moves(
-    robot: Robot, path: ProgramPath, k: int, q_a: Array, pose_b: Array, branch: int
+    robot: Robot, path: ProgramPath, k: int, q_a: Array, pose_b: Array, branch: int, q_want: Array
 ) -> tuple[Array, Array, Array, Array, Array]:
     """Samples of tool moves (straight lines) from joints ``q_a`` (P, n) to TCP poses ``pose_b``
-    (P, 4, 4) in ``branch``: as :func:`_joint_moves`; NaN joints where a line fails."""
+    (P, 4, 4) in ``branch``: as :func:`_joint_moves`; NaN joints where a line fails or does not
+    end at the joints ``q_want`` (P, n) of the target's state."""
     assert path.geometry is not None
     tcp = path.tcp[k]
     pose_a = tcp_pose(robot, q_a, tcp)
@@ -191,7 +191,9 @@ def _tool_moves(
         q, qd, qdd = joints_on_path(robot, path.geometry, tcp, branch, pose, twist, acc, ref)
     except KinergyError:
         return (np.full(shape, np.nan),) * 3 + (weights, duration)
-    return q.reshape(shape), qd.reshape(shape), qdd.reshape(shape), weights, duration
+    q = q.reshape(shape)
+    q[np.any(np.abs(q_b - q_want) > 1e-6, axis=1)] = np.nan
+    return q, qd.reshape(shape), qdd.reshape(shape), weights, duration
 
 
 def _energy(
@@ -245,7 +247,7 @@ def move_costs(
         cost = np.full(ia.size, np.inf)
         if path.tool[k] is None:
             q_a = prev.q[ia]
-            q_b = q_a + _wrap(here.q[ib] - q_a)
+            q_b = here.q[ib]
             per = max(1, _CHUNK // (3 * _NODES))
             for lo in range(0, ia.size, per):
                 sl = slice(lo, lo + per)
@@ -258,7 +260,7 @@ def move_costs(
                 for lo in range(0, pick.size, per):
                     sel = pick[lo : lo + per]
                     samples = _tool_moves(
-                        robot, path, k, prev.q[ia[sel]], here.pose[ib[sel]], int(b)
+                        robot, path, k, prev.q[ia[sel]], here.pose[ib[sel]], int(b), here.q[ib[sel]]
                     )
                     cost[sel] = _energy(robot, path, k, samples, standby)
         cost += _hold_power(robot, path, k, here.q)[ib]

@@ -26,7 +26,7 @@ from kinergy.optimize.path_costs import TargetStates
 from kinergy.trajectory.program_path import ProgramPath
 from kinergy.trajectory.robot_program import Move
 
-__all__ = ["cheapest_cycle", "chosen_moves", "lever_mask", "masked"]
+__all__ = ["cheapest_cycle", "chosen_moves", "lever_mask", "masked", "wrapped_moves"]
 
 Array = NDArray[np.float64]
 
@@ -92,24 +92,57 @@ def masked(costs: list[Array], mask: list[NDArray[np.bool_]]) -> list[Array]:
     return out
 
 
-def chosen_moves(
-    robot: Robot, path: ProgramPath, states: list[TargetStates], choice: NDArray[np.intp]
-) -> list[Move]:
-    """The program's moves with the chosen states as their targets (module docstring)."""
-    lo, hi = joint_limits(robot)
-    moves = path.program.moves
-    q_prev = wrap_near(states[-1].q[choice[-1]], path.q_end[-1], lo, hi)
+def _closed_joints(path: ProgramPath, q: Array, lo: Array, hi: Array) -> Array:
+    """Joints of every target, each move taking the smaller turn of every joint, with the cycle
+    closed: where the turns of a joint add up to whole turns, the joint-space move whose turn of
+    that joint is closest to it goes the other way round. Shape (K, n), rad."""
+    start = wrap_near(q[-1], path.q_end[-1], lo, hi)
+    delta = _wrap(np.diff(np.vstack([q[-1:], q]), axis=0))  # (K, n): the smaller turns
+    turns = np.round(delta.sum(axis=0) / (2.0 * np.pi))
+    joint_moves = np.array([not m.tool_space for m in path.program.moves])
+    for j in np.flatnonzero(turns):
+        if not np.any(joint_moves):
+            break
+        full = 2.0 * np.pi * turns[j]
+        cost = np.where(joint_moves, np.abs(delta[:, j] - full), np.inf)
+        delta[int(np.argmin(cost)), j] -= full
+    return np.asarray(start + np.cumsum(delta, axis=0))
+
+
+def _wrap(q: Array) -> Array:
+    return np.asarray(np.pi - np.mod(np.pi - q, 2.0 * np.pi))
+
+
+def _moves_at(path: ProgramPath, q_all: Array, poses: Array, same: list[bool]) -> list[Move]:
+    """The program's moves to joints ``q_all`` (K, n) and TCP poses ``poses`` (K, 4, 4); a move
+    marked ``same`` is kept as written."""
     out = []
-    for k, move in enumerate(moves):
-        st = states[k]
-        q = wrap_near(st.q[choice[k]], q_prev, lo, hi)
-        changed = choice[k] != st.own or not np.allclose(q, path.q_end[k], atol=1e-9)
-        if not changed:
+    for k, move in enumerate(path.program.moves):
+        q = q_all[k]
+        if same[k] and np.allclose(q, path.q_end[k], atol=1e-9):
             out.append(move)
         elif not move.pose and not move.tool_space:
             out.append(move.replaced(target=q, qnear=None))
         else:
-            pose = pose_vector(st.pose[choice[k]])
+            pose = pose_vector(poses[k])
             out.append(move.replaced(target=pose, pose=True, qnear=None if move.tool_space else q))
-        q_prev = q
     return out
+
+
+def chosen_moves(
+    path: ProgramPath, states: list[TargetStates], choice: NDArray[np.intp]
+) -> list[Move]:
+    """The program's moves with the chosen states as their targets (module docstring)."""
+    q_all = np.array([st.q[c] for st, c in zip(states, choice, strict=True)])
+    poses = np.array([st.pose[c] for st, c in zip(states, choice, strict=True)])
+    same = [int(c) == st.own for st, c in zip(states, choice, strict=True)]
+    return _moves_at(path, q_all, poses, same)
+
+
+def wrapped_moves(robot: Robot, path: ProgramPath, states: list[TargetStates]) -> list[Move]:
+    """The ``2 pi`` lever: the program's own targets, each joint taking the smaller turn from the
+    joints before it (within its limits), the cycle closed (:func:`_closed_joints`)."""
+    lo, hi = joint_limits(robot)
+    q_all = _closed_joints(path, _wrap(path.q_end), lo, hi)
+    poses = np.array([st.pose[st.own] for st in states])
+    return _moves_at(path, q_all, poses, [True] * path.moves)

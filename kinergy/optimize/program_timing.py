@@ -20,6 +20,7 @@ times fixed. :func:`path_problem` states it as a
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -170,11 +171,17 @@ def scaled_to(
 
 
 def retime(
-    checks: PathChecks, budget: float, *, share_budget: bool = True, maxiter: int = 15
+    checks: PathChecks,
+    budget: float,
+    *,
+    share_budget: bool = True,
+    maxiter: int = 15,
+    seconds: float = 20.0,
 ) -> tuple[ProgramResult, str, int]:
     """The verified energy-optimal timing at ``budget`` s (from the program uniformly scaled to
-    it; at most ``maxiter`` SLSQP iterations per attempt): the result, the solver's message and its
-    iterations.
+    it; at most ``maxiter`` SLSQP iterations per attempt, and the solver stops where it is after
+    about ``seconds`` s: a long program's timing is then improved, not optimal): the result, the
+    solver's message and its iterations.
 
     Raises
     ------
@@ -193,4 +200,5 @@ def retime(
         )
     v0, a0 = scaled_to(problem, path, path.speed, path.accel, budget)
     uniform = checks.run(v0, a0, "uniform")
-    return best_verified(checks, budget, v0, a0, uniform, share_budget, maxiter)
+    deadline = time.monotonic() + seconds
+    return best_verified(checks, budget, v0, a0, uniform, share_budget, maxiter, deadline)

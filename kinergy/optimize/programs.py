@@ -39,7 +39,14 @@ from kinergy.model.robot import Robot
 from kinergy.optimize.objectives import PROGRAM_OBJECTIVE, Objective
 from kinergy.optimize.path_costs import move_costs, symmetry_angles, target_states
 from kinergy.optimize.problem import uniform_scaling
-from kinergy.optimize.program_search import cheapest_cycle, chosen_moves, lever_mask, masked
+from kinergy.optimize.program import serial
+from kinergy.optimize.program_search import (
+    cheapest_cycle,
+    chosen_moves,
+    lever_mask,
+    masked,
+    wrapped_moves,
+)
 from kinergy.optimize.program_timing import PathChecks, path_problem, retime
 from kinergy.optimize.program_verify import PathRun, TargetCheck, simulate_path, target_errors
 from kinergy.optimize.verify import ProgramResult
@@ -250,7 +257,11 @@ def _search_levers(
     states = target_states(search.robot, path, free=free, symmetry=symmetry)
     say(f"estimating {sum(s.q.shape[0] for s in states)} target states' moves")
     costs = move_costs(search.robot, path, states, standby=standby)
-    levels = [("2pi", False, False)]
+    say("2pi: re-simulating")
+    search.try_program(
+        "2pi", path.program.with_moves(wrapped_moves(search.robot, path, states)), "smaller turns"
+    )
+    levels = []
     if free:
         levels.append(("configurations", True, False))
     if symmetry != "none":
@@ -262,11 +273,12 @@ def _search_levers(
         if not np.isfinite(estimate):
             continue
         changed = sum(int(c != s.own) for c, s in zip(choice, states, strict=True))
-        moves = chosen_moves(search.robot, path, states, choice)
+        moves = chosen_moves(path, states, choice)
         say(f"{name}: estimated {estimate:.1f} J, re-simulating")
         search.try_program(name, path.program.with_moves(moves), f"{changed} target states changed")
 
 
+@serial
 def optimize_program(
     robot: Robot,
     program: RobotProgram,

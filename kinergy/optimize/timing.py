@@ -252,6 +252,7 @@ def _optimum(
     *,
     share_budget: bool,
     maxiter: int = 150,
+    deadline: float | None = None,
 ) -> tuple[ProgramResult, Solution | None, int]:
     """Solve, re-simulate at 500 Hz, and tighten the bounds by any excess found there (up to
     four attempts). Returns the verified program, the last solution (None at the fastest cycle
@@ -274,6 +275,7 @@ def _optimum(
             share_budget=share_budget,
             torque_margin=margin,
             maxiter=maxiter,
+            deadline=deadline,
         )
         iterations += sol.iterations
         result = checks.run(sol.v, sol.a, "optimized", sol.value)
@@ -282,7 +284,7 @@ def _optimum(
             for kind, (ratio, _, _) in result.check.worst().items()
             if ratio > 1.0 + LIMIT_TOL
         }
-        if not over or "position" in over:
+        if not over or "position" in over or (deadline is not None and time.monotonic() > deadline):
             break  # (a movej cannot leave the box its waypoints span: nothing to tighten)
         current = _tightened(current, over)
         if "torque" in over:
@@ -323,13 +325,16 @@ def best_verified(
     uniform: ProgramResult,
     share_budget: bool,
     maxiter: int = 150,
+    deadline: float | None = None,
 ) -> tuple[ProgramResult, str, int]:
     """The verified optimum at ``cycle_time`` from ``(v0, a0)``: solved, re-simulated at 500 Hz
     and re-solved with the caps tightened by any excess found there (up to four attempts), or
     ``uniform`` should the solver end above it; the solver's message (and the fallback taken)
-    and its iterations (``maxiter``: SLSQP's limit per attempt)."""
+    and its iterations (``maxiter``: SLSQP's limit per attempt; ``deadline``: a
+    ``time.monotonic()`` after which the solver stops where it is and no further attempt is
+    made)."""
     optimized, sol, iterations = _optimum(
-        checks, cycle_time, v0, a0, share_budget=share_budget, maxiter=maxiter
+        checks, cycle_time, v0, a0, share_budget=share_budget, maxiter=maxiter, deadline=deadline
     )
     message = "fastest cycle time: every move at its limits" if sol is None else sol.message
     # uniform scaling to the budget is the program itself at the program's own cycle time
