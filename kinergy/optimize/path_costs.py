@@ -4,9 +4,10 @@ Each move's target can be reached in several joint configurations: the inverse-k
 (:mod:`kinergy.dynamics.ik`: eight for a pose target of a movej with ``--configurations free``;
 the program's own otherwise) and, for a tool symmetric about its z axis, any turn of the target
 about that axis (:data:`kinergy.optimize.program_verify.SYMMETRIES`: 180 or 90 degree steps, or
-every 30 degrees for ``z``). :func:`target_states` lists them per move, each joint at the ``2 pi``
+every 45 degrees for ``z``). :func:`target_states` lists them per move, each joint at the ``2 pi``
 choice nearest the program's own joints there (so a cycle of states is a cycle of joints: the
-program ends where it starts).
+program ends where it starts), and for 180 and 90 degree turns also with the last joint the
+other way round.
 
 :func:`move_costs` estimates the energy of every move from each state of its start target to
 each state of its end target: the move alone, from rest to rest, at the program's own ``v`` and
@@ -40,11 +41,11 @@ __all__ = ["TargetStates", "move_costs", "symmetry_angles", "target_states"]
 Array = NDArray[np.float64]
 
 #: Gauss-Legendre nodes per phase (ramp up, cruise, braking) of the estimate
-_NODES = 6
+_NODES = 4
 #: samples evaluated at once (memory: about 1 kB each)
 _CHUNK = 60_000
 #: steps of the turn about a fully symmetric tool's axis, rad
-_Z_STEP = np.pi / 6
+_Z_STEP = np.pi / 4
 
 
 @dataclass(frozen=True, eq=False)
@@ -91,6 +92,18 @@ def _fits(q: Array, lo: Array, hi: Array) -> bool:
     return bool(np.all(np.any(~np.isnan(wrap_choices(q, lo, hi, most=1)), axis=-1)))
 
 
+def _turn_choices(q: Array, own: Array, lo: Array, hi: Array, *, both: bool) -> list[Array]:
+    """A state's joints at the ``2 pi`` choice nearest the program's own, and with ``both`` the
+    other way round for the last joint (a turned tool can get there either way), if within its
+    limits."""
+    near = wrap_near(q, own, lo, hi)
+    if not both:
+        return [near]
+    other = near.copy()
+    other[-1] -= 2.0 * np.pi * np.sign(near[-1] - own[-1])
+    return [near, other] if lo[-1] <= other[-1] <= hi[-1] else [near]
+
+
 def target_states(
     robot: Robot, path: ProgramPath, *, free: bool, symmetry: str
 ) -> list[TargetStates]:
@@ -110,12 +123,14 @@ def target_states(
         poses = rotation_about_z(base, angles)  # (A, 4, 4)
         sols = ik_branches(geometry, poses @ np.linalg.inv(path.tcp[k]), hint6=own_q[5])
         any_branch = move.tool_space or (free and move.pose)
+        few = angles.size <= 4
         rows = []
         for a in range(angles.size):
             for b in range(8) if any_branch else [int(path.branch[k])]:
                 q = sols[a, b]
                 if not np.any(np.isnan(q)) and _fits(q, lo, hi):
-                    rows.append((wrap_near(q, own_q, lo, hi), b, angles[a], poses[a]))
+                    for q_s in _turn_choices(q, own_q, lo, hi, both=few and angles[a] != 0.0):
+                        rows.append((q_s, b, angles[a], poses[a]))
         own = next(
             i
             for i, row in enumerate(rows)
