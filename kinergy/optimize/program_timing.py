@@ -180,7 +180,7 @@ def retime(
 ) -> tuple[ProgramResult, str, int]:
     """The verified energy-optimal timing at ``budget`` s (from the program uniformly scaled to
     it; at most ``maxiter`` SLSQP iterations per attempt, and the solver stops where it is after
-    about ``seconds`` s: a long program's timing is then improved, not optimal): the result, the
+    about ``seconds`` s of processor time: a long program's timing is then improved, not optimal): the result, the
     solver's message and its iterations.
 
     Raises
@@ -200,5 +200,5 @@ def retime(
         )
     v0, a0 = scaled_to(problem, path, path.speed, path.accel, budget)
     uniform = checks.run(v0, a0, "uniform")
-    deadline = time.monotonic() + seconds
+    deadline = time.process_time() + seconds
     return best_verified(checks, budget, v0, a0, uniform, share_budget, maxiter, deadline)

@@ -231,7 +231,7 @@ def solve_timing(
     maxiter : int
         SLSQP iterations.
     deadline : float, optional
-        ``time.monotonic()`` after which SLSQP stops at its current iterate.
+        ``time.process_time()`` after which SLSQP stops at its current iterate.
 
     Returns
     -------
@@ -244,7 +244,7 @@ def solve_timing(
     model = _Model(problem, variables, x0)
 
     def stop(_: Array) -> None:
-        if deadline is not None and time.monotonic() > deadline:
+        if deadline is not None and time.process_time() > deadline:
             raise StopIteration
 
     res = minimize(

@@ -284,7 +284,11 @@ def _optimum(
             for kind, (ratio, _, _) in result.check.worst().items()
             if ratio > 1.0 + LIMIT_TOL
         }
-        if not over or "position" in over or (deadline is not None and time.monotonic() > deadline):
+        if (
+            not over
+            or "position" in over
+            or (deadline is not None and time.process_time() > deadline)
+        ):
             break  # (a movej cannot leave the box its waypoints span: nothing to tighten)
         current = _tightened(current, over)
         if "torque" in over:
@@ -331,7 +335,7 @@ def best_verified(
     and re-solved with the caps tightened by any excess found there (up to four attempts), or
     ``uniform`` should the solver end above it; the solver's message (and the fallback taken)
     and its iterations (``maxiter``: SLSQP's limit per attempt; ``deadline``: a
-    ``time.monotonic()`` after which the solver stops where it is and no further attempt is
+    ``time.process_time()`` after which the solver stops where it is and no further attempt is
     made)."""
     optimized, sol, iterations = _optimum(
         checks, cycle_time, v0, a0, share_budget=share_budget, maxiter=maxiter, deadline=deadline
