@@ -88,7 +88,7 @@ def test_never_writes_over_the_program(tmp_path: Path) -> None:
         optimize, ["ur5e", str(source), "--urscript", str(source), "--no-blends"]
     )
     assert result.exit_code != 0
-    assert "will not write over" in str(result.exception)
+    assert "is also an input" in str(result.exception)
     assert source.read_text() == SMALL
 
 

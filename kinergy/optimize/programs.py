@@ -333,26 +333,15 @@ def optimize_program(
     objective = PROGRAM_OBJECTIVE(standby)
     path = program_path(robot, program)
     say(f"{program.name}: simulating the program at 500 Hz")
-    own = simulate_path(robot, path, objective=objective)
-    caps = (
-        float(np.max(np.abs(own.motion.qd))) if v_max is None else v_max,
-        float(np.max(np.abs(own.motion.qdd))) if a_max is None else a_max,
-    )
-    own = simulate_path(
-        robot, path, objective=objective, speed_cap=caps[0], acceleration_cap=caps[1]
-    )
+    own, caps = _as_written(robot, path, objective, v_max, a_max)
     budget = own.result.cycle_time if cycle_time is None else cycle_time
     search = _Search(robot, budget, objective, caps, own)
     search.levers.append(Lever("program", own.result, True, "as written"))
     _search_levers(search, path, configurations == "free", tool_symmetry, standby, say)
     if blends:
         say("blends: re-simulating")
-        best_path = search.best.path
-        search.try_program(
-            "blends",
-            best_path.program.with_moves(via_blends(robot, best_path)),
-            "via points blended",
-        )
+        best = search.best.path
+        search.try_program("blends", best.program.with_moves(via_blends(robot, best)), "blended")
     optimized = _timed(search, say)
     levers = tuple(search.levers)
     if compare_timing:
@@ -370,6 +359,22 @@ def optimize_program(
         "cycle_time": budget,
     }
     return ProgramOptimization(own, optimized, levers, targets, settings)
+
+
+def _as_written(
+    robot: Robot, path: ProgramPath, objective: Objective, v_max: float | None, a_max: float | None
+) -> tuple[PathRun, tuple[float, float]]:
+    """The program re-simulated, and the joint speed and acceleration caps: ``v_max`` and
+    ``a_max``, or the program's own peaks."""
+    own = simulate_path(robot, path, objective=objective)
+    caps = (
+        float(np.max(np.abs(own.motion.qd))) if v_max is None else v_max,
+        float(np.max(np.abs(own.motion.qdd))) if a_max is None else a_max,
+    )
+    checked = simulate_path(
+        robot, path, objective=objective, speed_cap=caps[0], acceleration_cap=caps[1]
+    )
+    return checked, caps
 
 
 def _timed(search: _Search, say: Callable[[str], None]) -> PathRun:

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from kinergy.errors import KinergyError
+from kinergy.files import atomic_folder, check_outputs
 from kinergy.io.rtde import write_log
 from kinergy.io.urscript import program_script, write_script
 from kinergy.io.urscript_reader import parse_program, read_program
@@ -82,38 +82,22 @@ def _motion_signals(motion: Motion) -> dict[str, Any]:
     return {"target_q": motion.q, "target_qd": motion.qd, "target_qdd": motion.qdd}
 
 
-def _outputs(
-    source: Path, urscript: str | os.PathLike[str] | None, motions: str | os.PathLike[str] | None
-) -> list[Path]:
-    """The files to write; refuses any that is the program being optimised."""
-    targets: list[Path] = []
-    if urscript is not None:
-        targets.append(Path(urscript))
-    if motions is not None:
-        targets += [Path(motions) / "program.csv", Path(motions) / "optimized.csv"]
-    for path in targets:
-        if path.exists() and path.resolve() == source.resolve():
-            raise KinergyError(f"{path}: will not write over the program being optimised")
-    return targets
-
-
 def _write(
     run: tuple[ProgramOptimization, str],
     urscript: str | os.PathLike[str] | None,
     motions: str | os.PathLike[str] | None,
 ) -> list[Path]:
-    """Write the URScript and the motions where asked: all or none."""
+    """Write the URScript and the motions folder where asked: all or none."""
     result, script = run
     written: list[Path] = []
     try:
         if urscript is not None:
             written.append(write_script(urscript, script))
         if motions is not None:
-            Path(motions).mkdir(parents=True, exist_ok=True)
-            for name, run_ in (("program", result.program), ("optimized", result.optimized)):
-                path = Path(motions) / f"{name}.csv"
-                write_log(path, run_.motion.t, _motion_signals(run_.motion))
-                written.append(path)
+            with atomic_folder(motions) as folder:
+                for name, run_ in (("program", result.program), ("optimized", result.optimized)):
+                    write_log(folder / f"{name}.csv", run_.motion.t, _motion_signals(run_.motion))
+            written += [Path(motions) / "program.csv", Path(motions) / "optimized.csv"]
     except BaseException:
         for path in written:
             path.unlink(missing_ok=True)
@@ -140,7 +124,7 @@ def run_program_optimize(
         the joint limits, a cycle time shorter than the fastest possible; an unwritable file.
     """
     source = Path(program_file)
-    _outputs(source, urscript, motions)
+    check_outputs([("--urscript", urscript), ("--motions", motions)], [source])
     program = read_program(source)
     result = optimize_program(robot, program, progress=progress, **options)
     script = optimized_script(result)
