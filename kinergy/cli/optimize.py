@@ -263,9 +263,9 @@ def program_text(run: ProgramRun) -> str:
 @click.option(
     "--standby",
     type=click.FloatRange(min=0.0),
-    default=0.0,
-    show_default=True,
-    help="URScript programs: standby power (W) counted over the cycle time.",
+    default=None,
+    help="URScript programs: standby power (W) counted over the cycle time [default: the robot "
+    "file's].",
 )
 @click.option(
     "--motions",
@@ -289,7 +289,7 @@ def optimize(
     configurations: str,
     tool_symmetry: str,
     no_blends: bool,
-    standby: float,
+    standby: float | None,
     motions: str | None,
 ) -> None:
     """Energy-optimal speeds and accelerations of a movej program at a cycle time.

@@ -20,9 +20,9 @@ or, without recovery, the summed bus power clipped at 0 (the supply takes nothin
 :class:`SupplyEnergy` (what :func:`kinergy.optimize.programs.optimize_program` minimises) is the
 energy the arm draws from its supply: the joints' electrical powers summed on the DC bus, a
 braking surplus lost in the shunt (the bus power clipped at 0), plus the controller's standby
-power times the cycle time. It is :class:`ElectricalEnergy` without recovery plus standby until
-a DC-bus model of the drives replaces the bus sum (:data:`PROGRAM_OBJECTIVE` names the one the
-program optimiser uses: switching is that one line).
+power times the cycle time: the drives' DC-bus model (:func:`kinergy.drives.bus.supply_power`,
+what ``kinergy energy`` reports as drawn from the supply). :data:`PROGRAM_OBJECTIVE` names the
+objective the program optimiser uses: switching is that one line.
 """
 
 from __future__ import annotations
@@ -33,6 +33,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.drives.bus import supply_power
 from kinergy.optimize.program import ProgramSamples
 
 __all__ = ["PROGRAM_OBJECTIVE", "ElectricalEnergy", "Objective", "SupplyEnergy", "bus_power"]
@@ -85,7 +86,8 @@ class SupplyEnergy:
     standby: float = 0.0
 
     def __call__(self, samples: ProgramSamples) -> tuple[Array, Array]:
-        return samples.integrate(bus_power(samples, recovery=False) + self.standby)
+        bus = supply_power(samples.drive.power, self.standby)
+        return samples.integrate(bus.motors + bus.standby)
 
 
 #: the objective of :func:`kinergy.optimize.programs.optimize_program`, given the standby power

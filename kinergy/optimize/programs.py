@@ -290,7 +290,7 @@ def optimize_program(
     configurations: str = "keep",
     tool_symmetry: str = "none",
     blends: bool = True,
-    standby: float = 0.0,
+    standby: float | None = None,
     cycle_time: float | None = None,
     v_max: float | None = None,
     a_max: float | None = None,
@@ -307,8 +307,9 @@ def optimize_program(
     tool_symmetry : {'none', 'z', 'z2', 'z4'}
     blends : bool
         Whether via points may get blend radii.
-    standby : float
-        The controller's standby power, W (adds ``standby * cycle time`` to every figure).
+    standby : float, optional
+        Standby power, W (adds ``standby * cycle time`` to every figure); default the robot
+        file's ``standby_power``.
     cycle_time : float, optional
         s (default the program's own).
     v_max, a_max : float, optional
@@ -330,6 +331,7 @@ def optimize_program(
         raise KinergyError(f"configurations: expected keep or free, got {configurations!r}")
     symmetry_angles(tool_symmetry)  # validates
     say = progress if progress is not None else (lambda _: None)
+    standby = robot.standby_power if standby is None else standby
     objective = PROGRAM_OBJECTIVE(standby)
     path = program_path(robot, program)
     say(f"{program.name}: simulating the program at 500 Hz")

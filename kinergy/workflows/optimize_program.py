@@ -132,7 +132,7 @@ def run_program_optimize(
     again = simulate_path(
         robot,
         program_path(robot, back),
-        objective=PROGRAM_OBJECTIVE(float(options.get("standby", 0.0))),
+        objective=PROGRAM_OBJECTIVE(float(result.settings["standby"])),
     )
     readback = supply(again.result)
     written = _write((result, script), urscript, motions)
