@@ -7,12 +7,17 @@ and the readers fall back to this one to say what is wrong with a file it refuse
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
 from kinergy.io.columns import printable
 from kinergy.io.log_layout import LogLayout
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["read_text_table"]
 
@@ -50,7 +55,7 @@ def read_text_table(layout: LogLayout, *, repair: bool = False) -> tuple[Array, 
     notes: list[str] = []
     t_col = names.index("timestamp")
     if repair:
-        keep = _good_rows(values[:, t_col], ~bad.any(axis=1))
+        keep = _good_rows(values[:, t_col], np.asarray(~bad.any(axis=1), dtype=bool))
         if not keep.all():
             lines = np.flatnonzero(~keep) + skip + 1
             shown = ", ".join(str(x) for x in lines[:8]) + (" ..." if lines.size > 8 else "")
@@ -86,7 +91,7 @@ def check_times(
         )
 
 
-def _text_frame(layout: LogLayout):  # type: ignore[no-untyped-def]
+def _text_frame(layout: LogLayout) -> pd.DataFrame:
     """The file as a pandas frame of strings, one column per name (a trailing empty column
     dropped)."""
     import pandas as pd  # imported here: slow to import, and only this reader needs it
@@ -119,7 +124,7 @@ def _text_frame(layout: LogLayout):  # type: ignore[no-untyped-def]
     return frame
 
 
-def _numbers(frame) -> Array:  # type: ignore[no-untyped-def]
+def _numbers(frame: pd.DataFrame) -> Array:
     """The frame's cells as floats; nan where a cell is not a number."""
     import pandas as pd  # imported here: slow to import, and only this reader needs it
 
