@@ -33,7 +33,14 @@ from numpy.typing import NDArray
 
 Array = NDArray[np.float64]
 
-__all__ = ["regressor_kernel", "regressor_rows", "rnea_kernel", "rnea_rows"]
+__all__ = [
+    "regressor_gradient_kernel",
+    "regressor_gradient_rows",
+    "regressor_kernel",
+    "regressor_rows",
+    "rnea_kernel",
+    "rnea_rows",
+]
 
 
 @njit(cache=True, fastmath=False, inline="always")
@@ -259,6 +266,33 @@ def _regressor_block(j, sax, kmat, y, clear) -> None:
             y[i, c0 + c] = 0.0
 
 
+@njit(cache=True, fastmath=False, inline="always")
+def _regressor_scratch(n):
+    """Scratch space of :func:`_regressor_sample` for n joints."""
+    frames = np.empty((6, n, 3))  # pos, omega, vel, alpha, acl
+    rot = np.empty((n, 3, 3))
+    work = np.zeros((9, 3))
+    sax = np.empty((n, 6))  # joint axes (angular; linear) in the current link frame
+    kmat = np.zeros((6, 10))  # only its non-zero entries are ever written
+    return frames, rot, work, sax, kmat
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _regressor_sample(geo, g0, q, qd, qdd, y, clear, scratch) -> None:
+    """One sample's regressor ``y`` (n, 10 n) (:func:`regressor_rows`)."""
+    frames, rot, work, sax, kmat = scratch
+    axis, axis_v = geo[6], geo[7]
+    pos, omega, vel, alpha, acl = frames[0], frames[1], frames[2], frames[3], frames[4]
+    _motion_pass(geo, g0, q, qd, qdd, rot, pos, omega, vel, alpha, acl, work)
+    for j in range(q.shape[0]):
+        _carry_axes(j, rot, pos, sax, work)
+        for r in range(3):
+            sax[j, r] = axis[j, r]
+            sax[j, 3 + r] = axis_v[j, r]
+        _wrench_matrix(omega[j], alpha[j], acl[j], kmat)
+        _regressor_block(j, sax, kmat, y, clear)
+
+
 @njit(cache=True, fastmath=False)
 def regressor_rows(lo, hi, geo, g0, state, y, clear) -> None:
     """Fill rows lo:hi of ``y`` (N, n, 10 n) with the regressor in the parameter order
@@ -275,23 +309,55 @@ def regressor_rows(lo, hi, geo, g0, state, y, clear) -> None:
     ten wrench columns back to each joint.
     """
     q, qd, qdd = state
-    axis, axis_v = geo[6], geo[7]
-    n = q.shape[1]
-    frames = np.empty((6, n, 3))
-    pos, omega, vel, alpha, acl = frames[0], frames[1], frames[2], frames[3], frames[4]
-    rot = np.empty((n, 3, 3))
-    work = np.zeros((9, 3))
-    sax = np.empty((n, 6))  # joint axes (angular; linear) in the current link frame
-    kmat = np.zeros((6, 10))
+    scratch = _regressor_scratch(q.shape[1])
     for k in range(lo, hi):
-        _motion_pass(geo, g0, q[k], qd[k], qdd[k], rot, pos, omega, vel, alpha, acl, work)
+        _regressor_sample(geo, g0, q[k], qd[k], qdd[k], y[k], clear, scratch)
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _weighted(geo, g0, x, weights, y, scratch) -> float:
+    """``sum(weights * Y(x))`` for one sample, ``x = (q, qd, qdd)`` (n,) each."""
+    _regressor_sample(geo, g0, x[0], x[1], x[2], y, True, scratch)
+    acc = 0.0
+    for i in range(y.shape[0]):
+        for c in range(y.shape[1]):
+            acc += weights[i, c] * y[i, c]
+    return acc
+
+
+@njit(cache=True, fastmath=False)
+def regressor_gradient_rows(lo, hi, geo, g0, state, weights, step_q, sens) -> None:
+    """Rows lo:hi of ``sens`` (3, N, n): the derivatives of ``f = sum(weights[k] * Y_k)`` in
+    every sample's ``q``, ``qd`` and ``qdd``.
+
+    ``Y`` is linear in ``qdd`` and a quadratic in ``qd``, so a unit forward step in ``qdd`` and
+    a central unit step in ``qd`` give their derivatives up to rounding; ``q`` takes a central
+    step of ``step_q`` rad (error ``O(step_q^2)``).
+    """
+    q, qd, qdd = state
+    n = q.shape[1]
+    scratch = _regressor_scratch(n)
+    y = np.empty((n, 10 * n))
+    x = np.empty((3, n))
+    steps = (step_q, 1.0)
+    for k in range(lo, hi):
+        x[0, :] = q[k]
+        x[1, :] = qd[k]
+        x[2, :] = qdd[k]
+        w = weights[k]
+        f0 = _weighted(geo, g0, x, w, y, scratch)
         for j in range(n):
-            _carry_axes(j, rot, pos, sax, work)
-            for r in range(3):
-                sax[j, r] = axis[j, r]
-                sax[j, 3 + r] = axis_v[j, r]
-            _wrench_matrix(omega[j], alpha[j], acl[j], kmat)
-            _regressor_block(j, sax, kmat, y[k], clear)
+            for kind in range(2):  # central steps in q, qd
+                h = steps[kind]
+                x[kind, j] += h
+                up = _weighted(geo, g0, x, w, y, scratch)
+                x[kind, j] -= 2.0 * h
+                down = _weighted(geo, g0, x, w, y, scratch)
+                x[kind, j] = state[kind][k, j]
+                sens[kind, k, j] = (up - down) / (2.0 * h)
+            x[2, j] += 1.0
+            sens[2, k, j] = _weighted(geo, g0, x, w, y, scratch) - f0
+            x[2, j] = qdd[k, j]
 
 
 _CHUNK = 256  # samples per parallel work item
@@ -311,3 +377,12 @@ def regressor_kernel(geo, g0, state, y, clear) -> None:
     big_n = y.shape[0]
     for c in prange((big_n + _CHUNK - 1) // _CHUNK):
         regressor_rows(c * _CHUNK, min(big_n, (c + 1) * _CHUNK), geo, g0, state, y, clear)
+
+
+@njit(cache=True, parallel=True)
+def regressor_gradient_kernel(geo, g0, state, weights, step_q, sens) -> None:
+    """:func:`regressor_gradient_rows` over all samples, split over threads."""
+    big_n = weights.shape[0]
+    for c in prange((big_n + _CHUNK - 1) // _CHUNK):
+        lo, hi = c * _CHUNK, min(big_n, (c + 1) * _CHUNK)
+        regressor_gradient_rows(lo, hi, geo, g0, state, weights, step_q, sens)

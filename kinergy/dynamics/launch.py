@@ -21,7 +21,13 @@ from kinergy.dynamics import _kernels
 from kinergy.dynamics.chain import KernelData
 from kinergy.dynamics.threads import kernel_threads
 
-__all__ = ["SERIAL_ROWS", "compile_kernels", "regressor_into", "rnea_into"]
+__all__ = [
+    "SERIAL_ROWS",
+    "compile_kernels",
+    "regressor_gradient_into",
+    "regressor_into",
+    "rnea_into",
+]
 
 Array = NDArray[np.float64]
 
@@ -31,37 +37,48 @@ SERIAL_ROWS = 256
 _NOTICE_AFTER = 1.0
 _NOTICE = "kinergy: compiling the dynamics kernels (once, about 20 s)"
 
-_compiled = False
+_compiled: set[str] = set()
 _lock = threading.Lock()
 
 
-def compile_kernels(data: KernelData) -> None:
-    """Compile (or load from numba's cache) every dynamics kernel, once per process; prints
-    :data:`_NOTICE` on stderr if that takes more than a second."""
-    global _compiled
-    if _compiled:
+def _with_notice(compile_all: Callable[[], None]) -> None:
+    """Run ``compile_all``, printing :data:`_NOTICE` on stderr if it takes over a second."""
+    timer = threading.Timer(_NOTICE_AFTER, lambda: print(_NOTICE, file=sys.stderr, flush=True))
+    timer.daemon = True
+    timer.start()
+    try:
+        compile_all()
+    finally:
+        timer.cancel()
+
+
+def compile_kernels(data: KernelData, *, gradient: bool = False) -> None:
+    """Compile (or load from numba's cache) the dynamics kernels once per process (with
+    ``gradient``, the regressor gradient's too), with a notice if that takes a while."""
+    if "dynamics" in _compiled and (not gradient or "gradient" in _compiled):
         return
+    n = data.geo[0].shape[0]
+    z = np.zeros((1, n))
+    state = (z, z, z)
+
+    def dynamics() -> None:
+        args = (data.geo, data.ends, data.body, state, np.empty((0, 6)), np.empty((1, n)))
+        _kernels.rnea_kernel(*args)
+        _kernels.rnea_rows(0, 1, *args)
+        y = np.empty((1, n, 10 * n))
+        _kernels.regressor_kernel(data.geo, data.ends[2], state, y, True)
+        _kernels.regressor_rows(0, 1, data.geo, data.ends[2], state, y, True)
+
+    def gradients() -> None:
+        args = (data.geo, data.ends[2], state, np.zeros((1, n, 10 * n)), 1e-5, np.empty((3, 1, n)))
+        _kernels.regressor_gradient_kernel(*args)
+        _kernels.regressor_gradient_rows(0, 1, *args)
+
     with _lock:
-        if _compiled:
-            return
-        timer = threading.Timer(_NOTICE_AFTER, lambda: print(_NOTICE, file=sys.stderr, flush=True))
-        timer.daemon = True
-        timer.start()
-        try:
-            n = data.geo[0].shape[0]
-            z = np.zeros((1, n))
-            state = (z, z, z)
-            for kernel, rows in ((_kernels.rnea_kernel, _kernels.rnea_rows),):
-                kernel(data.geo, data.ends, data.body, state, np.empty((0, 6)), np.empty((1, n)))
-                rows(
-                    0, 1, data.geo, data.ends, data.body, state, np.empty((0, 6)), np.empty((1, n))
-                )
-            y = np.empty((1, n, 10 * n))
-            _kernels.regressor_kernel(data.geo, data.ends[2], state, y, True)
-            _kernels.regressor_rows(0, 1, data.geo, data.ends[2], state, y, True)
-        finally:
-            timer.cancel()
-        _compiled = True
+        for key, fn in (("dynamics", dynamics), ("gradient", gradients if gradient else None)):
+            if fn is not None and key not in _compiled:
+                _with_notice(fn)
+                _compiled.add(key)
 
 
 def _launch(
@@ -113,3 +130,24 @@ def regressor_into(
     compile_kernels(data)
     args = (data.geo, data.ends[2] if g0 is None else g0, state, y, clear)
     _launch(_kernels.regressor_rows, _kernels.regressor_kernel, y.shape[0], args, threads)
+
+
+def regressor_gradient_into(
+    data: KernelData,
+    state: tuple[Array, Array, Array],
+    weights: Array,
+    sens: Array,
+    step_q: float,
+    threads: int | None = None,
+) -> None:
+    """Fill ``sens`` (3, N, n) with the derivatives of ``sum(weights * Y)`` in each sample's
+    ``q``, ``qd``, ``qdd`` (:func:`kinergy.dynamics._kernels.regressor_gradient_rows`)."""
+    compile_kernels(data, gradient=True)
+    args = (data.geo, data.ends[2], state, weights, step_q, sens)
+    _launch(
+        _kernels.regressor_gradient_rows,
+        _kernels.regressor_gradient_kernel,
+        weights.shape[0],
+        args,
+        threads,
+    )
