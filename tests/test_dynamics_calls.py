@@ -70,3 +70,23 @@ def test_serial_and_parallel_paths_give_the_same_bits(ur5e: kinergy.Robot, threa
     for k in (0, SERIAL_ROWS, len(q) - 1):  # one sample at a time: the serial path
         np.testing.assert_array_equal(kinergy.rnea(ur5e, q[k], qd[k], qdd[k]), tau[k])
         np.testing.assert_array_equal(kinergy.regressor(ur5e, q[k], qd[k], qdd[k]), y[k])
+
+
+def test_regressor_gradient_matches_central_differences(ur5e: kinergy.Robot) -> None:
+    from kinergy.dynamics.regressor import regressor_gradient
+
+    q, qd, qdd = _states(40)
+    weights = np.random.default_rng(9).normal(size=(40, 6, 60))
+    sens = regressor_gradient(ur5e, q, qd, qdd, weights)
+
+    def f(*x: np.ndarray) -> np.ndarray:
+        return np.einsum("sic,sic->s", weights, kinergy.regressor(ur5e, *x))
+
+    h = 1e-6
+    for kind in range(3):
+        for j in range(6):
+            up, down = [q.copy(), qd.copy(), qdd.copy()], [q.copy(), qd.copy(), qdd.copy()]
+            up[kind][:, j] += h
+            down[kind][:, j] -= h
+            numeric = (f(*up) - f(*down)) / (2 * h)
+            np.testing.assert_allclose(sens[kind, :, j], numeric, rtol=1e-6, atol=1e-6)
