@@ -34,6 +34,7 @@ from numpy.typing import NDArray
 Array = NDArray[np.float64]
 
 __all__ = [
+    "GRADIENT_CHUNK",
     "regressor_gradient_kernel",
     "regressor_gradient_rows",
     "regressor_kernel",
@@ -361,6 +362,8 @@ def regressor_gradient_rows(lo, hi, geo, g0, state, weights, step_q, sens) -> No
 
 
 _CHUNK = 256  # samples per parallel work item
+#: samples per parallel work item of the gradient (a sample costs 5 n + 1 regressors)
+GRADIENT_CHUNK = 16
 
 
 @njit(cache=True, parallel=True)
@@ -383,6 +386,6 @@ def regressor_kernel(geo, g0, state, y, clear) -> None:
 def regressor_gradient_kernel(geo, g0, state, weights, step_q, sens) -> None:
     """:func:`regressor_gradient_rows` over all samples, split over threads."""
     big_n = weights.shape[0]
-    for c in prange((big_n + _CHUNK - 1) // _CHUNK):
-        lo, hi = c * _CHUNK, min(big_n, (c + 1) * _CHUNK)
+    for c in prange((big_n + GRADIENT_CHUNK - 1) // GRADIENT_CHUNK):
+        lo, hi = c * GRADIENT_CHUNK, min(big_n, (c + 1) * GRADIENT_CHUNK)
         regressor_gradient_rows(lo, hi, geo, g0, state, weights, step_q, sens)

@@ -87,12 +87,14 @@ def _launch(
     rows: int,
     args: tuple[object, ...],
     threads: int | None,
+    serial_rows: int = SERIAL_ROWS,
 ) -> None:
-    """``serial(0, rows, *args)`` for small batches or one thread, else ``parallel(*args)``."""
+    """``serial(0, rows, *args)`` for batches up to ``serial_rows`` or one thread, else
+    ``parallel(*args)``."""
     if threads is not None:
         with kernel_threads(threads):
-            _launch(serial, parallel, rows, args, None)
-    elif rows <= SERIAL_ROWS or numba.get_num_threads() == 1:
+            _launch(serial, parallel, rows, args, None, serial_rows)
+    elif rows <= serial_rows or numba.get_num_threads() == 1:
         serial(0, rows, *args)
     else:
         parallel(*args)
@@ -150,4 +152,5 @@ def regressor_gradient_into(
         weights.shape[0],
         args,
         threads,
+        _kernels.GRADIENT_CHUNK,
     )

@@ -163,7 +163,9 @@ class ExcitationRegression:
         (3, N, n: ``q``, ``qd``, ``qdd``) and the condition number.
 
         With ``G = dF/dW`` (:func:`criterion`), ``dF/dx[s, j] = sum(G[s] * dW[s]/dx[s, j])``:
-        the link columns' part is :func:`kinergy.dynamics.regressor.regressor_gradient` with
+        the link columns' part is :func:`kinergy.dynamics.regressor.regressor_gradient` (one
+        thread: 200 samples of an optimisation loop lose more to a parallel launch on a busy
+        machine than they gain) with
         ``G`` scattered onto the base columns (no regressor derivative is stored), the drive
         columns' part :meth:`drive_gradient`.
         """
