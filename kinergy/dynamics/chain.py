@@ -264,6 +264,8 @@ class KernelData:
     Attributes
     ----------
     chain : Chain
+    inertials : LinkInertials
+        The payload merged into the last link.
     geo : tuple of 8 ndarray
         :func:`kernel_geometry` of the chain.
     ends : tuple of 3 ndarray
@@ -275,6 +277,7 @@ class KernelData:
     """
 
     chain: Chain
+    inertials: LinkInertials
     geo: tuple[Array, Array, Array, Array, Array, Array, Array, Array]
     ends: tuple[Array, Array, Array]
     body: tuple[Array, Array, Array]
@@ -293,6 +296,7 @@ def kernel_data(robot: Robot) -> KernelData:
         body = link_inertials(robot)
         data = KernelData(
             chain,
+            body,
             kernel_geometry(chain),
             tuple(  # type: ignore[arg-type]
                 np.ascontiguousarray(x, dtype=float)

@@ -22,7 +22,6 @@ from kinergy.dynamics.chain import (
     contiguous_state,
     gravity_in_frame0,
     kernel_data,
-    link_inertials,
     output_array,
 )
 from kinergy.dynamics.kinematics import joint_axes
@@ -125,8 +124,7 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> Array:
     ndarray, shape (n, n) or (N, n, n)
     """
     single, s = check_state(robot, q=q)
-    chain = kernel_data(robot).chain
-    body = link_inertials(robot)
+    chain, body = kernel_data(robot).chain, kernel_data(robot).inertials
     z, o, link = joint_axes(chain, s["q"])  # (N, n, 3), (N, n, 3), (N, n, 4, 4)
     n = robot.n
     rot = link[..., :3, :3]
