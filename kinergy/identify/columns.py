@@ -83,7 +83,6 @@ class Columns:
         return x[self.fric_at[m] : self.fric_at[m + 1]]
 
 
-
 def rotor_columns(n_mat: Array, dwm: Array) -> Array:
     """Reflected rotor inertia columns, shape (N, n, n): motor ``m``'s column on joint ``j`` is
     ``N[m, j] (N qdd)_m`` (UR5e eq 2), ``dwm = qdd N^T`` (N, n) the motor accelerations, rad/s^2;

@@ -6,23 +6,26 @@ negative rotor inertia, friction outside its model's bounds), the
 robot is written from the least-squares fit constrained to physical values instead: a convex
 problem (a semidefinite program) solved by cvxpy with Clarabel (SCS as the fallback):
 
-    minimise    |R z - r|^2 / sse_0  +  eps |S^-1 (pi - pi_0)|^2  +  eps_d |dropped - prior|^2
+    minimise    |R (z - z_hat)|^2 / (sigma^2 c)  +  eps |S^-1 (pi - pi_0)|^2  +  eps_d |dropped - prior|^2
     subject to  T_l P_l(pi - payload) T_l  >=  margin 1     (each link, Wensing et al. 2018)
                 rotor inertias >= 0,  friction within FrictionModel.bounds
 
-``R z - r`` is the regression's own reduced triangle (:func:`kinergy.linalg.reduce`, column-scaled
-unknowns ``z``, so the data enter as a (p + 1) x p matrix whatever the number of samples), ``pi``
+``R`` is the regression's own reduced triangle (:func:`kinergy.linalg.reduce`, column-scaled
+unknowns ``z``, so the data enter as a (p + 1) x p matrix whatever the number of samples) and
+``z_hat`` its least-squares optimum, so the first term is the chi^2 the constraints cost
+(``|R z - r|^2 = |R (z - z_hat)|^2 + sse_0``, the residual being orthogonal to the columns),
+in units ``c`` of the chi^2 the model itself would cost (feasible, so the optimum is below 1); ``pi``
 the links' standard parameters (10 per link) whose base projection gives the link columns,
 ``P_l`` link ``l``'s 4x4 pseudo-inertia (positive definite exactly for a physically consistent
 link), ``T_l`` a scaling that makes it dimensionless (kg and 0.1 m). The small ``eps`` terms
 only settle what the data cannot see: the standard parameters outside the base projection stay
 nearest the model's, and columns the data cannot tell apart stay at the model's unless a
-constraint moves them. With ``sse_0`` the unconstrained fit's squared residual, the objective's
-rise times ``rows - parameters`` is the chi^2 the constraints cost.
+constraint moves them.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -48,9 +51,9 @@ Array = NDArray[np.float64]
 
 #: smallest eigenvalue of each link's scaled pseudo-inertia (kg and LENGTH_SCALE as units)
 MARGIN = 1e-5
-#: weights of the terms that settle the directions the data cannot see
-_EPS_LINKS = 1e-9
-_EPS_DROPPED = 1e-3
+#: weights (in units of the model's chi^2) of the terms that settle what the data cannot see
+_EPS_LINKS = 1e-6
+_EPS_DROPPED = 1e-4
 
 
 def bounds(cols: Columns, models: Sequence[str]) -> tuple[Array, Array]:
@@ -121,11 +124,27 @@ def _lmi(pi: cp.Expression, payload: Array, t: Array) -> tuple[list[cp.Constrain
     return constraints, pieces
 
 
+def _metric(problem: Solved) -> Array:
+    """``L`` with ``|L (z - z_hat)|^2`` the chi^2 increase of the unknowns ``z`` (scaled) over the
+    regression's optimum ``z_hat``: the triangle (with the ridge term) over the residual's
+    standard deviation (floored at 1e-6 of the signal for noise-free data)."""
+    red = problem.reduced
+    sigma2 = max(problem.sigma2, 1e-12 * float(red.r_y @ red.r_y) / red.rows, 1e-300)
+    rows = [red.r_a]
+    if problem.lam > 0.0:
+        ridge = np.zeros((problem.kept.size, red.r_a.shape[1]))
+        ridge[np.arange(problem.kept.size), problem.kept] = np.sqrt(problem.lam)
+        rows.append(ridge)
+    return np.vstack(rows) / np.sqrt(sigma2)
+
+
 def _solve(problem: cp.Problem) -> str | None:
     """Solve with Clarabel, else SCS; the solver's name, or None when neither finds the optimum."""
     for solver in ("CLARABEL", "SCS"):
         try:
-            problem.solve(solver=solver)
+            with warnings.catch_warnings():  # "inaccurate" is judged below, by the links
+                warnings.simplefilter("ignore", UserWarning)
+                problem.solve(solver=solver)
         except (cp.error.SolverError, ValueError):  # pragma: no cover - solver failure
             continue
         if problem.status in ("optimal", "optimal_inaccurate"):
@@ -157,6 +176,53 @@ def _active(
     return phrases, at_bound
 
 
+def _realisation(
+    problem: Solved,
+    base: BaseParameters,
+    cols: Columns,
+    pis: tuple[Array, Array, Array],
+    merged_rotor: dict[int, Array],
+    t: Array,
+) -> tuple[Array, Array, str] | None:
+    """Physical links that reproduce the identified base parameters exactly, the constrained
+    problem's solution at no cost, when they exist (None otherwise).
+
+    Among them, the standard parameters closest to the model's (``|S^-1 (pi - pi0)|``, ``pis`` =
+    (pi0, scale, payload)); a rotor inertia merged into link columns (``merged_rotor``, motor ->
+    its column in link base columns, (b,)) may move by ``d >= -J_model`` with the links taking
+    ``-C d`` so the torques stay the identified ones. Returns the standard parameters, all
+    unknowns and the solver.
+    """
+    pi0, scale, payload = pis
+    n_link = base.size
+    motors = sorted(merged_rotor)
+    v = cp.Variable(pi0.size)
+    pi = pi0 + cp.multiply(scale, v)
+    p_mat = base_projection(base, pi0.size)
+    theta = problem.x[:n_link]
+    size = np.maximum(np.abs(theta), 1e-12 * max(float(np.abs(theta).max()), 1e-300))
+    constraints, _ = _lmi(pi, payload, t)
+    j0 = np.array([cols.prior[n_link + m] for m in motors])
+    d = cp.Variable(len(motors))
+    shift = 0.0
+    objective = cp.sum_squares(v)
+    if motors:
+        c_mat = np.column_stack([merged_rotor[m] for m in motors])
+        unit = np.where(j0 > 0, j0, 1e-6)
+        shift = c_mat @ cp.multiply(unit, d)
+        constraints.append(j0 + cp.multiply(unit, d) >= 0)
+        objective = objective + cp.sum_squares(d)
+    constraints.append((p_mat @ pi + shift - theta) / size == 0)
+    solver = _solve(cp.Problem(cp.Minimize(objective), constraints))
+    if solver is None or v.value is None:
+        return None
+    x = problem.x.copy()
+    if motors:
+        moved = j0 + np.where(j0 > 0, j0, 1e-6) * np.asarray(d.value)
+        x[n_link + np.array(motors)] = np.maximum(moved, 0.0)
+    return pi0 + scale * np.asarray(v.value), x, solver
+
+
 def physical_fit(
     problem: Solved,
     base: BaseParameters,
@@ -166,6 +232,7 @@ def physical_fit(
     scale: Array,
     payload: Array,
     names: Sequence[str],
+    merged_rotor: dict[int, Array],
 ) -> ConstrainedFit | None:
     """Least squares on the regression's reduced triangle constrained to physical values (module
     docstring).
@@ -186,6 +253,9 @@ def physical_fit(
         The payload's share of ``pi0`` (the last link's), which the links' consistency excludes.
     names : sequence of str
         Joint names, for the active-constraint phrases.
+    merged_rotor : dict
+        Rotor inertias merged into link columns: motor -> its column in link base columns (b,)
+        (:class:`~kinergy.identify.regression.Merging`).
 
     Returns
     -------
@@ -196,23 +266,28 @@ def physical_fit(
     n_link, p = cols.n_link, cols.prior.size
     p_mat = base_projection(base, pi0.size)
     lo, hi = bounds(cols, models)
-    sse0 = max(problem.solution.sse, 1e-300)
+    t = _link_scaling(pi0)
+    extra = problem.x[n_link:]
+    if np.all((extra >= lo) & (extra <= hi)):
+        found = _realisation(problem, base, cols, (pi0, scale, payload), merged_rotor, t)
+        if found is not None and all(e is None for e in link_consistency(found[0] - payload)):
+            phrases, _ = _active(found[1], cols, lo, hi, found[0], payload, names)
+            return ConstrainedFit(found[0], found[1], 0.0, tuple(phrases), (), found[2])
+    metric = _metric(problem)
+    z_hat = problem.x * red.scale
     v = cp.Variable(pi0.size)
     z_extra = cp.Variable(p - n_link)
     pi = pi0 + cp.multiply(scale, v)
     z = cp.hstack([cp.multiply(red.scale[:n_link], p_mat @ pi), z_extra])
     z_prior = cols.prior * red.scale
-    fit = cp.sum_squares(red.r_a @ z - red.r_y)
-    if problem.lam > 0.0:
-        kept = problem.kept
-        fit = fit + problem.lam * cp.sum_squares(z[kept] - z_prior[kept])
     dropped = problem.dropped[problem.dropped >= n_link] - n_link
     size = np.maximum(np.abs(z_prior[n_link:][dropped]), 1e-6 * float(np.linalg.norm(red.r_y)))
-    objective = fit / sse0 + _EPS_LINKS * cp.sum_squares(v)
+    # in units of the chi^2 of the model itself (feasible): the optimum lies in [0, 1]
+    unit = max(float(np.sum((metric @ (z_prior - z_hat)) ** 2)), 1e-12)
+    objective = cp.sum_squares(metric @ (z - z_hat)) / unit + _EPS_LINKS * cp.sum_squares(v)
     if dropped.size:
         gap = (z_extra[dropped] - z_prior[n_link:][dropped]) / size
         objective = objective + _EPS_DROPPED * cp.sum_squares(gap)
-    t = _link_scaling(pi0)
     constraints, _ = _lmi(pi, payload, t)
     s_extra = red.scale[n_link:]
     finite_lo, finite_hi = np.isfinite(lo), np.isfinite(hi)
@@ -229,8 +304,6 @@ def physical_fit(
     x = np.empty(p)
     x[:n_link] = p_mat @ pi_hat
     x[n_link:] = np.clip(np.asarray(z_extra.value) / s_extra, lo, hi)
-    z_hat = x * red.scale
-    sse = float(np.sum((red.r_a @ z_hat - red.r_y) ** 2))
-    chi2 = max(sse - problem.solution.sse, 0.0) / max(problem.sigma2, 1e-300)
+    chi2 = float(np.sum((metric @ (x * red.scale - z_hat)) ** 2))
     phrases, at_bound = _active(x, cols, lo, hi, pi_hat, payload, names)
     return ConstrainedFit(pi_hat, x, chi2, tuple(phrases), tuple(at_bound), solver)

@@ -490,7 +490,7 @@ def _fit(
         physical_fit=_physical(stacked, written),
         write_back=written.method,
         drives="currents" if steps.drives else ("regression" if target != "moment" else "model"),
-        scale=SCALE_NOTE if target == "current" else None,
+        scale=SCALE_NOTE if target == "current" and steps.drives else None,
         friction_holding=steps.drives.holding if steps.drives else None,
         links_not_physical_closest=written.links_not_physical_closest,
         links_physical=written.links_physical,
@@ -590,7 +590,7 @@ def identify_full(
     target = _pick_target(datas, target)
     with_currents = currents and all(d.current is not None for d in datas)
     start = robot
-    if target == "current":  # torque constants and friction shapes from the model's links first
+    if with_currents and target == "current":  # drives from the model's links first
         start = drives_from_currents(robot, datas, friction=friction).robot
         friction = None
     base = base_parameters(start)
@@ -598,12 +598,12 @@ def identify_full(
     flow = fit_power_flow(start, stacked, base.expressions())
     solved = solve(stacked, flow.ols, solver, ridge)
     merging = merged_columns(flow.ols, stacked.cols)
-    written = write_back(start, base, solved, stacked, target == "moment")
+    written = write_back(start, base, solved, stacked, target == "moment", merging.rotor)
     drives = None
     if with_currents:
         drives = drives_from_currents(written.robot, datas, friction=friction)
     out = drives.robot if drives is not None else written.robot
-    if target == "current":  # the common scale from the model's published masses
+    if with_currents and target == "current":  # the common scale from the published masses
         gravity = scale_row(robot, base, stacked.q) @ base.project(inertial_parameters(out))
         out = rescaled(out, 1.0 / float(gravity))
     steps = _Steps(stacked, base, flow, solved, merging, written, drives, out)

@@ -572,7 +572,9 @@ def drives_from_currents(
         current regression.
     """
     problems = _diagnose_motion(robot, logs)
-    warnings = [f"{text}; kept the model's torque constant and friction" for text in problems.values()]
+    warnings = [
+        f"{text}; kept the model's torque constant and friction" for text in problems.values()
+    ]
     rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
     out, stats, held = _current_step(robot, rotor, logs, problems, (friction, hold), warnings)
     flags, std = [], []

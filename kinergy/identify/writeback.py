@@ -121,6 +121,7 @@ def _links(
     base: BaseParameters,
     problem: Solved,
     stacked: Stacked,
+    merged_rotor: dict[int, Array],
     warnings: list[str],
 ) -> _Links:
     """Steps 1 and 2 of the module docstring (warnings appended for the constrained fit)."""
@@ -135,7 +136,9 @@ def _links(
     if not (flagged or outside):
         return _Links(pi - payload, x, CLOSEST, None, flagged)
     names = robot.joint_names
-    refit = physical_fit(problem, base, cols, stacked.models, pi0, scale, payload, names)
+    refit = physical_fit(
+        problem, base, cols, stacked.models, pi0, scale, payload, names, merged_rotor
+    )
     if refit is None:
         for col, phrase in outside.items():  # never written: the model's value instead
             warnings.append(f"{phrase}: kept the model's value (the constrained fit failed)")
@@ -244,7 +247,9 @@ def _flags(cols: Columns, problem: Solved, written: _Links) -> tuple[str, ...]:
     for k in range(cols.prior.size):
         if k in at_bound:
             out.append(AT_BOUND)
-        elif k in dropped or (k >= cols.n_link and written.x[k] != problem.x[k] and written.refit is None):
+        elif k in dropped or (
+            k >= cols.n_link and written.x[k] != problem.x[k] and written.refit is None
+        ):
             out.append(KEPT)
         else:
             out.append(IDENTIFIED)
@@ -267,14 +272,20 @@ def _with_drive(
 
 
 def write_back(
-    robot: Robot, base: BaseParameters, problem: Solved, stacked: Stacked, commanded: bool
+    robot: Robot,
+    base: BaseParameters,
+    problem: Solved,
+    stacked: Stacked,
+    commanded: bool,
+    merged_rotor: dict[int, Array],
 ) -> WriteBack:
     """The identified robot from the solved regression ``problem`` of ``stacked`` (module
     docstring). ``commanded``: a fit against ``target_moment``, which keeps the model's
-    friction."""
+    friction; ``merged_rotor`` gives each merged rotor inertia's column in link base columns
+    (motor -> (b,)), which the constrained fit may move."""
     warnings: list[str] = []
     cols = stacked.cols
-    written = _links(robot, base, problem, stacked, warnings)
+    written = _links(robot, base, problem, stacked, merged_rotor, warnings)
     link_joints, links, physical = _with_links(robot, written.links, warnings)
     final = [
         _with_drive(m, joint, stacked, written.x, commanded, warnings)
