@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import columns_option, fmt_vector, note, repair_option, table
+from kinergy.cli.common import columns_option, note, repair_option, table
 from kinergy.cli.validate import validation_text
 from kinergy.identify.full import FullFit
 from kinergy.identify.payload import PayloadEstimate
@@ -19,8 +19,11 @@ __all__ = ["identify"]
 
 def _payload_text(report: PayloadEstimate, out: str) -> str:
     lines = [
-        f"payload: {report.mass:.4f} +- {report.mass_std:.4f} kg at "
-        f"{fmt_vector(report.com)} m (flange frame), from {report.signal}; wrote {out}"
+        f"payload: {report.mass:.4f} +- {report.mass_std:.4f} kg at ["
+        + ", ".join(
+            f"{c:.4f} +- {sd:.4f}" for c, sd in zip(report.com, report.com_std, strict=True)
+        )
+        + f"] m (flange frame), from {report.signal}; wrote {out}"
     ]
     lines += [f"note: {n}" for n in report.notes]
     return "\n".join(lines)
