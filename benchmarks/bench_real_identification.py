@@ -33,6 +33,7 @@ import numpy as np
 DATA = Path(__file__).resolve().parents[2] / "shared" / "datasets"
 UR10E = DATA / "ur10e-innopolis"
 UR10E_COLUMNS = "timestamp,actual_q:6,actual_qd:6,actual_current:6,target_current:6,target_moment:6"
+UR10E_SHORT = "timestamp,actual_q:6,actual_qd:6,actual_current:6"
 HELD_OUT = UR10E / "validation_data" / "ur-20_01_17-ptp_10_points.csv"
 PAYLOAD_MASS = 2.805
 
@@ -196,14 +197,16 @@ def physical_problems(model: Path) -> list[str]:
     """What is unphysical in a written model: link masses, link inertias, rotor inertias,
     friction coefficients."""
     from kinergy.model import load_robot
+    from kinergy.model.robot import inertia_matrix
 
     robot = load_robot(str(model))
     problems = []
     for j in robot.joints:
         if j.link.mass < 0:
             problems.append(f"{j.name}: mass {j.link.mass:g}")
-        if np.linalg.eigvalsh(np.asarray(j.link.inertia)).min() < 0:
-            problems.append(f"{j.name}: link inertia not positive semidefinite")
+        eig = np.linalg.eigvalsh(inertia_matrix(j.link.inertia))
+        if eig.min() < 0 or eig.max() > eig.sum() - eig.max() + 1e-12 * eig.max():
+            problems.append(f"{j.name}: link inertia not physical (principal moments {eig})")
         if j.drive.rotor_inertia < 0:
             problems.append(f"{j.name}: rotor inertia {j.drive.rotor_inertia:g}")
         for name, value in j.drive.friction.params.items():
@@ -214,9 +217,11 @@ def physical_problems(model: Path) -> list[str]:
 
 def every_log() -> list[tuple[Path, str, str | None]]:
     """(log, robot, columns) for every log of the datasets that carries joint signals."""
-    logs: list[tuple[Path, str, str | None]] = [
-        (p, "ur10e", UR10E_COLUMNS) for p in sorted(UR10E.rglob("*.csv"))
-    ]
+    logs: list[tuple[Path, str, str | None]] = []
+    for p in sorted(UR10E.rglob("*.csv")):
+        with p.open() as f:  # the 2019 runs log time, positions, speeds and currents only
+            fields = len(f.readline().split(","))
+        logs.append((p, "ur10e", UR10E_COLUMNS if fields == 31 else UR10E_SHORT))
     logs += [(p, "ur3e", None) for p in sorted((DATA / "ur3e-aurt").glob("wave_*.csv"))]
     return logs
 
@@ -243,7 +248,8 @@ def bench_sweep(out: Path) -> dict:
 
 
 def bench_bad(out: Path) -> dict:
-    """Three bad logs made from the UR10e ptp program's first samples."""
+    """Three bad logs: the UR10e ptp program's first sample held for 20 s, the same with joint 1
+    swinging (the other signals frozen), and 0.8 s of a Fourier run."""
     raw = np.loadtxt(HELD_OUT, delimiter=",")
     q0 = raw[0, 1:7]
     t = np.arange(0, 20.0, 0.01)
@@ -256,7 +262,8 @@ def bench_bad(out: Path) -> dict:
     one[:, 1] = q0[0] + 0.5 * np.sin(t)
     one[:, 7] = 0.5 * np.cos(t)
     cases["one joint moving"] = one
-    cases["shorter than a second"] = raw[:80]
+    fourier = UR10E / "identification_data" / "ur-20_02_12-50sec_12harm.csv"
+    cases["shorter than a second"] = np.loadtxt(fourier, delimiter=",")[1000:1080]
     results = {}
     for name, table in cases.items():
         path = out / f"bad_{name.replace(' ', '_')}.csv"

@@ -64,3 +64,18 @@ def test_real_program_with_holds_is_reported_per_log_and_segment() -> None:
                 assert isinstance(m, SignalMetrics)
                 assert np.isfinite(m.r2) or m.note, "a bare nan"
                 assert np.isfinite(m.rms) and m.rms >= 0
+
+
+@pytest.mark.skipif(not DATASETS.exists(), reason="shared datasets not available")
+def test_a_log_shorter_than_a_second_is_refused_and_nothing_written(tmp_path: Path) -> None:
+    from kinergy.errors import KinergyError
+    from kinergy.workflows.identify import identify_model
+
+    fourier = DATASETS / "identification_data" / "ur-20_02_12-50sec_12harm.csv"
+    short = tmp_path / "short.csv"
+    short.write_text("".join(fourier.read_text().splitlines(keepends=True)[1000:1080]))
+    datas = prepared_logs([short], n_joints=6, columns=UR10E_COLUMNS)
+    out = tmp_path / "model.toml"
+    with pytest.raises(KinergyError, match=r"span 0\.\d+ s: identification needs at least 1 s"):
+        identify_model(kinergy.load_robot("ur10e"), datas, out, method="full")
+    assert not out.exists()

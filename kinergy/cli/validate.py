@@ -6,6 +6,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import click
+import numpy as np
 
 from kinergy.cli.common import columns_option, load, note, payload_option, repair_option, table
 from kinergy.identify.metrics import JointMetrics
@@ -25,7 +26,7 @@ __all__ = ["report_text", "validate", "validation_text"]
 
 def _r2(m: JointMetrics) -> str:
     note = m.note if isinstance(m, SignalMetrics) else None
-    return note or f"{m.r2:.4f}"
+    return note or (f"{m.r2:.4f}" if np.isfinite(m.r2) else "signal constant")
 
 
 def _metrics_table(metrics: Sequence[JointMetrics], names: Sequence[str], unit: str) -> str:

@@ -6,6 +6,7 @@ import datetime
 import os
 from collections.abc import Sequence
 
+from kinergy.errors import KinergyError
 from kinergy.identify.full import identify_full
 from kinergy.identify.nursing import identify_nursing
 from kinergy.identify.payload import PayloadEstimate, identify_payload
@@ -14,10 +15,12 @@ from kinergy.identify.result import IdentificationResult
 from kinergy.identify.sequential import identify_sequential
 from kinergy.model import Payload, Robot, save_robot
 
-__all__ = ["METHODS", "identify_model", "identify_payload_model"]
+__all__ = ["METHODS", "MIN_SECONDS", "identify_model", "identify_payload_model"]
 
 #: identification methods by the name ``--method`` takes
 METHODS = ("sequential", "full", "nursing")
+#: s: the shortest logs (all together) an identification accepts
+MIN_SECONDS = 1.0
 
 
 def _header(what: str, logs: Sequence[str | os.PathLike[str]]) -> str:
@@ -38,7 +41,19 @@ def identify_model(
     solver: str = "ols",
     ridge: float = 0.0,
 ) -> IdentificationResult:
-    """Identify ``robot`` from prepared logs by ``method`` and write the model to ``out``."""
+    """Identify ``robot`` from prepared logs by ``method`` and write the model to ``out``.
+
+    Raises
+    ------
+    KinergyError
+        Logs spanning less than :data:`MIN_SECONDS` together (nothing is written).
+    """
+    seconds = sum(float(d.t[-1] - d.t[0]) for d in datas)
+    if seconds < MIN_SECONDS:
+        raise KinergyError(
+            f"the logs span {seconds:.2f} s: identification needs at least {MIN_SECONDS:g} s of "
+            "motion (a few periods of every joint's excitation)"
+        )
     if method == "sequential":
         result = identify_sequential(robot, list(datas), friction=friction)
     elif method == "nursing":
