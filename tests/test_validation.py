@@ -79,3 +79,16 @@ def test_a_log_shorter_than_a_second_is_refused_and_nothing_written(tmp_path: Pa
     with pytest.raises(KinergyError, match=r"span 0\.\d+ s: identification needs at least 1 s"):
         identify_model(kinergy.load_robot("ur10e"), datas, out, method="full")
     assert not out.exists()
+
+
+@pytest.mark.skipif(not DATASETS.exists(), reason="shared datasets not available")
+def test_a_corrupted_log_is_refused_in_one_line() -> None:
+    from kinergy.errors import KinergyError
+    from kinergy.identify.sanity import check_signals
+
+    corrupted = DATASETS / "identification_data" / "ur-19_09_27-11_32_02.csv"  # speeds of 1e293
+    datas = prepared_logs(
+        [corrupted], n_joints=6, columns="timestamp,actual_q:6,actual_qd:6,actual_current:6"
+    )
+    with pytest.raises(KinergyError, match=r"not a value a robot logs .* a corrupted log$"):
+        check_signals(datas)

@@ -12,6 +12,7 @@ from kinergy.identify.nursing import identify_nursing
 from kinergy.identify.payload import PayloadEstimate, identify_payload
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult
+from kinergy.identify.sanity import check_signals
 from kinergy.identify.sequential import identify_sequential
 from kinergy.model import Payload, Robot, save_robot
 
@@ -46,8 +47,10 @@ def identify_model(
     Raises
     ------
     KinergyError
-        Logs spanning less than :data:`MIN_SECONDS` together (nothing is written).
+        Logs spanning less than :data:`MIN_SECONDS` together, or with signals no robot logs
+        (:func:`~kinergy.identify.sanity.check_signals`); nothing is written.
     """
+    check_signals(datas)
     seconds = sum(float(d.t[-1] - d.t[0]) for d in datas)
     if seconds < MIN_SECONDS:
         raise KinergyError(
@@ -71,6 +74,7 @@ def identify_payload_model(
     robot: Robot, datas: Sequence[IdentData], out: str | os.PathLike[str]
 ) -> tuple[Payload, PayloadEstimate]:
     """Identify the payload of ``robot`` (the model without it) and write the model with it."""
+    check_signals(datas)
     payload, report = identify_payload(robot, list(datas))
     what = f"{robot.name} with the payload identified"
     save_robot(robot.with_payload(payload), out, header=_header(what, [d.path for d in datas]))

@@ -9,6 +9,7 @@ from typing import Any
 
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import predict
+from kinergy.identify.sanity import check_signals
 from kinergy.identify.validation import ValidationReport, validation_report
 from kinergy.model.robot import Robot
 from kinergy.report.plots import error_boxplot, save, time_series
@@ -22,6 +23,7 @@ def validate_logs(
     """UR5e Tables V and VII for ``datas``, pooled and per log, moving and holding apart
     (:func:`~kinergy.identify.validation.validation_report`); with ``plots``, also write the
     measured-against-predicted figures to that folder."""
+    check_signals(datas)
     report = validation_report(robot, list(datas))
     if plots is not None:
         write_validation_plots(robot, datas, plots)
