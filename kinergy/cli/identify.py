@@ -53,6 +53,14 @@ def _full_text(fit: FullFit) -> list[str]:
         + f"), condition {fit.condition:.3g}"
         + (f"; largest relative standard error {max(rel)[0]:.2g} ({max(rel)[1]})" if rel else "")
     ]
+    vague = [
+        k + 1 for k, p in enumerate(params) if p.flag == IDENTIFIED and abs(p.rel_std or 0.0) > 1
+    ]
+    if vague:
+        lines.append(
+            f"poorly determined (standard error above the value): base parameters "
+            f"{', '.join(f'b{k}' for k in vague)}; more varied motion would pin them down"
+        )
     phys = fit.physical_fit
     if phys is not None:
         before = " ".join(f"{m.rms:.3g}" for m in fit.regression)
