@@ -223,6 +223,16 @@ def _realisation(
     return pi0 + scale * np.asarray(v.value), x, solver
 
 
+def _within(z: cp.Variable, lo: Array, hi: Array) -> list[cp.Constraint]:
+    """``lo <= z <= hi`` where the bounds are finite."""
+    out = []
+    for bound, sign in ((lo, 1.0), (hi, -1.0)):
+        finite = np.isfinite(bound)
+        if finite.any():
+            out.append(sign * z[finite] >= sign * bound[finite])
+    return out
+
+
 def physical_fit(
     problem: Solved,
     base: BaseParameters,
@@ -290,11 +300,7 @@ def physical_fit(
         objective = objective + _EPS_DROPPED * cp.sum_squares(gap)
     constraints, _ = _lmi(pi, payload, t)
     s_extra = red.scale[n_link:]
-    finite_lo, finite_hi = np.isfinite(lo), np.isfinite(hi)
-    if finite_lo.any():
-        constraints.append(z_extra[finite_lo] >= (lo * s_extra)[finite_lo])
-    if finite_hi.any():
-        constraints.append(z_extra[finite_hi] <= (hi * s_extra)[finite_hi])
+    constraints += _within(z_extra, lo * s_extra, hi * s_extra)
     solver = _solve(cp.Problem(cp.Minimize(objective), constraints))
     if solver is None or v.value is None or z_extra.value is None:
         return None
