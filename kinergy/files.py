@@ -1,18 +1,134 @@
-"""Writing output files whole or not at all."""
+"""Output files written whole or not at all, never over an input, and TOML read safely.
+
+Every file kinergy writes goes through :func:`atomic_write` (or :func:`atomic_folder` for a folder
+of outputs): the content goes to a temporary file beside the target, is flushed to disk (fsync)
+and renamed into place, so a reader never sees half a file and a failure, Ctrl-C or SIGTERM
+leaves no temporary behind and the old file untouched. :func:`check_outputs` refuses, before
+anything is computed, an output that is one of the command's inputs or another output, and an
+existing path that is not a regular file (a device such as ``/dev/null``, a FIFO, a socket, a
+folder, a symbolic link), which renaming over would destroy.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import os
+import shutil
+import signal
+import stat
 import tempfile
 import tomllib
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
+from types import FrameType
 from typing import IO, Any
 
 from kinergy.errors import KinergyError
 
-__all__ = ["atomic_write", "read_toml"]
+__all__ = [
+    "MARKER",
+    "MAX_TOML_BYTES",
+    "Terminated",
+    "atomic_folder",
+    "atomic_write",
+    "check_output",
+    "check_outputs",
+    "read_toml",
+    "terminate_on_signals",
+]
+
+#: a file kinergy puts into every folder it writes, so it may replace that folder later
+MARKER = ".kinergy-output"
+#: a TOML file larger than this is refused before it is read (robot and task files are a few kB)
+MAX_TOML_BYTES = 16 * 1024 * 1024
+
+PathLike = str | os.PathLike[str]
+
+
+class Terminated(BaseException):
+    """SIGTERM arrived: raised in the main thread so that every cleanup runs on the way out."""
+
+
+@contextlib.contextmanager
+def terminate_on_signals() -> Iterator[None]:
+    """Inside the block SIGTERM raises :class:`Terminated` (SIGINT raises KeyboardInterrupt as
+    always), so temporaries are removed and no half-written output stays behind."""
+
+    def raise_terminated(signum: int, frame: FrameType | None) -> None:
+        raise Terminated(signum)
+
+    try:
+        previous = signal.signal(signal.SIGTERM, raise_terminated)
+    except ValueError:  # not the main thread: leave signals alone
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def check_output(path: PathLike) -> Path:
+    """``path`` as an output: refused when it exists and is not a regular file (device, FIFO,
+    socket, folder) or is a symbolic link, or when its folder exists as a file.
+
+    Returns the path. Raises KinergyError, one line naming the path.
+    """
+    target = Path(path)
+    try:
+        info = os.lstat(target)
+    except FileNotFoundError:
+        info = None
+    except OSError as exc:
+        raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
+    if info is not None:
+        if stat.S_ISLNK(info.st_mode):
+            raise KinergyError(
+                f"{target}: is a symbolic link; give the file it points to, or another name"
+            )
+        if not stat.S_ISREG(info.st_mode):
+            kind = "a folder" if stat.S_ISDIR(info.st_mode) else "not a regular file"
+            raise KinergyError(f"{target}: is {kind}; kinergy writes only regular files")
+    parent = target.parent
+    if parent.exists() and not parent.is_dir():
+        raise KinergyError(f"{target}: {parent} is not a folder")
+    return target
+
+
+def _same(a: Path, b: Path) -> bool:
+    if a.exists() and b.exists():
+        with contextlib.suppress(OSError):
+            return os.path.samefile(a, b)
+    return a.resolve() == b.resolve()
+
+
+def check_outputs(
+    outputs: Sequence[tuple[str, PathLike | None]], inputs: Sequence[PathLike]
+) -> None:
+    """Refuse outputs that would destroy an input or each other, before any work is done.
+
+    Parameters
+    ----------
+    outputs : sequence of (flag, path or None)
+        Each output with the flag that named it (``--out``); None: not asked for.
+    inputs : sequence of path
+        Every file the command reads (logs, robot and task files, programs).
+
+    Raises
+    ------
+    KinergyError
+        ``--out log.csv: is also an input (log.csv); choose another name``, and the like.
+    """
+    given = [(flag, Path(p)) for flag, p in outputs if p is not None]
+    for k, (flag, path) in enumerate(given):
+        for source in inputs:
+            if _same(path, Path(source)):
+                raise KinergyError(
+                    f"{flag} {path}: is also an input ({source}); choose another name"
+                )
+        for other_flag, other in given[:k]:
+            if _same(path, other):
+                raise KinergyError(f"{flag} {path}: is also the output of {other_flag}")
 
 
 @contextlib.contextmanager
@@ -30,42 +146,110 @@ def _temporary(target: Path) -> Iterator[tuple[int, str]]:
         raise
 
 
+def _fsync_folder(folder: Path) -> None:
+    with contextlib.suppress(OSError):  # not every file system lets a folder be opened
+        fd = os.open(folder, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
 def atomic_write(
-    path: str | os.PathLike[str], write: Callable[[IO[Any]], object], *, binary: bool = False
+    path: PathLike, write: Callable[[IO[Any]], object], *, binary: bool = False
 ) -> Path:
-    """Write a file through ``write(handle)`` into a temporary file beside it, then rename it
-    into place: readers never see a half-written file, and a failure leaves nothing behind.
+    """Write a file through ``write(handle)`` into a temporary file beside it, flush it to disk
+    and rename it into place: readers never see a half-written file, and a failure (an
+    exception, Ctrl-C, SIGTERM under :func:`terminate_on_signals`) leaves nothing behind.
 
     Raises
     ------
     KinergyError
-        ``PATH: cannot write (reason)`` when the folder or file cannot be written.
+        ``PATH: cannot write (reason)``, or :func:`check_output`'s refusals.
     """
-    target = Path(path)
+    target = check_output(path)
     with _temporary(target) as (fd, tmp):
         try:
             mode = "wb" if binary else "w"
             kwargs: dict[str, Any] = {} if binary else {"encoding": "utf-8", "newline": "\n"}
             with os.fdopen(fd, mode, **kwargs) as handle:
                 write(handle)
+                handle.flush()
+                os.fsync(handle.fileno())
             os.chmod(tmp, 0o644)  # mkstemp makes it private; outputs are for reading
             os.replace(tmp, target)
         except OSError as exc:
             raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
+    _fsync_folder(target.parent)
     return target
 
 
-def read_toml(path: str | os.PathLike[str], what: str) -> dict[str, Any]:
+def _replaceable(folder: Path) -> bool:
+    """A folder kinergy may replace: missing, empty, or one it wrote itself (:data:`MARKER`)."""
+    if not folder.exists():
+        return True
+    if folder.is_symlink() or not folder.is_dir():
+        return False
+    return not any(folder.iterdir()) or (folder / MARKER).is_file()
+
+
+@contextlib.contextmanager
+def atomic_folder(path: PathLike) -> Iterator[Path]:
+    """Build a folder of outputs beside ``path`` and rename it into place at the end.
+
+    Yields the temporary folder to write into. On success it replaces ``path`` (which must be
+    missing, empty, or a folder kinergy wrote before); on any failure it is removed and ``path``
+    is untouched.
+
+    Raises
+    ------
+    KinergyError
+        ``path`` is a file, a link, or a folder with other content (one line naming it).
+    """
+    target = Path(path)
+    if not _replaceable(target):
+        raise KinergyError(
+            f"{target}: exists and holds files kinergy did not write; give an empty or new folder"
+        )
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        building = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
+    except OSError as exc:
+        raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
+    try:
+        (building / MARKER).write_text("written by kinergy; it may replace this folder\n")
+        yield building
+        os.chmod(building, 0o755)
+        old = None
+        if target.exists():
+            old = target.with_name(f".{target.name}.old-{os.getpid()}")
+            os.replace(target, old)
+        os.replace(building, target)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(building, ignore_errors=True)
+        raise
+
+
+def read_toml(path: PathLike, what: str) -> dict[str, Any]:
     """Parse a TOML file; ``what`` names the kind of file in messages ("robot file").
 
     Raises
     ------
     KinergyError
-        ``PATH: cannot read WHAT (reason)``, ``PATH: not a text (UTF-8) file`` or
-        ``PATH: not valid TOML: ... (line L column C)``.
+        ``PATH: cannot read WHAT (reason)``, ``PATH: not a text (UTF-8) file``,
+        ``PATH: not valid TOML: ... (line L column C)``, a file over :data:`MAX_TOML_BYTES`, or
+        nesting too deep to be a robot or task file.
     """
     path = Path(path)
     try:
+        size = path.stat().st_size
+        if size > MAX_TOML_BYTES:
+            raise KinergyError(
+                f"{path}: {size / 1e6:.1f} MB is too large for a {what} "
+                f"(at most {MAX_TOML_BYTES // (1024 * 1024)} MiB)"
+            )
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise KinergyError(f"{path}: cannot read {what} ({exc.strerror})") from None
@@ -75,3 +259,5 @@ def read_toml(path: str | os.PathLike[str], what: str) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise KinergyError(f"{path}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise KinergyError(f"{path}: not a {what}: its tables or arrays nest too deeply") from None

@@ -17,6 +17,7 @@ from collections.abc import Sequence
 import click
 
 from kinergy.errors import KinergyError
+from kinergy.files import Terminated, terminate_on_signals
 
 __all__ = ["COMMANDS", "LazyGroup", "cli", "main", "run"]
 
@@ -60,17 +61,21 @@ def cli() -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point: run the CLI, turning user errors into one line and a non-zero exit."""
     try:
-        cli.main(
-            args=list(argv) if argv is not None else None,
-            prog_name="kinergy",
-            standalone_mode=False,
-        )
+        with terminate_on_signals():
+            cli.main(
+                args=list(argv) if argv is not None else None,
+                prog_name="kinergy",
+                standalone_mode=False,
+            )
     except KinergyError as exc:
         click.echo(f"kinergy: error: {exc}", err=True)
         return 1
-    except click.exceptions.Abort:
-        click.echo("kinergy: aborted", err=True)
-        return 1
+    except (click.exceptions.Abort, KeyboardInterrupt):
+        click.echo("kinergy: interrupted; no output was left half-written", err=True)
+        return 130
+    except Terminated:
+        click.echo("kinergy: terminated; no output was left half-written", err=True)
+        return 143
     except click.ClickException as exc:
         exc.show()
         return exc.exit_code
