@@ -92,3 +92,17 @@ def test_a_corrupted_log_is_refused_in_one_line() -> None:
     )
     with pytest.raises(KinergyError, match=r"not a value a robot logs .* a corrupted log$"):
         check_signals(datas)
+
+
+@pytest.mark.skipif(not DATASETS.exists(), reason="shared datasets not available")
+def test_a_static_log_is_refused_by_every_method(tmp_path: Path) -> None:
+    from kinergy.errors import KinergyError
+    from kinergy.workflows.identify import METHODS, identify_model
+
+    static = DATASETS / "validation_data" / "ur-20_01_17-p1.csv"  # holds only
+    datas = prepared_logs([static], n_joints=6, columns=UR10E_COLUMNS)
+    for method in METHODS:
+        out = tmp_path / f"{method}.toml"
+        with pytest.raises(KinergyError, match="no joint moves in these logs"):
+            identify_model(kinergy.load_robot("ur10e"), datas, out, method=method)
+        assert not out.exists()

@@ -10,9 +10,12 @@ import numpy as np
 from kinergy.errors import KinergyError
 from kinergy.identify.preprocess import IdentData
 
-__all__ = ["LIMITS", "check_signals"]
+__all__ = ["LIMITS", "STILL_SPAN", "check_motion", "check_signals"]
 
 #: largest plausible magnitude per signal (attribute of IdentData, log name, limit, unit)
+#: rad: logs in which no joint's position spans this much show no motion to identify from
+STILL_SPAN = 0.02
+
 LIMITS = (
     ("q", "actual_q", 1e3, "rad"),
     ("qd", "actual_qd", 1e2, "rad/s"),
@@ -43,3 +46,20 @@ def check_signals(datas: Sequence[IdentData]) -> None:
                     f"t = {d.t[row]:.3f} s, not a value a robot logs (beyond {limit:g} {unit}): "
                     "a corrupted log"
                 )
+
+
+def check_motion(datas: Sequence[IdentData]) -> None:
+    """Raise when no joint moves in any log (every position spans less than
+    :data:`STILL_SPAN`): no method can identify anything from a static log.
+
+    Raises
+    ------
+    KinergyError
+        One line naming the largest span found.
+    """
+    span = max(float(np.max(np.ptp(d.q, axis=0))) for d in datas)
+    if span < STILL_SPAN:
+        raise KinergyError(
+            f"no joint moves in these logs (largest position span {span:.2g} rad, below "
+            f"{STILL_SPAN} rad): nothing to identify from"
+        )

@@ -18,7 +18,7 @@ from kinergy.identify.nursing import identify_nursing
 from kinergy.identify.payload import PayloadEstimate, identify_payload
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult
-from kinergy.identify.sanity import check_signals
+from kinergy.identify.sanity import check_motion, check_signals
 from kinergy.identify.sequential import identify_sequential
 from kinergy.model import Payload, Robot, save_robot
 from kinergy.model.robot import Source
@@ -83,10 +83,11 @@ def run_method(
     Raises
     ------
     KinergyError
-        Logs spanning less than :data:`MIN_SECONDS` together, or with signals no robot logs
-        (:func:`~kinergy.identify.sanity.check_signals`); nothing is written.
+        Logs spanning less than :data:`MIN_SECONDS` together, with signals no robot logs or
+        without motion (:mod:`kinergy.identify.sanity`); nothing is written.
     """
     check_signals(datas)
+    check_motion(datas)
     seconds = sum(float(d.t[-1] - d.t[0]) for d in datas)
     if seconds < MIN_SECONDS:
         raise KinergyError(
