@@ -111,8 +111,11 @@ def test_toml_that_nests_too_deeply_is_one_line(tmp_path: Path) -> None:
 
 _SLOW_WRITER = textwrap.dedent(
     """
-    import sys, time
+    import signal, sys, time
     from kinergy.files import atomic_write, terminate_on_signals
+
+    # A shell's background job starts with SIGINT ignored; Ctrl-C at a terminal is not.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
     def slow(fh):
         fh.write("partial")

@@ -6,8 +6,6 @@ import click
 
 from kinergy.cli.common import (
     columns_option,
-    fmt,
-    fmt_vector,
     note,
     progress,
     repair_option,
@@ -16,8 +14,9 @@ from kinergy.cli.common import (
 )
 from kinergy.cli.validate import validation_text
 from kinergy.friction.registry import MODELS
+from kinergy.identify.full import FullFit
 from kinergy.identify.payload import PayloadEstimate
-from kinergy.identify.result import IdentificationResult
+from kinergy.identify.result import FLAGS, IDENTIFIED, DriveEstimate, IdentificationResult
 from kinergy.jsonable import dumps
 from kinergy.model import load_robot
 from kinergy.workflows.identify import METHODS, identify_model, identify_payload_model
@@ -28,11 +27,60 @@ __all__ = ["identify"]
 
 def _payload_text(report: PayloadEstimate, out: str) -> str:
     lines = [
-        f"payload: {report.mass:.4f} +- {report.mass_std:.4f} kg at "
-        f"{fmt_vector(report.com)} m (flange frame), from {report.signal}; wrote {out}"
+        f"payload: {report.mass:.4f} +- {report.mass_std:.4f} kg at ["
+        + ", ".join(
+            f"{c:.4f} +- {sd:.4f}" for c, sd in zip(report.com, report.com_std, strict=True)
+        )
+        + f"] m (flange frame), from {report.signal}; wrote {out}"
     ]
     lines += [f"note: {n}" for n in report.notes]
     return "\n".join(lines)
+
+
+def _with_std(j: DriveEstimate, key: str, value: float, spec: str) -> str:
+    """``value +- std`` of parameter ``key`` of joint ``j``, with its flag when not identified."""
+    std = j.std.get(key)
+    text = f"{value:{spec}}" + (f" +- {std:.2g}" if std is not None else "")
+    flag = j.flags.get(key, IDENTIFIED)
+    return text if flag == IDENTIFIED else f"{text} ({flag})"
+
+
+def _full_text(fit: FullFit) -> list[str]:
+    """The full method's base parameters (flags, largest relative standard error) and, when the
+    robot was written from the constrained fit, what the physical constraints cost."""
+    params = fit.base_parameters
+    counts = {f: sum(p.flag == f for p in params) for f in FLAGS}
+    rel = [
+        (abs(p.rel_std), f"b{k + 1} = {p.name[:40]}{'...' if len(p.name) > 40 else ''}")
+        for k, p in enumerate(params)
+        if p.flag == IDENTIFIED and p.rel_std is not None
+    ]
+    lines = [
+        f"base parameters: {len(params)} ("
+        + ", ".join(f"{c} {f}" for f, c in counts.items() if c)
+        + f"), condition {fit.condition:.3g}"
+        + (f"; largest relative standard error {max(rel)[0]:.2g} ({max(rel)[1]})" if rel else "")
+    ]
+    vague = [
+        k + 1 for k, p in enumerate(params) if p.flag == IDENTIFIED and abs(p.rel_std or 0.0) > 1
+    ]
+    if vague:
+        lines.append(
+            f"poorly determined (standard error above the value): base parameters "
+            f"{', '.join(f'b{k}' for k in vague)}; more varied motion would pin them down"
+        )
+    phys = fit.physical_fit
+    if phys is not None:
+        before = " ".join(f"{m.rms:.3g}" for m in fit.regression)
+        after = " ".join(f"{m.rms:.3g}" for m in phys.regression)
+        lines += [
+            f"physical fit ({phys.solver}): chi^2 up by {phys.chi2_increase:.3g}; RMS per joint "
+            f"[N m] {before} unconstrained, {after} physical",
+            *(f"  active: {a}" for a in phys.active),
+        ]
+    if fit.scale:
+        lines.append(f"scale: {fit.scale}")
+    return lines
 
 
 def _choice_text(result: IdentificationResult) -> list[str]:
@@ -63,13 +111,15 @@ def _choice_text(result: IdentificationResult) -> list[str]:
 def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     rows = []
     for j in result.joints:
-        fr = " ".join(f"{k}={fmt(v)}" for k, v in j.friction.items() if k != "model")
+        fr = " ".join(
+            f"{k}={_with_std(j, k, v, '.6g')}" for k, v in j.friction.items() if k != "model"
+        )
         rows.append(
             [
                 j.name,
-                f"{j.rotor_inertia:.4e}",
+                _with_std(j, "rotor_inertia", j.rotor_inertia, ".4e"),
                 f"{j.motor_inertia:.4e}",
-                f"{j.torque_constant:.4f}",
+                _with_std(j, "torque_constant", j.torque_constant, ".4f"),
                 f"{j.friction['model']} {fr}",
             ]
         )
@@ -79,6 +129,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
         f"{result.robot.name}: {result.method} identification from {logs} log(s), {samples} samples",
         table(headers, rows),
     ]
+    if isinstance(result.fit, FullFit):
+        lines += _full_text(result.fit)
     lines += _choice_text(result)
     text = validation_text(result.fit, result.robot.joint_names)
     if text:

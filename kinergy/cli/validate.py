@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from pathlib import Path
 
 import click
+import numpy as np
 
 from kinergy.cli.common import (
     columns_option,
@@ -17,34 +19,95 @@ from kinergy.cli.common import (
 )
 from kinergy.identify.metrics import JointMetrics
 from kinergy.identify.result import Validation
+from kinergy.identify.validation import (
+    HOLD_SECONDS,
+    HOLD_SPEED,
+    SignalMetrics,
+    ValidationReport,
+)
 from kinergy.jsonable import dumps
 from kinergy.workflows.logs import prepared_logs
 from kinergy.workflows.validate import validate_logs
 
-__all__ = ["validate", "validation_text"]
+__all__ = ["report_text", "validate", "validation_text"]
+
+
+def _r2(m: JointMetrics) -> str:
+    note = m.note if isinstance(m, SignalMetrics) else None
+    return note or (f"{m.r2:.4f}" if np.isfinite(m.r2) else "signal constant")
 
 
 def _metrics_table(metrics: Sequence[JointMetrics], names: Sequence[str], unit: str) -> str:
-    return table(
-        ["joint", f"mean [{unit}]", f"max [{unit}]", f"RMS [{unit}]", "R^2"],
-        [
-            [name, f"{m.mean:.4f}", f"{m.max:.4f}", f"{m.rms:.4f}", f"{m.r2:.4f}"]
-            for name, m in zip(names, metrics, strict=True)
-        ],
-    )
+    normalised = all(isinstance(m, SignalMetrics) for m in metrics)
+    headers = ["joint", f"mean [{unit}]", f"max [{unit}]", f"RMS [{unit}]"]
+    rows = []
+    for name, m in zip(names, metrics, strict=True):
+        row = [name, f"{m.mean:.4f}", f"{m.max:.4f}", f"{m.rms:.4f}"]
+        if isinstance(m, SignalMetrics) and normalised:
+            row.append(f"{m.nrms:.3f}")
+        rows.append([*row, _r2(m)])
+    return table(headers + (["NRMS"] if normalised else []) + ["R^2"], rows)
+
+
+#: the tables of a validation: field, title, unit
+_TABLES = (
+    ("torque", "Torque against target_moment (UR5e Table V)", "N m"),
+    ("current", "Current against actual_current (UR5e Table VII)", "A"),
+    ("joint_torque", "Joint torque against measured torque", "N m"),
+)
 
 
 def validation_text(report: Validation, names: Sequence[str]) -> str:
     """The torque, current and joint-torque tables of a validation report ('' when it has none)."""
     parts = []
-    for metrics, title, unit in (
-        (report.torque, "Torque against target_moment (UR5e Table V)", "N m"),
-        (report.current, "Current against actual_current (UR5e Table VII)", "A"),
-        (report.joint_torque, "Joint torque against measured torque", "N m"),
-    ):
+    for key, title, unit in _TABLES:
+        metrics = getattr(report, key)
         if metrics:
             parts += [title, _metrics_table(metrics, names, unit), ""]
     return "\n".join(parts).rstrip()
+
+
+def _per_log_text(report: ValidationReport, names: Sequence[str]) -> str:
+    """Per log and signal: R^2 per joint while moving, and the RMS while holding."""
+    parts = []
+    for key, title, unit in _TABLES:
+        rows = []
+        for log in report.logs:
+            moving = getattr(log.moving, key) if log.moving else None
+            holding = getattr(log.holding, key) if log.holding else None
+            if moving is None and holding is None:
+                continue
+            none = [None] * len(names)
+            cells = [
+                (_r2(m) if m is not None else "-") + (f" / {h.rms:.3g}" if h is not None else "")
+                for m, h in zip(moving or none, holding or none, strict=True)
+            ]
+            rows.append([Path(log.log).stem, f"{log.holding_fraction:.0%}", *cells])
+        if rows:
+            parts += [
+                f"{title}: R^2 while moving / RMS [{unit}] while holding",
+                table(["log", "holding", *names], rows),
+                "",
+            ]
+    return "\n".join(parts).rstrip()
+
+
+def report_text(report: ValidationReport, names: Sequence[str]) -> str:
+    """``validate``'s text: pooled tables, the moving and holding segments, and each log."""
+    text = validation_text(report, names)
+    if not text:
+        return "the logs have neither target_moment nor actual_current nor measured torques"
+    lines = [
+        f"{report.samples} samples, {report.holding_fraction:.0%} in static holds (every joint "
+        f"below {HOLD_SPEED} rad/s for {HOLD_SECONDS} s or more)\n",
+        text,
+    ]
+    for label, part in (("moving", report.moving), ("holding", report.holding)):
+        if part is not None and report.moving is not None and report.holding is not None:
+            lines += [f"\n--- {label} samples only ---", validation_text(part, names)]
+    if len(report.logs) > 1:
+        lines += ["\n--- per log ---", _per_log_text(report, names)]
+    return "\n".join(lines)
 
 
 @click.command()
@@ -87,9 +150,6 @@ def validate(
         click.echo(dumps(report))
         return
     click.echo(f"{r.name} on {', '.join(logs)}\n")
-    text = validation_text(report, r.joint_names)
-    click.echo(
-        text or "the logs have neither target_moment nor actual_current nor measured torques"
-    )
+    click.echo(report_text(report, r.joint_names))
     if plots:
         click.echo(f"\nplots in {plots}")

@@ -8,6 +8,9 @@ Rows are the (sample, joint) pairs of every log, stacked; columns, in this order
 - friction: ``N^T F(wm)``, ``F`` each motor's friction columns
   (:func:`kinergy.friction.registry.friction_columns`) at the motor speeds ``wm = N qd``.
 
+Against currents alone a common scale of every parameter and of the torque constants cannot be
+told apart; :func:`scale_row` measures it against the model's published masses.
+
 The ``power_flow`` model's columns depend on the direction of power flow through the gear, i.e.
 on the sign of the load torque: :func:`power_flow_load` decides it from the measurement, and the
 friction block is rebuilt for each decision (:func:`set_friction`).
@@ -40,6 +43,7 @@ __all__ = [
     "joint_frictions",
     "power_flow_load",
     "rotor_columns",
+    "scale_row",
     "set_friction",
     "stack",
 ]
@@ -107,7 +111,10 @@ def joint_frictions(
 
 
 def columns(
-    robot: Robot, base: BaseParameters, models: list[str], params: list[dict[str, float]]
+    robot: Robot,
+    base: BaseParameters,
+    models: list[str],
+    params: list[dict[str, float]],
 ) -> Columns:
     """Name, group and prior of every column: base parameters, rotor inertias, friction levels."""
     n = robot.n
@@ -183,13 +190,28 @@ class Stacked:
 
     @property
     def n_fixed(self) -> int:
-        """Columns that do not depend on the load torque (link and rotor)."""
+        """Columns before the friction block (link and rotor)."""
         return self.cols.n_link + self.n_mat.shape[0]
 
     @property
     def needs_load(self) -> bool:
         """Whether any friction model depends on the direction of power flow."""
         return any(m in LOAD_DEPENDENT for m in self.models)
+
+
+def scale_row(robot: Robot, base: BaseParameters, q: Array) -> Array:
+    """How the link base parameters scale the model's gravity torques, shape (b,).
+
+    With ``G(q) = Y_b(q, 0, 0)`` the base columns at rest and ``g0 = G pi_b,model`` the model's
+    gravity torques (N m) at the poses ``q`` (N, n), the row is ``sum(g0 * G) / |g0|^2``: its
+    product with base parameters is their gravity torques projected on the model's, 1 for the
+    model (the scale the model's published masses set).
+    """
+    step = max(1, q.shape[0] // 2000)  # the gravity torques of a few thousand poses suffice
+    qs = q[::step]
+    at_rest = base.regressor(regressor(robot, qs, np.zeros_like(qs), np.zeros_like(qs)))
+    g0 = at_rest @ base.project(inertial_parameters(robot))
+    return np.asarray(np.einsum("sj,sjb->b", g0, at_rest) / float(np.sum(g0**2)))
 
 
 def stack(

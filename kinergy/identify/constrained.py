@@ -1,24 +1,43 @@
-"""The full method's physically consistent refit: least squares constrained to real bodies.
+"""The full method's physically consistent fit: least squares constrained to real bodies and drives.
 
-When the standard parameters closest to the model's (:func:`kinergy.identify.physical.
-standard_from_base`) are not a physical link, or a rotor inertia comes out negative, the robot is
-written from the least-squares fit constrained to physically consistent links (pseudo-inertia
-positive definite, Wensing et al. 2018) and non-negative rotor inertias: a small convex problem on
-the regression's own triangle (linear matrix inequalities), solved by a log-barrier method
-(:func:`barrier_lsq`). It reproduces the identified base parameters exactly whenever they have a
-physical realisation.
+When the unconstrained least squares of :mod:`kinergy.identify.regression` has no physical
+realisation (a link whose standard parameters closest to the model's are not a real body, a
+negative rotor inertia, friction outside its model's bounds), the
+robot is written from the least-squares fit constrained to physical values instead: a convex
+problem (a semidefinite program) solved by cvxpy with Clarabel (SCS as the fallback):
+
+    minimise    |R (z - z_hat)|^2 / (sigma^2 c)  +  eps |S^-1 (pi - pi_0)|^2  +  eps_d |dropped - prior|^2
+    subject to  T_l P_l(pi - payload) T_l  >=  margin 1     (each link, Wensing et al. 2018)
+                rotor inertias >= 0,  friction within FrictionModel.bounds
+
+``R`` is the regression's own reduced triangle (:func:`kinergy.linalg.reduce`, column-scaled
+unknowns ``z``, so the data enter as a (p + 1) x p matrix whatever the number of samples) and
+``z_hat`` its least-squares optimum, so the first term is the chi^2 the constraints cost
+(``|R z - r|^2 = |R (z - z_hat)|^2 + sse_0``, the residual being orthogonal to the columns),
+in units ``c`` of the chi^2 the model itself would cost (feasible, so the optimum is below 1); ``pi``
+the links' standard parameters (10 per link) whose base projection gives the link columns,
+``P_l`` link ``l``'s 4x4 pseudo-inertia (positive definite exactly for a physically consistent
+link), ``T_l`` a scaling that makes it dimensionless (kg and 0.1 m). The small ``eps`` terms
+only settle what the data cannot see: the standard parameters outside the base projection stay
+nearest the model's, and columns the data cannot tell apart stay at the model's unless a
+constraint moves them.
 """
 
 from __future__ import annotations
 
+import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 
+import cvxpy as cp
 import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.dynamics.regressor import BaseParameters
+from kinergy.friction.registry import get_model
 from kinergy.identify.columns import Columns
 from kinergy.identify.physical import (
+    LENGTH_SCALE,
     PSEUDO_BASIS,
     base_projection,
     link_consistency,
@@ -26,268 +45,191 @@ from kinergy.identify.physical import (
 )
 from kinergy.identify.regression import Solved
 
-__all__ = ["ConstrainedFit", "barrier_lsq", "physical_fit"]
+__all__ = ["MARGIN", "ConstrainedFit", "bounds", "physical_fit"]
 
 Array = NDArray[np.float64]
 
-
-# ---------------------------------------------------------------------------------------------
-# The log-barrier solver
-
-
-def _barrier(u: Array, c_blocks: Array, b_blocks: Array, a_vec: Array, r_mat: Array) -> float:
-    """``-sum log det(C_l + sum_k u_k B_lk) - sum log(a + R u)``; inf outside the feasible set."""
-    slack = a_vec + r_mat @ u
-    if np.any(slack <= 0):
-        return np.inf
-    eig = np.linalg.eigvalsh(c_blocks + np.einsum("k,lkab->lab", u, b_blocks))
-    if np.any(eig <= 0):
-        return np.inf
-    return float(-np.sum(np.log(eig)) - np.sum(np.log(slack)))
+#: smallest eigenvalue of each link's scaled pseudo-inertia (kg and LENGTH_SCALE as units)
+MARGIN = 1e-5
+#: weights (in units of the model's chi^2) of the terms that settle what the data cannot see
+_EPS_LINKS = 1e-6
+_EPS_DROPPED = 1e-4
 
 
-def _newton_step(
-    u: Array, t: float, gtg: Array, gtr: Array, lmi: tuple[Array, Array], lin: tuple[Array, Array]
-) -> tuple[Array, float] | None:
-    """Newton step on ``t |r0 + jac u|^2 + barrier`` and its decrement; None when singular.
-    ``lmi`` = (c_blocks, b_blocks), ``lin`` = (a_vec, r_mat)."""
-    (c_blocks, b_blocks), (a_vec, r_mat) = lmi, lin
-    inv = np.linalg.inv(c_blocks + np.einsum("k,lkab->lab", u, b_blocks))
-    mk = np.einsum("lab,lkbc->lkac", inv, b_blocks)  # X^-1 B_k
-    slack = a_vec + r_mat @ u
-    grad = 2.0 * t * (gtg @ u + gtr) - np.einsum("lkaa->k", mk) - r_mat.T @ (1.0 / slack)
-    hess = (
-        2.0 * t * gtg + np.einsum("lkab,lmba->km", mk, mk) + (r_mat / slack[:, None] ** 2).T @ r_mat
-    )
-    try:
-        step = -np.linalg.solve(hess, grad)
-    except np.linalg.LinAlgError:
-        return None
-    return step, float(-grad @ step)
-
-
-def barrier_lsq(
-    r0: Array,
-    jac: Array,
-    lmi: tuple[Array, Array],
-    lin: tuple[Array, Array],
-    u0: Array,
-    gap: float = 1e-3,
-) -> Array | None:
-    """``min |r0 + jac u|^2`` subject to ``C_l + sum_k u_k B_lk > 0`` (symmetric blocks) and
-    ``a + R u > 0``, from a strictly feasible ``u0``: a log-barrier interior-point method with
-    Newton steps (Boyd & Vandenberghe, Convex Optimization, section 11.3), stopped when the
-    barrier's duality gap is below ``gap``.
-
-    ``lmi`` = (``C`` (L, d, d), ``B`` (L, K, d, d)), ``lin`` = (``a`` (M,), ``R`` (M, K)).
-    Returns ``None`` when ``u0`` is not strictly feasible or Newton fails.
-    """
-    gtg, gtr = jac.T @ jac, jac.T @ r0
-    m = lmi[0].shape[0] * lmi[0].shape[1] + lin[0].size  # barrier weight count
-
-    def merit(u: Array, t: float) -> float:
-        r = r0 + jac @ u
-        return t * float(r @ r) + _barrier(u, *lmi, *lin)
-
-    u = u0.copy()
-    if not np.isfinite(_barrier(u, *lmi, *lin)):
-        return None
-    t = m / max(float((r0 + jac @ u) @ (r0 + jac @ u)), 1e-6)
-    for _ in range(60):  # outer: t grows tenfold each time
-        for _ in range(100):  # Newton on t f + barrier
-            newton = _newton_step(u, t, gtg, gtr, lmi, lin)
-            if newton is None:
-                return None
-            step, decrement = newton
-            if decrement / 2.0 < 1e-9:
-                break
-            value = merit(u, t)
-            size = 1.0
-            while size > 1e-12:
-                trial = u + size * step
-                if merit(trial, t) <= value - 0.25 * size * decrement:
-                    break
-                size *= 0.5
-            else:
-                break
-            u = trial
-        if m / t < gap:
-            return u
-        t *= 10.0
-    return u
-
-
-# ---------------------------------------------------------------------------------------------
-# The constrained problem
-
-
-@dataclass(frozen=True, eq=False)
-class _Affine:
-    """The unknowns of the constrained fit, ``u = [eta, t, delta]`` (``nk + nt + nd``).
-
-    ``eta`` moves the kept unknowns along the regression's information (``x[kept] = x_hat +
-    m_mat eta``, ``|eta|^2`` the chi^2 increase); ``t`` moves along the null space ``z_null`` of
-    the base projection (standard parameters the data cannot see); ``delta`` moves the merged
-    rotor inertias (``J = j0 + j_unit delta``). The standard parameters are ``pi = pi_a + b_mat u``.
-    """
-
-    m_mat: Array
-    lam_h: Array
-    vec_h: Array
-    p_mat: Array
-    k_mat: Array
-    z_null: Array
-    motors: list[int]
-    j0: Array
-    j_unit: Array
-    c_dj: Array
-    pi_a: Array
-    b_mat: Array
-
-    @property
-    def sizes(self) -> tuple[int, int, int]:
-        """``(nk, nt, nd)``."""
-        return self.m_mat.shape[1], self.z_null.shape[1], len(self.motors)
-
-
-def _information(problem: Solved) -> tuple[Array, Array, Array] | None:
-    """Eigen-decomposition of the regression's information ``H`` in scaled unknowns, and
-    ``m_mat`` with ``x[kept] - x_hat[kept] = m_mat @ eta`` (``|eta|^2`` the chi^2 increase)."""
-    red, kept = problem.reduced, problem.kept
-    s = red.scale[kept]
-    # noise-free data: a floor at 1e-9 of the signal keeps H finite
-    sigma2 = max(problem.sigma2, 1e-18 * float(red.r_y @ red.r_y) / red.rows, 1e-300)
-    r_k = red.r_a[:, kept]
-    # information in the scaled unknowns z = s x (unit-norm columns: well conditioned)
-    hess = (r_k.T @ r_k + problem.lam * np.eye(kept.size)) / sigma2
-    lam_h, vec_h = np.linalg.eigh(0.5 * (hess + hess.T))
-    if lam_h[0] <= 0:
-        return None
-    return lam_h, vec_h, vec_h / np.sqrt(lam_h) / s[:, None]
-
-
-def _affine(
-    problem: Solved,
-    base: BaseParameters,
-    cols: Columns,
-    x: Array,
-    pi0: Array,
-    scale: Array,
-    merged_rotor: dict[int, Array],
-) -> _Affine | None:
-    """The standard parameters as an affine function of ``u`` (:class:`_Affine`):
-    ``pi = pi_s(theta - C dJ) + S Z t`` with ``theta = theta_hat + m_mat[:b] eta``,
-    ``pi_s`` = :func:`standard_from_base`'s map and ``C dJ`` the merged rotor inertias' share."""
-    info = _information(problem)
-    if info is None:
-        return None
-    lam_h, vec_h, m_mat = info
-    n_link, p = cols.n_link, pi0.size
-    p_mat = base_projection(base, p)
-    k_mat = (scale**2)[:, None] * p_mat.T @ np.linalg.inv((p_mat * scale**2) @ p_mat.T)  # pi_s
-    _, sv, vt = np.linalg.svd(p_mat * scale)
-    z_null = vt[int(np.sum(sv > 1e-12 * sv[0])) :].T  # orthonormal, scaled coordinates
-    motors = sorted(merged_rotor)
-    j0 = np.array([cols.prior[n_link + m] for m in motors])
-    j_unit = np.where(j0 > 0, j0, 1e-6)
-    c_dj = (
-        np.column_stack([merged_rotor[m] for m in motors]) * j_unit
-        if motors
-        else np.zeros((n_link, 0))
-    )
-    km = k_mat @ m_mat[:n_link]
-    pi_a = pi0 + k_mat @ (x[:n_link] - p_mat @ pi0)
-    b_mat = np.hstack([km, scale[:, None] * z_null, -k_mat @ c_dj])
-    return _Affine(m_mat, lam_h, vec_h, p_mat, k_mat, z_null, motors, j0, j_unit, c_dj, pi_a, b_mat)
-
-
-def _objective(aff: _Affine, pi0: Array, scale: Array, eps: float) -> tuple[Array, Array]:
-    """``r0`` and ``jac`` of ``|eta|^2 + eps (|S^-1 (pi_s - pi0)|^2 + |t|^2 + |delta|^2)``."""
-    nk, nt, nd = aff.sizes
-    p = pi0.size
-    root = np.sqrt(eps)
-    r0 = np.concatenate([np.zeros(nk), root * (aff.pi_a - pi0) / scale, np.zeros(nt + nd)])
-    jac = np.zeros((nk + p + nt + nd, nk + nt + nd))
-    jac[:nk, :nk] = np.eye(nk)
-    jac[nk : nk + p, :nk] = root * aff.b_mat[:, :nk] / scale[:, None]
-    jac[nk : nk + p, nk + nt :] = -root * (aff.k_mat @ aff.c_dj) / scale[:, None]
-    jac[nk + p :, nk:] = root * np.eye(nt + nd)
-    return r0, jac
-
-
-def _link_blocks(aff: _Affine, pi0: Array, payload: Array) -> tuple[Array, Array, Array] | None:
-    """The links' constraints ``pseudo-inertia(pi - payload) > 1e-3`` times the start's smallest
-    eigenvalue as blocks ``C + sum_k u_k B_k`` (each link normalised by that eigenvalue), and the
-    start: the model, each link thickened by 1e-6 of its largest pseudo-inertia eigenvalue (a
-    flat model link, e.g. a thin disc, sits on the boundary; the barrier needs the inside).
-    None when the model itself is not physical."""
-    n_links = pi0.size // 10
-    eig0 = np.linalg.eigvalsh(pseudo_inertia(pi0 - payload))
-    if np.any(eig0[:, 0] < -1e-9 * eig0[:, -1]):
-        return None
-    pi_start = pi0.copy()
-    for link in range(n_links):  # Sigma + e 1  <=>  Ixx, Iyy, Izz + 2 e
-        pi_start[10 * link + np.array([4, 6, 9])] += 2e-6 * eig0[link, -1]
-    ref = np.linalg.eigvalsh(pseudo_inertia(pi_start - payload))[:, 0]
-    c_blocks = pseudo_inertia(aff.pi_a - payload) / ref[:, None, None] - 1e-3 * np.eye(4)
-    b_blocks = np.einsum("lpk,pab->lkab", aff.b_mat.reshape(n_links, 10, -1), PSEUDO_BASIS)
-    b_blocks /= ref[:, None, None, None]
-    return c_blocks, b_blocks, pi_start
-
-
-def _rotor_bounds(
-    aff: _Affine, cols: Columns, x: Array, kept: NDArray[np.intp]
-) -> tuple[Array, Array]:
-    """Rotor inertias, affine in ``u`` (kept ones through ``eta``, merged ones through
-    ``delta``), ``>= -1e-3`` of their size (the barrier's strict start; clipped to 0 after), as
-    ``a + R u > 0``."""
-    nk, nt, nd = aff.sizes
-    rotor_rows = np.flatnonzero([cols.group[k] == "rotor" for k in kept])
-    rot_a = np.concatenate([x[kept[rotor_rows]], aff.j0])
-    rot_b = np.zeros((rotor_rows.size + nd, nk + nt + nd))
-    rot_b[: rotor_rows.size, :nk] = aff.m_mat[rotor_rows]
-    rot_b[rotor_rows.size :, nk + nt :] = np.diag(aff.j_unit)
-    rot_scale = np.maximum(np.abs(np.concatenate([cols.prior[kept[rotor_rows]], aff.j0])), 1e-9)
-    return rot_a / rot_scale + 1e-3, rot_b / rot_scale[:, None]
-
-
-def _start(
-    aff: _Affine, problem: Solved, cols: Columns, x: Array, scale: Array, pi_start: Array
-) -> Array:
-    """``u`` of ``pi_start`` with the model's rotor inertias and friction (strictly feasible)."""
-    nk, nt, nd = aff.sizes
-    kept, n_link = problem.kept, cols.n_link
-    s = problem.reduced.scale[kept]
-    u0 = np.zeros(nk + nt + nd)
-    x0 = cols.prior[kept].copy()
-    x0[:n_link] = aff.p_mat @ pi_start
-    u0[:nk] = np.sqrt(aff.lam_h) * (aff.vec_h.T @ (s * (x0 - x[kept])))
-    pi_u0 = aff.pi_a + aff.b_mat[:, :nk] @ u0[:nk]  # = pi_s(P pi_start); the rest is null space
-    u0[nk : nk + nt] = aff.z_null.T @ ((pi_start - pi_u0) / scale)
-    return u0
+def bounds(cols: Columns, models: Sequence[str]) -> tuple[Array, Array]:
+    """Lower and upper bounds of every non-link column (p - b,), in the unknowns' own units:
+    rotor inertias >= 0, each friction level within its model's ``bounds``
+    (:class:`kinergy.friction.model.FrictionModel`)."""
+    n_extra = len(cols.group) - cols.n_link
+    lo, hi = np.full(n_extra, -np.inf), np.full(n_extra, np.inf)
+    n = len(models)
+    lo[:n] = 0.0
+    for m, model in enumerate(models):
+        spec = get_model(model)
+        for k, name in enumerate(spec.linear):
+            low, high = spec.bounds.get(name, (-np.inf, np.inf))
+            at = int(cols.fric_at[m]) + k - cols.n_link
+            lo[at], hi[at] = low, high
+    return lo, hi
 
 
 @dataclass(frozen=True, eq=False)
 class ConstrainedFit:
-    """The constrained fit: standard parameters ``pi`` (p,), the regression unknowns they go with
-    ``x`` (all columns; rotor inertias clipped at 0) and the chi^2 increase ``|eta|^2``."""
+    """The constrained fit.
+
+    Attributes
+    ----------
+    pi : ndarray, shape (10 n,)
+        Standard parameters of the links (payload included), kg, kg m, kg m^2.
+    x : ndarray, shape (p,)
+        The regression unknowns they go with (link columns the base projection of ``pi``).
+    chi2 : float
+        The chi^2 the constraints cost: the rise of the squared residual over the residual
+        variance.
+    active : tuple of str
+        The constraints the solution sits on, one phrase each.
+    at_bound : tuple of int
+        Columns (indices into ``x``) held at a bound.
+    solver : str
+    """
 
     pi: Array
     x: Array
     chi2: float
+    active: tuple[str, ...]
+    at_bound: tuple[int, ...]
+    solver: str
 
 
-def _unknowns(aff: _Affine, problem: Solved, cols: Columns, x: Array, u: Array) -> Array:
-    """The regression unknowns of the solution ``u``, rotor inertias clipped at 0."""
-    nk, nt, _ = aff.sizes
-    n_link, kept = cols.n_link, problem.kept
-    out = x.copy()
-    out[kept] = x[kept] + aff.m_mat @ u[:nk]
-    out[:n_link] = aff.p_mat @ (aff.pi_a + aff.b_mat @ u)
-    if aff.motors:
-        out[n_link + np.array(aff.motors)] = aff.j0 + aff.j_unit * u[nk + nt :]
-    n_rot = cols.group.count("rotor")
-    out[n_link : n_link + n_rot] = np.maximum(out[n_link : n_link + n_rot], 0.0)
+def _link_scaling(pi0: Array) -> Array:
+    """``T_l`` (n, 4, 4): diag(1 / (L sqrt(m)), ..., 1 / sqrt(m)) with the model's link masses."""
+    mass = np.maximum(pi0.reshape(-1, 10)[:, 0], 1e-3)
+    t = np.zeros((mass.size, 4, 4))
+    for k in range(3):
+        t[:, k, k] = 1.0 / (LENGTH_SCALE * np.sqrt(mass))
+    t[:, 3, 3] = 1.0 / np.sqrt(mass)
+    return t
+
+
+def _lmi(pi: cp.Expression, payload: Array, t: Array) -> tuple[list[cp.Constraint], list[Array]]:
+    """Each link's scaled pseudo-inertia above :data:`MARGIN`; the constraint and the constant
+    matrices ``T E_k T`` it is made of (n, 10, 4, 4 as a list per link)."""
+    constraints, pieces = [], []
+    for link in range(t.shape[0]):
+        basis = np.einsum("ab,kbc,cd->kad", t[link], PSEUDO_BASIS, t[link])
+        shift = np.einsum("k,kab->ab", payload[10 * link : 10 * link + 10], basis)
+        mat = sum(pi[10 * link + k] * basis[k] for k in range(10)) - shift
+        constraints.append(0.5 * (mat + mat.T) >> MARGIN * np.eye(4))
+        pieces.append(basis)
+    return constraints, pieces
+
+
+def _metric(problem: Solved) -> Array:
+    """``L`` with ``|L (z - z_hat)|^2`` the chi^2 increase of the unknowns ``z`` (scaled) over the
+    regression's optimum ``z_hat``: the triangle (with the ridge term) over the residual's
+    standard deviation (floored at 1e-6 of the signal for noise-free data)."""
+    red = problem.reduced
+    sigma2 = max(problem.sigma2, 1e-12 * float(red.r_y @ red.r_y) / red.rows, 1e-300)
+    rows = [red.r_a]
+    if problem.lam > 0.0:
+        ridge = np.zeros((problem.kept.size, red.r_a.shape[1]))
+        ridge[np.arange(problem.kept.size), problem.kept] = np.sqrt(problem.lam)
+        rows.append(ridge)
+    return np.vstack(rows) / np.sqrt(sigma2)
+
+
+def _solve(problem: cp.Problem) -> str | None:
+    """Solve with Clarabel, else SCS; the solver's name, or None when neither finds the optimum."""
+    for solver in ("CLARABEL", "SCS"):
+        try:
+            with warnings.catch_warnings():  # "inaccurate" is judged below, by the links
+                warnings.simplefilter("ignore", UserWarning)
+                problem.solve(solver=solver)
+        except (cp.error.SolverError, ValueError):  # pragma: no cover - solver failure
+            continue
+        if problem.status in ("optimal", "optimal_inaccurate"):
+            return solver
+    return None
+
+
+def _active(
+    x: Array, cols: Columns, lo: Array, hi: Array, pi: Array, payload: Array, names: Sequence[str]
+) -> tuple[list[str], list[int]]:
+    """The constraints ``x`` and ``pi`` sit on (within 1e-6 of the bound's scale)."""
+    phrases, at_bound = [], []
+    t = _link_scaling(pi)
+    eig = np.linalg.eigvalsh(np.einsum("lab,lbc,lcd->lad", t, pseudo_inertia(pi - payload), t))
+    for link, low in enumerate(eig[:, 0]):
+        if low < 1.01 * MARGIN:
+            phrases.append(
+                f"link {link + 1} ({names[link]}): physical consistency (pseudo-inertia at its margin)"
+            )
+    extra = x[cols.n_link :]
+    for k, (value, low, high) in enumerate(zip(extra, lo, hi, strict=True)):
+        size = max(abs(float(cols.prior[cols.n_link + k])), 1e-9)
+        if np.isfinite(low) and value <= low + 1e-6 * size:
+            phrases.append(f"{cols.names[cols.n_link + k]} at its lower bound {low:.4g}")
+            at_bound.append(cols.n_link + k)
+        elif np.isfinite(high) and value >= high - 1e-6 * size:
+            phrases.append(f"{cols.names[cols.n_link + k]} at its upper bound {high:.4g}")
+            at_bound.append(cols.n_link + k)
+    return phrases, at_bound
+
+
+def _realisation(
+    problem: Solved,
+    base: BaseParameters,
+    cols: Columns,
+    pis: tuple[Array, Array, Array],
+    merged_rotor: dict[int, Array],
+    t: Array,
+) -> tuple[Array, Array, str] | None:
+    """Physical links that reproduce the identified base parameters exactly, the constrained
+    problem's solution at no cost, when they exist (None otherwise).
+
+    Among them, the standard parameters closest to the model's (``|S^-1 (pi - pi0)|``, ``pis`` =
+    (pi0, scale, payload)); a rotor inertia merged into link columns (``merged_rotor``, motor ->
+    its column in link base columns, (b,)) may move by ``d >= -J_model`` with the links taking
+    ``-C d`` so the torques stay the identified ones. Returns the standard parameters, all
+    unknowns and the solver.
+    """
+    pi0, scale, payload = pis
+    n_link = base.size
+    motors = sorted(merged_rotor)
+    v = cp.Variable(pi0.size)
+    pi = pi0 + cp.multiply(scale, v)
+    p_mat = base_projection(base, pi0.size)
+    theta = problem.x[:n_link]
+    size = np.maximum(np.abs(theta), 1e-12 * max(float(np.abs(theta).max()), 1e-300))
+    constraints, _ = _lmi(pi, payload, t)
+    j0 = np.array([cols.prior[n_link + m] for m in motors])
+    d = cp.Variable(len(motors))
+    shift = 0.0
+    objective = cp.sum_squares(v)
+    if motors:
+        c_mat = np.column_stack([merged_rotor[m] for m in motors])
+        unit = np.where(j0 > 0, j0, 1e-6)
+        shift = c_mat @ cp.multiply(unit, d)
+        constraints.append(j0 + cp.multiply(unit, d) >= 0)
+        objective = objective + cp.sum_squares(d)
+    constraints.append((p_mat @ pi + shift - theta) / size == 0)
+    solver = _solve(cp.Problem(cp.Minimize(objective), constraints))
+    if solver is None or v.value is None:
+        return None
+    x = problem.x.copy()
+    if motors:
+        moved = j0 + np.where(j0 > 0, j0, 1e-6) * np.asarray(d.value)
+        x[n_link + np.array(motors)] = np.maximum(moved, 0.0)
+    return pi0 + scale * np.asarray(v.value), x, solver
+
+
+def _within(z: cp.Variable, lo: Array, hi: Array) -> list[cp.Constraint]:
+    """``lo <= z <= hi`` where the bounds are finite."""
+    out = []
+    for bound, sign in ((lo, 1.0), (hi, -1.0)):
+        finite = np.isfinite(bound)
+        if finite.any():
+            out.append(sign * z[finite] >= sign * bound[finite])
     return out
 
 
@@ -295,51 +237,79 @@ def physical_fit(
     problem: Solved,
     base: BaseParameters,
     cols: Columns,
+    models: Sequence[str],
     pi0: Array,
     scale: Array,
     payload: Array,
+    names: Sequence[str],
     merged_rotor: dict[int, Array],
-    eps: float = 1e-3,
 ) -> ConstrainedFit | None:
-    """Least squares constrained to physical links and non-negative rotor inertias.
+    """Least squares on the regression's reduced triangle constrained to physical values (module
+    docstring).
 
-    The regression's cost grows from its minimum ``x_hat = problem.x`` (kept unknowns) as
-    ``(x - x_hat)^T H (x - x_hat)``, ``H`` from the reduced triangle (``(R^T R + lambda 1) /
-    sigma^2`` in scaled unknowns); with ``x - x_hat = V Lambda^-1/2 eta`` (``H = V Lambda V^T``)
-    that is ``|eta|^2``, a chi^2 increase. The link base parameters ``theta`` are ``x``'s first
-    ``b``; the standard parameters are ``pi = pi_s(theta - C dJ) + S Z t``
-    (:func:`~kinergy.identify.physical.standard_from_base` plus the null space ``Z`` of ``P S``;
-    ``C dJ`` moves merged rotor inertias, ``dJ = J_model delta``), and ::
-
-        |eta|^2 + eps (|S^-1 (pi_s - pi0)|^2 + |t|^2 + |delta|^2)
-
-    is minimised subject to every link's pseudo-inertia (of ``pi - payload``, kg and m) staying
-    above 1e-3 times the model's smallest eigenvalue and every rotor inertia being >= 0 (a convex
-    problem: linear matrix inequalities, solved by :func:`barrier_lsq` from the model, which is
-    feasible); ``eps`` only settles what the data cannot see. ``pi0`` (p,) are the model's
-    standard parameters, ``scale`` (p,) their typical sizes, ``merged_rotor`` the merged rotor
-    columns in link base columns (motor -> (b,)).
+    Parameters
+    ----------
+    problem : Solved
+        The unconstrained regression (its triangle, ridge weight, kept and dropped columns).
+    base : BaseParameters
+    cols : Columns
+    models : sequence of str
+        Each motor's friction model (its ``bounds`` bound the friction columns).
+    pi0 : ndarray, shape (10 n,)
+        The model's standard parameters (payload included).
+    scale : ndarray, shape (10 n,)
+        Typical size of each standard parameter (:func:`~kinergy.identify.physical.parameter_scale`).
+    payload : ndarray, shape (10 n,)
+        The payload's share of ``pi0`` (the last link's), which the links' consistency excludes.
+    names : sequence of str
+        Joint names, for the active-constraint phrases.
+    merged_rotor : dict
+        Rotor inertias merged into link columns: motor -> its column in link base columns (b,)
+        (:class:`~kinergy.identify.regression.Merging`).
 
     Returns
     -------
     ConstrainedFit or None
-        ``None`` when the solver fails or its links are still not physical.
+        ``None`` when neither solver finds the optimum or a link is still not physical.
     """
-    aff = _affine(problem, base, cols, problem.x, pi0, scale, merged_rotor)
-    if aff is None:
+    red = problem.reduced
+    n_link, p = cols.n_link, cols.prior.size
+    p_mat = base_projection(base, pi0.size)
+    lo, hi = bounds(cols, models)
+    t = _link_scaling(pi0)
+    extra = problem.x[n_link:]
+    if np.all((extra >= lo) & (extra <= hi)):
+        found = _realisation(problem, base, cols, (pi0, scale, payload), merged_rotor, t)
+        if found is not None and all(e is None for e in link_consistency(found[0] - payload)):
+            phrases, _ = _active(found[1], cols, lo, hi, found[0], payload, names)
+            return ConstrainedFit(found[0], found[1], 0.0, tuple(phrases), (), found[2])
+    metric = _metric(problem)
+    z_hat = problem.x * red.scale
+    v = cp.Variable(pi0.size)
+    z_extra = cp.Variable(p - n_link)
+    pi = pi0 + cp.multiply(scale, v)
+    z = cp.hstack([cp.multiply(red.scale[:n_link], p_mat @ pi), z_extra])
+    z_prior = cols.prior * red.scale
+    dropped = problem.dropped[problem.dropped >= n_link] - n_link
+    size = np.maximum(np.abs(z_prior[n_link:][dropped]), 1e-6 * float(np.linalg.norm(red.r_y)))
+    # in units of the chi^2 of the model itself (feasible): the optimum lies in [0, 1]
+    unit = max(float(np.sum((metric @ (z_prior - z_hat)) ** 2)), 1e-12)
+    objective = cp.sum_squares(metric @ (z - z_hat)) / unit + _EPS_LINKS * cp.sum_squares(v)
+    if dropped.size:
+        gap = (z_extra[dropped] - z_prior[n_link:][dropped]) / size
+        objective = objective + _EPS_DROPPED * cp.sum_squares(gap)
+    constraints, _ = _lmi(pi, payload, t)
+    s_extra = red.scale[n_link:]
+    constraints += _within(z_extra, lo * s_extra, hi * s_extra)
+    solver = _solve(cp.Problem(cp.Minimize(objective), constraints))
+    if solver is None or v.value is None or z_extra.value is None:
         return None
-    blocks = _link_blocks(aff, pi0, payload)
-    if blocks is None:
+    pi_hat = pi0 + scale * np.asarray(v.value)
+    if any(e is not None for e in link_consistency(pi_hat - payload)):
         return None
-    c_blocks, b_blocks, pi_start = blocks
-    r0, jac = _objective(aff, pi0, scale, eps)
-    u0 = _start(aff, problem, cols, problem.x, scale, pi_start)
-    lin = _rotor_bounds(aff, cols, problem.x, problem.kept)
-    u = barrier_lsq(r0, jac, (c_blocks, b_blocks), lin, u0)
-    if u is None:
-        return None
-    pi = aff.pi_a + aff.b_mat @ u
-    if any(e is not None for e in link_consistency(pi - payload)):
-        return None
-    nk = aff.sizes[0]
-    return ConstrainedFit(pi, _unknowns(aff, problem, cols, problem.x, u), float(u[:nk] @ u[:nk]))
+    x = np.empty(p)
+    x[:n_link] = p_mat @ pi_hat
+    x[n_link:] = np.clip(np.asarray(z_extra.value) / s_extra, lo, hi)
+    chi2 = float(np.sum((metric @ (x * red.scale - z_hat)) ** 2))
+    phrases, at_bound = _active(x, cols, lo, hi, pi_hat, payload, names)
+    return ConstrainedFit(pi_hat, x, chi2, tuple(phrases), tuple(at_bound), solver)

@@ -66,6 +66,7 @@ where the load is within its noise of zero: a small bias
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -73,10 +74,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.drives.transmission import transmission_matrix
-from kinergy.dynamics.regressor import BaseParameters, base_parameters
+from kinergy.dynamics.regressor import BaseParameters, base_parameters, inertial_parameters
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import MODELS, get_model
-from kinergy.identify.columns import Columns, Stacked, columns, joint_frictions, stack
+from kinergy.friction.registry import MODELS, get_model, linear_values, with_linear_parameters
+from kinergy.identify.columns import Stacked, columns, joint_frictions, scale_row, stack
 from kinergy.identify.metrics import JointMetrics, fit_metrics
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.regression import (
@@ -90,15 +91,17 @@ from kinergy.identify.regression import (
     solve,
 )
 from kinergy.identify.result import (
+    KEPT,
     DriveEstimate,
     Fit,
     IdentificationResult,
     friction_entry,
     validation_metrics,
 )
+from kinergy.identify.sequential import DrivesFromCurrents, drives_from_currents
 from kinergy.identify.writeback import WriteBack, write_back
 from kinergy.jsonable import OPTIONAL
-from kinergy.model.robot import Robot
+from kinergy.model.robot import Friction, Robot
 
 __all__ = [
     "MAX_CONDITION",
@@ -109,6 +112,7 @@ __all__ = [
     "Parameter",
     "PhysicalFit",
     "identify_full",
+    "rescaled",
 ]
 
 Array = NDArray[np.float64]
@@ -121,6 +125,12 @@ SOLVERS = ("ols", "wls", "ridge")
 MOVING_SPEED = 0.05
 #: samples needed per unknown parameter
 SAMPLES_PER_PARAMETER = 2
+#: against currents alone, where the common scale of every unknown comes from
+SCALE_NOTE = (
+    "currents alone cannot fix a common scale of the links, rotor inertias, friction and torque "
+    "constants: taken from the model's published masses (the identified gravity torques, "
+    "projected on the model's, equal the model's)"
+)
 #: the IdentData field and the log signal of each target
 _FIELD = {"moment": "tau_ref", "torque": "torque", "current": "current"}
 _SIGNAL = {
@@ -138,13 +148,15 @@ _SIGNAL = {
 class Parameter:
     """One unknown of the regression: its value, standard error and relative standard error
     (None where not estimable) and, for the stacked unknowns, its group (``link``, ``rotor``,
-    ``friction``)."""
+    ``friction``, ``torque_constant``) and flag (:data:`~kinergy.identify.result.FLAGS`, as
+    written to the returned robot)."""
 
     name: str
     value: float
     std: float | None
     rel_std: float | None
     group: str | None = field(default=None, metadata=OPTIONAL)
+    flag: str | None = field(default=None, metadata=OPTIONAL)
 
 
 @dataclass(frozen=True)
@@ -163,11 +175,15 @@ class FullJoint(DriveEstimate):
 
 @dataclass(frozen=True)
 class PhysicalFit:
-    """The fit constrained to physical links and non-negative rotor inertias: its chi^2
-    increase over the unconstrained fit, its base parameters (b,), rotor inertias (n, kg m^2,
-    motor side) and per-joint metrics of its prediction of the target (N m, joint side)."""
+    """The fit constrained to physical values (:mod:`kinergy.identify.constrained`): its chi^2
+    increase over the unconstrained fit, the constraints it sits on, the solver, its base
+    parameters (b,), rotor inertias (n, kg m^2, motor side) and per-joint metrics of its
+    prediction of the target (N m, joint side; ``FullFit.regression`` is the unconstrained
+    fit's, so their RMS are the fit before and after the constraints)."""
 
     chi2_increase: float
+    active: tuple[str, ...]
+    solver: str
     base_parameters: tuple[float, ...]
     rotor_inertia: tuple[float, ...]
     regression: tuple[JointMetrics, ...]
@@ -200,7 +216,16 @@ class FullFit(Fit):
     physical_fit : PhysicalFit or None
         When the robot was written from the constrained fit.
     write_back : str
-        ``"closest"`` or ``"physically consistent least squares"``.
+        ``"closest"`` (the unconstrained fit is physical: it is the constrained problem's
+        solution) or ``"physically consistent least squares"``.
+    drives : str
+        Where the torque constants and friction come from: ``"currents"`` (UR5e eqs 17-18 on the
+        identified links, :func:`~kinergy.identify.sequential.drives_from_currents`),
+        ``"regression"`` (unknowns of the regression) or ``"model"``.
+    scale : str or None
+        Against currents alone: where the common scale comes from.
+    friction_holding : tuple of float or None
+        With drives from the currents: the friction fraction held through standstill per joint.
     links_not_physical_closest, links_physical, standard_parameters :
         Links (1-based) whose closest standard parameters are not physical; per link whether
         the returned robot's is the identified one; the written standard parameters by name.
@@ -221,6 +246,9 @@ class FullFit(Fit):
     base_parameters: tuple[Parameter, ...] = ()
     physical_fit: PhysicalFit | None = field(default=None, metadata=OPTIONAL)
     write_back: str = "closest"
+    drives: str = "model"
+    scale: str | None = field(default=None, metadata=OPTIONAL)
+    friction_holding: tuple[float | None, ...] | None = field(default=None, metadata=OPTIONAL)
     links_not_physical_closest: tuple[int, ...] = ()
     links_physical: tuple[bool, ...] = ()
     standard_parameters: dict[str, float] = field(default_factory=dict)
@@ -322,38 +350,69 @@ def _optional(value: float) -> float | None:
 
 
 def _parameters(
-    x: Array, std: Array, names: Sequence[str], groups: Sequence[str | None]
+    x: Array,
+    std: Array,
+    names: Sequence[str],
+    groups: Sequence[str | None],
+    flags: Sequence[str | None],
 ) -> tuple[Parameter, ...]:
     """The first ``len(names)`` unknowns ``x`` with their standard errors ``std``."""
     with np.errstate(divide="ignore", invalid="ignore"):
         rel = np.abs(std) / np.abs(x)
     return tuple(
-        Parameter(name, float(x[k]), _optional(std[k]), _optional(rel[k]), group)
-        for k, (name, group) in enumerate(zip(names, groups, strict=True))
+        Parameter(name, float(x[k]), _optional(std[k]), _optional(rel[k]), group, flag)
+        for k, (name, group, flag) in enumerate(zip(names, groups, flags, strict=True))
     )
 
 
+def _regression_drive(
+    m: int, written: WriteBack, solved: Solved, stacked: Stacked, commanded: bool
+) -> tuple[dict[str, str], dict[str, float | None]]:
+    """Flags and standard errors of motor ``m``'s rotor inertia, torque constant and friction as
+    the regression gave them."""
+    cols = stacked.cols
+    col = cols.n_link + m
+    flags = {"rotor_inertia": written.flags[col], "torque_constant": KEPT}
+    std: dict[str, float | None] = {"rotor_inertia": _optional(solved.std[col])}
+    names = get_model(stacked.models[m]).linear
+    for k, name in enumerate(names):
+        at = int(cols.fric_at[m]) + k
+        flags[name] = KEPT if commanded else written.flags[at]
+        std[name] = None if commanded else _optional(solved.std[at])
+    std["torque_constant"] = None
+    return flags, std
+
+
 def _joints(
-    written: WriteBack, solved: Solved, cols: Columns, models: list[str]
+    robot: Robot,
+    written: WriteBack,
+    solved: Solved,
+    stacked: Stacked,
+    drives: DrivesFromCurrents | None,
 ) -> tuple[FullJoint, ...]:
-    """Per joint: the drive as written, with standard errors and the merged flag."""
+    """Per joint: the drive as written, with standard errors, flags and the merged flag."""
+    cols, commanded = stacked.cols, stacked.models == ["none"] * robot.n
     out = []
-    for m, joint in enumerate(written.robot.joints):
+    for m, joint in enumerate(robot.joints):
         col = cols.n_link + m
-        fric_std = cols.friction(solved.std, m)
+        flags, std = _regression_drive(m, written, solved, stacked, commanded)
+        if drives is not None:
+            flags = {"rotor_inertia": flags["rotor_inertia"], **drives.flags[m]}
+            std = {"rotor_inertia": std["rotor_inertia"], **drives.std[m]}
+        friction = friction_entry(joint)
+        names = get_model(friction["model"]).linear
         out.append(
             FullJoint(
                 name=joint.name,
                 rotor_inertia=float(written.x[col]),
-                rotor_inertia_std=_optional(solved.std[col]),
+                rotor_inertia_std=std["rotor_inertia"],
                 rotor_inertia_merged=bool(col in solved.dropped),
                 motor_inertia=joint.drive.motor_inertia,
                 torque_constant=joint.drive.torque_constant,
-                friction=friction_entry(joint),
-                friction_std={
-                    name: _optional(s)
-                    for name, s in zip(get_model(models[m]).linear, fric_std, strict=True)
-                },
+                friction=friction,
+                flags=flags,
+                std=std,
+                friction_std={name: std.get(name) for name in names},
             )
         )
     return tuple(out)
@@ -361,32 +420,39 @@ def _joints(
 
 def _physical(stacked: Stacked, written: WriteBack) -> PhysicalFit | None:
     """The constrained fit's record, when the robot was written from it."""
-    if written.chi2 is None:
+    if written.chi2 is None or written.solver is None:
         return None
     n_link, n = stacked.cols.n_link, stacked.y3.shape[1]
     predicted = (stacked.a_flat @ written.x).reshape(stacked.y3.shape)
     return PhysicalFit(
         chi2_increase=written.chi2,
+        active=written.active,
+        solver=written.solver,
         base_parameters=tuple(written.x[:n_link].tolist()),
         rotor_inertia=tuple(written.x[n_link : n_link + n].tolist()),
         regression=fit_metrics(stacked.y3, predicted),
     )
 
 
+@dataclass(frozen=True, eq=False)
+class _Steps:
+    """What the steps of :func:`identify_full` produced, for its fit record."""
+
+    stacked: Stacked
+    base: BaseParameters
+    flow: FlowFit
+    solved: Solved
+    merging: Merging
+    written: WriteBack
+    drives: DrivesFromCurrents | None
+    robot: Robot
+
+
 def _fit(
-    datas: Sequence[IdentData],
-    stacked: Stacked,
-    base: BaseParameters,
-    flow: FlowFit,
-    solved: Solved,
-    merging: Merging,
-    written: WriteBack,
-    *,
-    target: str,
-    solver: str,
-    ridge: float,
+    datas: Sequence[IdentData], steps: _Steps, *, target: str, solver: str, ridge: float
 ) -> FullFit:
     """The fit record of the steps of :func:`identify_full`."""
+    stacked, flow, solved, written = steps.stacked, steps.flow, steps.solved, steps.written
     cols, y3 = stacked.cols, stacked.y3
     predicted = (stacked.a_flat @ solved.x).reshape(y3.shape)
     warnings = (
@@ -396,13 +462,16 @@ def _fit(
             f"the friction's power-flow directions did not settle in {flow.iterations} iterations"
         ]
     )
+    if steps.drives is not None:
+        warnings += list(steps.drives.warnings)
     weighted = solved.weights is not None
+    b = cols.n_link
     return FullFit(
-        **vars(validation_metrics(written.robot, datas)),
+        **vars(validation_metrics(steps.robot, datas)),
         samples=int(y3.shape[0]),
         logs=tuple(d.path for d in datas),
         lag=tuple(d.lag for d in datas),
-        warnings=(*warnings, *merging.warnings, *written.warnings),
+        warnings=(*warnings, *steps.merging.warnings, *written.warnings),
         target=target,
         solver=solver,
         ridge=float(ridge),
@@ -413,15 +482,41 @@ def _fit(
         condition_weighted=solved.solution.cond if weighted else None,
         residual_std=tuple(np.sqrt(np.mean((y3 - predicted) ** 2, axis=0)).tolist()),
         regression=fit_metrics(y3, predicted),
-        merged=merging.columns,
-        parameters=_parameters(solved.x, solved.std, cols.names, cols.group),
-        base_parameters=_parameters(solved.x, solved.std, base.expressions(), [None] * cols.n_link),
+        merged=steps.merging.columns,
+        parameters=_parameters(solved.x, solved.std, cols.names, cols.group, written.flags),
+        base_parameters=_parameters(
+            solved.x, solved.std, steps.base.expressions(), [None] * b, written.flags[:b]
+        ),
         physical_fit=_physical(stacked, written),
         write_back=written.method,
+        drives="currents" if steps.drives else ("regression" if target != "moment" else "model"),
+        scale=SCALE_NOTE if target == "current" and steps.drives else None,
+        friction_holding=steps.drives.holding if steps.drives else None,
         links_not_physical_closest=written.links_not_physical_closest,
         links_physical=written.links_physical,
         standard_parameters=written.standard_parameters,
     )
+
+
+def rescaled(robot: Robot, s: float) -> Robot:
+    """``robot`` with every torque scaled by ``s``: link masses and inertias, rotor inertias,
+    friction levels, torque and motor constants (centres of mass, currents and copper losses
+    unchanged). A fit against currents alone is only known up to this scale."""
+    joints = []
+    for j in robot.joints:
+        link = dataclasses.replace(j.link, mass=j.link.mass * s, inertia=j.link.inertia * s)
+        fr = j.drive.friction
+        levels = linear_values(fr.model, fr.params) * s
+        drive = dataclasses.replace(
+            j.drive,
+            motor_inertia=j.drive.motor_inertia * s,
+            reducer_inertia=j.drive.reducer_inertia * s,
+            torque_constant=j.drive.torque_constant * s,
+            motor_constant=j.drive.motor_constant * s,
+            friction=Friction(fr.model, with_linear_parameters(fr.model, fr.params, levels)),
+        )
+        joints.append(dataclasses.replace(j, link=link, drive=drive))
+    return robot.with_joints(joints)
 
 
 def identify_full(
@@ -432,6 +527,7 @@ def identify_full(
     solver: str = "ols",
     ridge: float = 0.0,
     friction: str | None = None,
+    currents: bool = True,
 ) -> IdentificationResult:
     """Identify link base parameters, rotor inertias and friction in one regression.
 
@@ -439,21 +535,23 @@ def identify_full(
     eq (1)) ``tau = Y_b pi_b + N^T diag(J) N qdd + N^T F(wm) phi`` with ``pi_b`` the links' base
     parameters (nursing eqs 15-16), ``J = J_m + J_r`` the rotor inertias (motor side, kg m^2;
     UR5e eq 2) and ``phi`` the friction models' linear parameters (motor side), then writes
-    standard link parameters that reproduce ``pi_b`` back into the model
-    (:mod:`kinergy.identify.writeback`).
+    physically consistent standard link parameters back into the model
+    (:mod:`kinergy.identify.writeback`, :mod:`kinergy.identify.constrained`). Against
+    ``target_moment`` or measured torques, logged currents then give the torque constants and
+    friction (UR5e eqs 17-18); against currents alone they are unknowns of the regression.
 
     Parameters
     ----------
     robot : Robot
-        The starting model: its kinematics, transmissions, torque constants and friction shape
-        parameters are used as they are; its link data, rotor inertias and friction levels are
-        the priors (kept where the logs cannot identify them, shrunk toward by ridge).
+        The starting model: its kinematics, transmissions and friction shape parameters are used
+        as they are; its link data, rotor inertias, torque constants and friction levels are the
+        priors (kept where the logs cannot identify them, shrunk toward by ridge).
     datas : sequence of IdentData
         Prepared logs (:func:`kinergy.identify.preprocess.prepare`), arrays (N, n).
     target : {"auto", "moment", "torque", "current"}
         The signal regressed against: ``target_moment`` (N m) on the commanded motion without
-        friction, measured joint torques (N m) or ``actual_current`` (A, times ``k_t``) on the real
-        motion with friction. ``"auto"``: torque if every log has it, else moment, else current.
+        friction, measured joint torques (N m) or ``actual_current`` (A) on the real motion with
+        friction. ``"auto"``: torque if every log has it, else moment, else current.
     solver : {"ols", "wls", "ridge"}
         Ordinary least squares; weighted least squares, per-joint weights ``1 / sigma_j^2`` from an
         OLS pass's residuals (Gautier); ridge regression toward the model's values.
@@ -462,8 +560,14 @@ def identify_full(
         docstring): 1e-6 to 1e-2 are typical.
     friction : str, optional
         Friction model for every joint (default: each joint's own). Its shape parameters are the
-        joint's when the model is the same, else defaults (smoothing 1e-3 rad/s, ...). Unused for
-        ``target="moment"`` (the feed-forward has no friction; the model's is kept).
+        joint's when the model is the same, else defaults (smoothing 1e-3 rad/s, ...).
+    currents : bool
+        Fit the torque constants and friction on the currents (UR5e eqs 17-18) when every log
+        has them (default), after the regression; False keeps the model's torque constants
+        (and, against ``target_moment``, its friction). Against currents alone they are fitted
+        first on the model's links, then again on the identified ones, and every parameter is
+        then scaled so that the links' gravity torques match the model's published masses
+        (a common scale that currents alone cannot fix, ``fit.scale``).
 
     Returns
     -------
@@ -484,23 +588,25 @@ def identify_full(
         raise KinergyError("no log to identify from")
     _check_options(solver, ridge, friction)
     target = _pick_target(datas, target)
-    base = base_parameters(robot)
-    stacked = _stack(robot, base, datas, target, friction)
-    flow = fit_power_flow(robot, stacked, base.expressions())
+    with_currents = currents and all(d.current is not None for d in datas)
+    start = robot
+    if with_currents and target == "current":  # drives from the model's links first
+        start = drives_from_currents(robot, datas, friction=friction).robot
+        friction = None
+    base = base_parameters(start)
+    stacked = _stack(start, base, datas, target, friction)
+    flow = fit_power_flow(start, stacked, base.expressions())
     solved = solve(stacked, flow.ols, solver, ridge)
     merging = merged_columns(flow.ols, stacked.cols)
-    written = write_back(robot, base, solved, stacked, target == "moment", merging.rotor)
-    fit = _fit(
-        datas,
-        stacked,
-        base,
-        flow,
-        solved,
-        merging,
-        written,
-        target=target,
-        solver=solver,
-        ridge=ridge,
-    )
-    joints = _joints(written, solved, stacked.cols, stacked.models)
-    return IdentificationResult(written.robot, "full", joints, fit)
+    written = write_back(start, base, solved, stacked, target == "moment", merging.rotor)
+    drives = None
+    if with_currents:
+        drives = drives_from_currents(written.robot, datas, friction=friction)
+    out = drives.robot if drives is not None else written.robot
+    if with_currents and target == "current":  # the common scale from the published masses
+        gravity = scale_row(robot, base, stacked.q) @ base.project(inertial_parameters(out))
+        out = rescaled(out, 1.0 / float(gravity))
+    steps = _Steps(stacked, base, flow, solved, merging, written, drives, out)
+    fit = _fit(datas, steps, target=target, solver=solver, ridge=ridge)
+    joints = _joints(out, written, solved, stacked, drives)
+    return IdentificationResult(out, "full", joints, fit)

@@ -13,13 +13,15 @@ Array = NDArray[np.float64]
 
 
 def r_squared(measured: ArrayLike, predicted: ArrayLike) -> Array:
-    """Coefficient of determination per column, ``1 - SS_res / SS_tot``; (N, n) -> (n,)."""
+    """Coefficient of determination per column, ``1 - SS_res / SS_tot``; (N, n) -> (n,). NaN
+    where the measured signal does not vary (``SS_tot`` at round-off of its level)."""
     y = np.asarray(measured, dtype=float)
     p = np.asarray(predicted, dtype=float)
     ss_res = np.sum((y - p) ** 2, axis=0)
     ss_tot = np.sum((y - y.mean(axis=0)) ** 2, axis=0)
     with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(ss_tot > 0, 1.0 - ss_res / ss_tot, np.nan)
+        varies = ss_tot > 1e-20 * np.maximum(np.sum(y**2, axis=0), 1e-300)
+        return np.where(varies, 1.0 - ss_res / ss_tot, np.nan)
 
 
 def rmse(measured: ArrayLike, predicted: ArrayLike) -> Array:

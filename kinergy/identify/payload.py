@@ -12,10 +12,19 @@ columns by least squares in N m, all joints stacked:
 Mass and first moment are always estimated; the six inertia terms only when the log excites them
 well enough (relative standard deviation below :data:`MAX_INERTIA_SPREAD`); otherwise the payload
 is a point mass, as UR's own ``set_payload`` takes it.
+
+The residuals of a real log are far from white (the model's errors follow the motion for seconds),
+so the white-noise formula understates the standard errors tenfold or more. They come instead
+from a delete-one-block jackknife over :data:`BLOCKS` contiguous time blocks (the larger of the
+two is stated): a motion whose parts disagree about the payload gets the wide error bars it
+deserves, and a centre of mass whose error exceeds :data:`MAX_COM_STD` is reported as not
+identifiable from this motion, with the motion that would fix it.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,12 +40,22 @@ from kinergy.linalg import scaled_lstsq
 from kinergy.model.robot import Payload, Robot
 from kinergy.predict import drive_state
 
-__all__ = ["PayloadEstimate", "identify_payload"]
+__all__ = ["BLOCKS", "MAX_COM_STD", "PayloadEstimate", "block_std", "identify_payload"]
 
 Array = NDArray[np.float64]
 
 #: inertia terms are reported only when their relative standard deviation is below this
 MAX_INERTIA_SPREAD = 0.2
+#: contiguous time blocks of the jackknife standard errors
+BLOCKS = 10
+#: m: a centre-of-mass coordinate with a larger standard error is not identifiable
+MAX_COM_STD = 0.02
+#: the motion that shows each centre-of-mass coordinate (flange frame)
+_COM_MOTION = {
+    "x": "wrist 3 turned through half a turn or more with the flange axis near horizontal",
+    "y": "wrist 3 turned through half a turn or more with the flange axis near horizontal",
+    "z": "the flange axis tilted from vertical to horizontal (wrists 1 and 2)",
+}
 
 
 @dataclass(frozen=True)
@@ -103,15 +122,80 @@ def identify_payload(
     signal = _pick_signal(datas) if signal == "auto" else signal
     a, b, x, std, cond = _point_mass(robot, bare, datas, signal)
     full, full_std, cond_full = scaled_lstsq(a, b)
+    full_std = np.maximum(full_std, block_std(a, b, robot.n))
     inertia_ok = bool(
         np.all(full_std[4:] < MAX_INERTIA_SPREAD * np.maximum(np.abs(full[4:]), 1e-3))
     )
+    white = std[0]
     if inertia_ok:
         x, std, cond = full, full_std, cond_full
     else:
+        std = np.maximum(std, block_std(a[:, :4], b, robot.n))
         x = np.concatenate([x, np.zeros(6)])
         std = np.concatenate([std, np.zeros(6)])
-    return _finish(robot, x, std, cond, inertia_ok, signal, datas)
+    payload, report = _finish(robot, x, std, cond, inertia_ok, signal, datas)
+    notes = _uncertainty_notes(report, float(white)) + _disagreement(robot, a, b, datas)
+    return payload, dataclasses.replace(report, notes=report.notes + notes)
+
+
+def _disagreement(robot: Robot, a: Array, b: Array, datas: list[IdentData]) -> tuple[str, ...]:
+    """With several logs, a note per centre-of-mass coordinate on which two logs' point-mass fits
+    differ by more than twice their combined standard error (the payload moved between them, or
+    the model explains the motions differently): the pooled figure would hide it."""
+    if len(datas) < 2:
+        return ()
+    edges = np.cumsum([0] + [robot.n * len(d) for d in datas])
+    fits = []
+    for lo, hi in itertools.pairwise(edges):
+        x, std, _ = scaled_lstsq(a[lo:hi, :4], b[lo:hi])
+        std = np.maximum(std, block_std(a[lo:hi, :4], b[lo:hi], robot.n))
+        com = _com(robot, x)
+        fits.append((com, std[1:4] / max(float(x[0]), 1e-12)))
+    notes = []
+    for (i, (c1, s1)), (j, (c2, s2)) in itertools.combinations(enumerate(fits), 2):
+        for k, axis in enumerate("xyz"):
+            if abs(c1[k] - c2[k]) > 2.0 * np.hypot(s1[k], s2[k]):
+                notes.append(
+                    f"logs {i + 1} and {j + 1} disagree on the centre of mass {axis}: "
+                    f"{c1[k]:.3f} +- {s1[k]:.3f} against {c2[k]:.3f} +- {s2[k]:.3f} m (was the "
+                    "payload moved between them?)"
+                )
+    return tuple(notes)
+
+
+def block_std(a: Array, b: Array, n: int, blocks: int = BLOCKS) -> Array:
+    """Standard errors of the least-squares ``x`` of ``a x = b`` from a delete-one-block
+    jackknife: ``sqrt((K - 1) / K * sum_k (x_k - mean x_k)^2)``, ``x_k`` the solution without
+    block ``k`` of ``K`` contiguous blocks of samples; rows are samples x ``n`` joints, (N n, p)
+    and (N n,) -> (p,). Zeros when there are fewer samples than ``2 K``."""
+    samples = len(b) // n
+    if samples < 2 * blocks:
+        return np.zeros(a.shape[1])
+    edges = n * np.linspace(0, samples, blocks + 1).astype(int)
+    keep = np.ones(len(b), dtype=bool)
+    fits = []
+    for lo, hi in itertools.pairwise(edges):
+        keep[:] = True
+        keep[lo:hi] = False
+        fits.append(scaled_lstsq(a[keep], b[keep])[0])
+    x = np.array(fits)
+    return np.sqrt((blocks - 1) / blocks * np.sum((x - x.mean(axis=0)) ** 2, axis=0))
+
+
+def _uncertainty_notes(report: PayloadEstimate, white_mass_std: float) -> tuple[str, ...]:
+    """How the standard errors were found and, per centre-of-mass coordinate whose error is too
+    large, that it is not identifiable and what motion would fix it."""
+    notes = [
+        f"standard errors from a jackknife over {BLOCKS} time blocks (correlated residuals): "
+        f"mass +- {report.mass_std:.2g} kg against {white_mass_std:.2g} kg by the white-noise formula"
+    ]
+    for axis, value, std in zip("xyz", report.com, report.com_std, strict=True):
+        if std > MAX_COM_STD:
+            notes.append(
+                f"centre of mass {axis} = {value:.3f} +- {std:.3f} m is not identifiable from "
+                f"this motion; it needs {_COM_MOTION[axis]}"
+            )
+    return tuple(notes)
 
 
 def _pick_signal(datas: list[IdentData]) -> str:

@@ -28,6 +28,7 @@ from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 
 __all__ = [
+    "MEASURED_TORQUE",
     "IdentData",
     "estimate_lag",
     "lowpass",
@@ -226,6 +227,9 @@ def _delay(t: Array, x: Array, lag: float) -> Array:
 
 
 #: (N, n) signals whose joint count must match the robot's
+#: the log signal of measured joint torques, N m (RTDE-style name, ``actual_joint_torque_k``)
+MEASURED_TORQUE = "actual_joint_torque"
+
 _JOINT_SIGNALS = (
     "target_q",
     "target_qd",
@@ -234,6 +238,7 @@ _JOINT_SIGNALS = (
     "actual_qd",
     "target_moment",
     "actual_current",
+    MEASURED_TORQUE,
     "joint_temperatures",
     "actual_joint_voltage",
 )
@@ -316,6 +321,8 @@ def prepare(
         log = _with_torque(log, n_joints, torque)
     log = uniform(running(log))
     torque = log.signals.pop("_torque", None) if torque is not None else None
+    if torque is None and MEASURED_TORQUE in log:  # arms with joint torque sensors
+        torque = np.asarray(log[MEASURED_TORQUE], dtype=float)
     fs = 1.0 / float(log.t[1] - log.t[0])
     cutoff = min(10.0, fs / 5.0) if cutoff is None else cutoff
     _check_joints(log, n_joints)

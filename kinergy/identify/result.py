@@ -29,6 +29,10 @@ from kinergy.model.robot import Joint, Robot
 from kinergy.predict import drive_state
 
 __all__ = [
+    "AT_BOUND",
+    "FLAGS",
+    "IDENTIFIED",
+    "KEPT",
     "DriveEstimate",
     "Fit",
     "IdentificationResult",
@@ -42,6 +46,13 @@ Array = NDArray[np.float64]
 
 #: a per-joint metrics field: one entry per joint, or None when no log has the signal
 Metrics = tuple[JointMetrics, ...] | None
+
+#: what the data did with a parameter: fitted, left at the starting model's value, or held at a
+#: physical bound by the constrained fit
+IDENTIFIED = "identified"
+KEPT = "kept from prior"
+AT_BOUND = "at bound"
+FLAGS = (IDENTIFIED, KEPT, AT_BOUND)
 
 
 @dataclass(frozen=True)
@@ -75,13 +86,17 @@ def friction_entry(joint: Joint) -> dict[str, Any]:
 class DriveEstimate:
     """One joint's identified drive, motor side: ``rotor_inertia`` = J_m + J_r and
     ``motor_inertia`` J_m (kg m^2), ``torque_constant`` k_t (N m/A), ``friction``
-    (:func:`friction_entry`)."""
+    (:func:`friction_entry`); per parameter (``rotor_inertia``, ``torque_constant`` and the
+    friction's linear parameters by name) its flag (:data:`FLAGS`) and its standard error from the
+    residuals (None where not estimated: a parameter kept from the prior)."""
 
     name: str
     rotor_inertia: float
     motor_inertia: float
     torque_constant: float
     friction: Mapping[str, Any]
+    flags: Mapping[str, str] = field(default_factory=dict)
+    std: Mapping[str, float | None] = field(default_factory=dict)
 
 
 @dataclass(frozen=True, eq=False)

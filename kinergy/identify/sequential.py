@@ -41,6 +41,9 @@ from kinergy.identify.columns import rotor_columns
 from kinergy.identify.friction_curve import search_shape
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import (
+    AT_BOUND,
+    IDENTIFIED,
+    KEPT,
     DriveEstimate,
     Fit,
     IdentificationResult,
@@ -53,9 +56,11 @@ from kinergy.model.robot import Friction, Joint, Robot, Source
 
 __all__ = [
     "AUTO_CANDIDATES",
+    "DrivesFromCurrents",
     "FrictionChoice",
     "SequentialFit",
     "SequentialJoint",
+    "drives_from_currents",
     "identify_sequential",
     "rotor_inertias",
 ]
@@ -259,7 +264,8 @@ def _rotor_step(
     robot: Robot, ref_logs: Sequence[IdentData], active: list[int], warnings: list[str]
 ) -> tuple[Array, Array, float | None]:
     """Rotor inertias (kg m^2, motor side), their standard errors (NaN where not identified) and
-    the regression's condition number (None without ``target_moment``)."""
+    the regression's condition number (None without ``target_moment``). A rotor inertia that
+    comes out negative is not written: the model's is kept (NaN standard error) with a warning."""
     rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
     rotor_std = np.full(robot.n, np.nan)
     cond = None
@@ -272,10 +278,13 @@ def _rotor_step(
     else:
         warnings.append("the logs have no target_moment: rotor inertias kept from the model")
     for j, joint in enumerate(robot.joints):
-        if rotor[j] <= 0:
+        if rotor[j] < 0:
             warnings.append(
-                f"joint {j + 1} ({joint.name}): identified rotor inertia {rotor[j]:.3g} kg m^2 is not positive"
+                f"joint {j + 1} ({joint.name}): identified rotor inertia {rotor[j]:.3g} kg m^2 "
+                "is negative, not a physical value (target_moment does not fit this model): "
+                f"kept the model's {joint.drive.rotor_inertia:.4g} kg m^2"
             )
+            rotor[j], rotor_std[j] = joint.drive.rotor_inertia, np.nan
     return rotor, rotor_std, cond
 
 
@@ -422,23 +431,33 @@ def _auto_fit(
 
 @dataclass(frozen=True)
 class _CurrentStats:
-    """A joint's standard errors and condition number from eq 18 (:class:`SequentialJoint`)."""
+    """A joint's standard errors and condition number from eq 18 (:class:`SequentialJoint`),
+    and the flags of its torque constant and friction parameters (empty: not fitted)."""
 
     torque_constant_std: float | None = None
     friction_std: dict[str, float] | None = None
     condition_current: float | None = None
+    flags: dict[str, str] = field(default_factory=dict)
+
+
+def _unsupported(model: str, values: Array, kt: float) -> str | None:
+    """Why a current fit's torque constant ``kt`` and friction levels ``values`` are not a
+    physical drive (a friction level outside its model's bounds), or None."""
+    if not kt > 0:
+        return f"torque constant {kt:.3g} N m/A is not positive"
+    spec = get_model(model)
+    for name, value in zip(spec.linear, values, strict=True):
+        low, high = spec.bounds.get(name, (-np.inf, np.inf))
+        if not low <= value <= high:
+            return f"friction {name} = {value:.3g} is outside [{low:.3g}, {high:.3g}]"
+    return None
 
 
 def _apply_current_fit(
     m: int, joint: Joint, fit: _CurrentFit, warnings: list[str]
 ) -> tuple[Joint, _CurrentStats]:
-    """``joint`` with the torque constant and friction of ``fit``, and their standard errors."""
-    if fit.fixed:
-        warnings.append(
-            f"joint {m + 1} ({joint.name}): the logs do not pin the torque constant down "
-            "(too little load torque against friction and noise); kept the model's "
-            f"{joint.drive.torque_constant:.4g} N m/A"
-        )
+    """``joint`` with the torque constant and friction of ``fit``, and their standard errors;
+    a fit that is not a physical drive is not written (the model's values, flagged)."""
     if fit.cond > MAX_CONDITION:
         raise KinergyError(
             f"joint {m + 1} ({joint.name}): the current regression is singular (condition "
@@ -447,19 +466,32 @@ def _apply_current_fit(
     x, std, names = fit.x, fit.std, get_model(fit.model).linear
     kt = 1.0 / x[0]
     values = x[1:] * kt
+    problem = _unsupported(fit.model, values, kt)
+    if problem is not None:
+        warnings.append(
+            f"joint {m + 1} ({joint.name}): {problem}, not a physical drive (the currents do "
+            f"not support friction model {fit.model!r} here): kept the model's torque constant "
+            "and friction"
+        )
+        kept = {name: KEPT for name in ("torque_constant", *names)}
+        return joint, _CurrentStats(condition_current=fit.cond, flags=kept)
+    if fit.fixed:
+        warnings.append(
+            f"joint {m + 1} ({joint.name}): the logs do not pin the torque constant down "
+            "(too little load torque against friction and noise); kept the model's "
+            f"{joint.drive.torque_constant:.4g} N m/A"
+        )
     kt_std = std[0] / x[0] ** 2
     value_std = np.sqrt((std[1:] * kt) ** 2 + (x[1:] * kt_std * kt) ** 2)
-    for name, value in zip(names, values, strict=True):
-        if value < 0 and name not in ("gamma1",):
-            warnings.append(
-                f"joint {m + 1} ({joint.name}): friction {name} = {value:.3g} is negative"
-            )
     friction = Friction(fit.model, with_linear_parameters(fit.model, fit.params, values))
     drive = dataclasses.replace(joint.drive, torque_constant=float(kt), friction=friction)
+    flags = {"torque_constant": KEPT if fit.fixed else IDENTIFIED}
+    flags.update({name: IDENTIFIED for name in names})
     stats = _CurrentStats(
         torque_constant_std=float(kt_std),
         friction_std={name: float(s) for name, s in zip(names, value_std, strict=True)},
         condition_current=fit.cond,
+        flags=flags,
     )
     return dataclasses.replace(joint, drive=drive), stats
 
@@ -523,6 +555,28 @@ def _sources(robot: Robot, has_ref: bool, has_current: bool) -> dict[str, Source
     return sources
 
 
+def _drive_flags(
+    joint: Joint, identified_rotor: float, rotor_std: float, stats: _CurrentStats
+) -> tuple[dict[str, str], dict[str, float | None]]:
+    """Flags and standard errors of one joint's rotor inertia, torque constant and friction."""
+    if np.isnan(rotor_std):
+        rotor_flag = KEPT
+    elif identified_rotor < joint.drive.reducer_inertia:
+        rotor_flag = AT_BOUND  # motor inertia held at 0
+    else:
+        rotor_flag = IDENTIFIED
+    names = get_model(joint.drive.friction.model).linear
+    flags = {"rotor_inertia": rotor_flag, "torque_constant": KEPT, **dict.fromkeys(names, KEPT)}
+    flags.update(stats.flags)
+    fitted = stats.flags.get("torque_constant") == IDENTIFIED
+    std: dict[str, float | None] = {
+        "rotor_inertia": None if np.isnan(rotor_std) else float(rotor_std),
+        "torque_constant": stats.torque_constant_std if fitted else None,
+    }
+    std.update({name: (stats.friction_std or {}).get(name) for name in names})
+    return flags, std
+
+
 def _joints(
     identified: Robot,
     rotor: tuple[Array, Array],
@@ -531,22 +585,26 @@ def _joints(
 ) -> tuple[SequentialJoint, ...]:
     """Per joint: the identified drive with ``rotor`` = (inertias, standard errors)."""
     inertia, std = rotor
-    return tuple(
-        SequentialJoint(
-            name=joint.name,
-            rotor_inertia=float(joint.drive.motor_inertia + joint.drive.reducer_inertia)
-            if inertia[j] >= joint.drive.reducer_inertia
-            else float(inertia[j]),
-            rotor_inertia_std=None if np.isnan(std[j]) else float(std[j]),
-            motor_inertia=joint.drive.motor_inertia,
-            torque_constant=joint.drive.torque_constant,
-            friction=friction_entry(joint),
-            identified=j not in problems,
-            problem=problems.get(j),
-            **vars(stats[j]),
+    out = []
+    for j, joint in enumerate(identified.joints):
+        flags, errors = _drive_flags(joint, float(inertia[j]), float(std[j]), stats[j])
+        fields = {k: v for k, v in vars(stats[j]).items() if k != "flags"}
+        out.append(
+            SequentialJoint(
+                name=joint.name,
+                rotor_inertia=float(joint.drive.motor_inertia + joint.drive.reducer_inertia),
+                rotor_inertia_std=None if np.isnan(std[j]) else float(std[j]),
+                motor_inertia=joint.drive.motor_inertia,
+                torque_constant=joint.drive.torque_constant,
+                friction=friction_entry(joint),
+                flags=flags,
+                std=errors,
+                identified=j not in problems,
+                problem=problems.get(j),
+                **fields,
+            )
         )
-        for j, joint in enumerate(identified.joints)
-    )
+    return tuple(out)
 
 
 def identify_sequential(
@@ -625,3 +683,47 @@ def identify_sequential(
     )
     joints = _joints(identified, (rotor, rotor_std), problems, stats)
     return IdentificationResult(identified, "sequential", joints, fit)
+
+
+@dataclass(frozen=True, eq=False)
+class DrivesFromCurrents:
+    """Step 3 on its own (:func:`drives_from_currents`): the robot with the torque constants and
+    friction the currents give, per joint the flags and standard errors of those parameters
+    (:class:`~kinergy.identify.result.DriveEstimate`), the friction fraction held through
+    standstill (None where not fitted) and the warnings."""
+
+    robot: Robot
+    flags: tuple[dict[str, str], ...]
+    std: tuple[dict[str, float | None], ...]
+    holding: tuple[float | None, ...]
+    warnings: tuple[str, ...]
+
+
+def drives_from_currents(
+    robot: Robot,
+    logs: Sequence[IdentData],
+    *,
+    friction: str | None = None,
+    hold: str | bool = "auto",
+) -> DrivesFromCurrents:
+    """Torque constants and friction of every motor from ``actual_current`` (UR5e eqs 17-18),
+    ``robot``'s links and rotor inertias taken as they are (the full method's drives).
+
+    Raises
+    ------
+    KinergyError
+        As :func:`identify_sequential`: too few samples, no joint that moves, a singular
+        current regression.
+    """
+    problems = _diagnose_motion(robot, logs)
+    warnings = [
+        f"{text}; kept the model's torque constant and friction" for text in problems.values()
+    ]
+    rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
+    out, stats, held, _ = _current_step(robot, rotor, logs, problems, (friction, hold), warnings)
+    flags, std = [], []
+    for joint, stat in zip(out.joints, stats, strict=True):
+        f, s = _drive_flags(joint, float(joint.drive.rotor_inertia), np.nan, stat)
+        flags.append({k: v for k, v in f.items() if k != "rotor_inertia"})
+        std.append({k: v for k, v in s.items() if k != "rotor_inertia"})
+    return DrivesFromCurrents(out, tuple(flags), tuple(std), held, tuple(warnings))

@@ -6,8 +6,10 @@ written, in this order of preference:
 1. the standard parameters closest to the model's that reproduce the identified base parameters
    exactly (:func:`~kinergy.identify.physical.standard_from_base`);
 2. when one of those links is not physical (:func:`~kinergy.identify.physical.link_consistency`)
-   or a rotor inertia is negative, the least-squares fit constrained to physical links and
-   non-negative rotor inertias (:func:`~kinergy.identify.constrained.physical_fit`);
+   or a rotor inertia, friction level or torque constant is outside its bounds, the
+   least-squares fit constrained to physical values
+   (:func:`~kinergy.identify.constrained.physical_fit`, a convex problem); when the
+   unconstrained fit is physical it is that problem's solution already;
 3. the model's data for a link still not physical.
 
 Rotor inertias give ``motor_inertia = J - reducer_inertia`` (UR5e eq 9, Table IV; below the
@@ -27,7 +29,7 @@ from kinergy.dynamics.regressor import BaseParameters, inertial_parameters, para
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import get_model, with_linear_parameters
 from kinergy.identify.columns import Columns, Stacked
-from kinergy.identify.constrained import physical_fit
+from kinergy.identify.constrained import ConstrainedFit, bounds, physical_fit
 from kinergy.identify.physical import (
     inertia_vector,
     link_consistency,
@@ -36,6 +38,7 @@ from kinergy.identify.physical import (
     standard_from_base,
 )
 from kinergy.identify.regression import Solved
+from kinergy.identify.result import AT_BOUND, IDENTIFIED, KEPT
 from kinergy.model.robot import Drive, Friction, Joint, Link, Robot, Source
 
 __all__ = ["CLOSEST", "CONSTRAINED", "WriteBack", "write_back"]
@@ -62,6 +65,12 @@ class WriteBack:
         :data:`CLOSEST` or :data:`CONSTRAINED`.
     chi2 : float or None
         The constrained fit's chi^2 increase; None when it was not used.
+    active : tuple of str
+        The constraints the constrained fit sits on.
+    solver : str or None
+        The constrained fit's solver.
+    flags : tuple of str
+        Per column of the regression: ``identified``, ``kept from prior`` or ``at bound``.
     links_not_physical_closest : tuple of int
         Links (1-based) whose closest standard parameters are not physical.
     links_physical : tuple of bool
@@ -75,6 +84,9 @@ class WriteBack:
     x: Array
     method: str
     chi2: float | None
+    active: tuple[str, ...]
+    solver: str | None
+    flags: tuple[str, ...]
     links_not_physical_closest: tuple[int, ...]
     links_physical: tuple[bool, ...]
     standard_parameters: dict[str, float]
@@ -84,51 +96,66 @@ class WriteBack:
 @dataclass(frozen=True, eq=False)
 class _Links:
     """The standard parameters of the links (the payload's share taken out of the last, (p,)),
-    the unknowns they go with, how, the chi^2 increase of the constrained fit, and the links
+    the unknowns they go with, how, the constrained fit (None when not used), and the links
     flagged."""
 
     links: Array
     x: Array
     method: str
-    chi2: float | None
+    refit: ConstrainedFit | None
     flagged: dict[int, str]
+
+
+def _out_of_bounds(cols: Columns, x: Array, lo: Array, hi: Array) -> dict[int, str]:
+    """Non-link columns of ``x`` outside their bounds (index -> phrase)."""
+    out = {}
+    for k, (value, low, high) in enumerate(zip(x[cols.n_link :], lo, hi, strict=True)):
+        if not low <= value <= high:
+            col = cols.n_link + k
+            out[col] = f"{cols.names[col]} = {value:.3g} is outside [{low:.3g}, {high:.3g}]"
+    return out
 
 
 def _links(
     robot: Robot,
     base: BaseParameters,
     problem: Solved,
-    cols: Columns,
+    stacked: Stacked,
     merged_rotor: dict[int, Array],
     warnings: list[str],
 ) -> _Links:
     """Steps 1 and 2 of the module docstring (warnings appended for the constrained fit)."""
+    cols = stacked.cols
     n_link, x = cols.n_link, problem.x
     pi0 = inertial_parameters(robot)
     payload = pi0 - inertial_parameters(robot, include_payload=False)  # the last link's part
     scale = parameter_scale(robot)
     pi = standard_from_base(base, x[:n_link], pi0, scale=scale)
     flagged = {j: p for j, p in enumerate(link_consistency(pi - payload)) if p is not None}
-    negative = [m for m in range(robot.n) if x[n_link + m] < 0.0]
-    if not (flagged or negative):
+    outside = _out_of_bounds(cols, x, *bounds(cols, stacked.models))
+    if not (flagged or outside):
         return _Links(pi - payload, x, CLOSEST, None, flagged)
-    refit = physical_fit(problem, base, cols, pi0, scale, payload, merged_rotor)
+    names = robot.joint_names
+    refit = physical_fit(
+        problem, base, cols, stacked.models, pi0, scale, payload, names, merged_rotor
+    )
     if refit is None:
+        for col, phrase in outside.items():  # never written: the model's value instead
+            warnings.append(f"{phrase}: kept the model's value (the constrained fit failed)")
+            x = x.copy()
+            x[col] = cols.prior[col]
         return _Links(pi - payload, x, CLOSEST, None, flagged)
     instead = (
-        "the returned robot takes its links, rotor inertias and friction from the "
-        f"least-squares fit constrained to physical links and non-negative rotor "
-        f"inertias (chi^2 up by {refit.chi2:.3g}; fit['physical_fit'], while "
-        "fit['base_parameters'] and fit['regression'] are the unconstrained fit)"
+        "the returned robot is the least-squares fit constrained to physical links, rotor "
+        f"inertias and friction (chi^2 up by {refit.chi2:.3g}; "
+        "fit['physical_fit'], while fit['base_parameters'] and fit['regression'] are the "
+        "unconstrained fit)"
     )
     for j, p in flagged.items():
         warnings.append(f"link {j + 1} ({robot.joints[j].name}): {p}; {instead}")
-    for m in negative:
-        warnings.append(
-            f"joint {m + 1} ({robot.joints[m].name}): identified rotor inertia "
-            f"{x[n_link + m]:.3g} kg m^2 is negative; {instead}"
-        )
-    return _Links(refit.pi - payload, refit.x, CONSTRAINED, refit.chi2, flagged)
+    for phrase in outside.values():
+        warnings.append(f"{phrase}; {instead}")
+    return _Links(refit.pi - payload, refit.x, CONSTRAINED, refit, flagged)
 
 
 def _with_links(
@@ -211,6 +238,39 @@ def _sources(robot: Robot, method: str, physical: list[bool], commanded: bool) -
     return sources
 
 
+def _flags(cols: Columns, problem: Solved, written: _Links) -> tuple[str, ...]:
+    """Each column's flag: at a bound of the constrained fit, kept from the prior (a column the
+    logs cannot tell apart, or one the fit could not make physical), else identified."""
+    at_bound = set(written.refit.at_bound) if written.refit is not None else set()
+    dropped = set(problem.dropped.tolist())
+    out = []
+    for k in range(cols.prior.size):
+        if k in at_bound:
+            out.append(AT_BOUND)
+        elif k in dropped or (
+            k >= cols.n_link and written.x[k] != problem.x[k] and written.refit is None
+        ):
+            out.append(KEPT)
+        else:
+            out.append(IDENTIFIED)
+    return tuple(out)
+
+
+def _with_drive(
+    m: int, joint: Joint, stacked: Stacked, x: Array, commanded: bool, warnings: list[str]
+) -> Joint:
+    """``joint`` with motor ``m``'s rotor inertia and friction (not ``commanded``) from the
+    unknowns ``x``."""
+    cols = stacked.cols
+    drive = _with_rotor(m, joint, float(x[cols.n_link + m]), warnings)
+    joint = dataclasses.replace(joint, drive=drive)
+    if not commanded:
+        friction = (stacked.models[m], stacked.params[m])
+        drive = _with_friction(m, joint, friction, cols.friction(x, m), warnings)
+        joint = dataclasses.replace(joint, drive=drive)
+    return joint
+
+
 def write_back(
     robot: Robot,
     base: BaseParameters,
@@ -220,37 +280,27 @@ def write_back(
     merged_rotor: dict[int, Array],
 ) -> WriteBack:
     """The identified robot from the solved regression ``problem`` of ``stacked`` (module
-    docstring).
-
-    ``commanded``: a fit against ``target_moment``, which keeps the model's friction;
-    ``merged_rotor`` gives each merged rotor inertia's column in link base columns (motor ->
-    (b,)), which the constrained fit may move.
-    """
+    docstring). ``commanded``: a fit against ``target_moment``, which keeps the model's
+    friction; ``merged_rotor`` gives each merged rotor inertia's column in link base columns
+    (motor -> (b,)), which the constrained fit may move."""
     warnings: list[str] = []
     cols = stacked.cols
-    n_link = cols.n_link
-    written = _links(robot, base, problem, cols, merged_rotor, warnings)
+    written = _links(robot, base, problem, stacked, merged_rotor, warnings)
     link_joints, links, physical = _with_links(robot, written.links, warnings)
-    final = []
-    for m, joint in enumerate(link_joints):
-        joint = dataclasses.replace(
-            joint, drive=_with_rotor(m, joint, float(written.x[n_link + m]), warnings)
-        )
-        if not commanded:
-            friction = (stacked.models[m], stacked.params[m])
-            values = cols.friction(written.x, m)
-            joint = dataclasses.replace(
-                joint, drive=_with_friction(m, joint, friction, values, warnings)
-            )
-        final.append(joint)
-    robot_out = dataclasses.replace(
-        robot.with_joints(final), sources=_sources(robot, written.method, physical, commanded)
-    )
+    final = [
+        _with_drive(m, joint, stacked, written.x, commanded, warnings)
+        for m, joint in enumerate(link_joints)
+    ]
+    sources = _sources(robot, written.method, physical, commanded)
+    refit = written.refit
     return WriteBack(
-        robot=robot_out,
+        robot=dataclasses.replace(robot.with_joints(final), sources=sources),
         x=written.x,
         method=written.method,
-        chi2=written.chi2,
+        chi2=refit.chi2 if refit is not None else None,
+        active=refit.active if refit is not None else (),
+        solver=refit.solver if refit is not None else None,
+        flags=_flags(cols, problem, written),
         links_not_physical_closest=tuple(sorted(j + 1 for j in written.flagged)),
         links_physical=tuple(physical),
         standard_parameters=dict(zip(parameter_names(robot), links.tolist(), strict=True)),

@@ -18,6 +18,7 @@ from kinergy.identify.nursing import identify_nursing
 from kinergy.identify.payload import PayloadEstimate, identify_payload
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult
+from kinergy.identify.sanity import check_motion, check_signals
 from kinergy.identify.sequential import identify_sequential
 from kinergy.model import Payload, Robot, save_robot
 from kinergy.model.robot import Source
@@ -25,6 +26,7 @@ from kinergy.predict import drive_state
 
 __all__ = [
     "METHODS",
+    "MIN_SECONDS",
     "identify_model",
     "identify_payload_model",
     "measured_electrics",
@@ -33,6 +35,8 @@ __all__ = [
 
 #: identification methods by the name ``--method`` takes
 METHODS = ("sequential", "full", "nursing")
+#: s: the shortest logs (all together) an identification accepts
+MIN_SECONDS = 1.0
 
 
 def _header(what: str, logs: Sequence[str | os.PathLike[str]]) -> str:
@@ -74,7 +78,22 @@ def run_method(
     ridge: float = 0.0,
 ) -> IdentificationResult:
     """Identify ``robot`` from prepared logs by ``method``, then the motor electrics and the
-    standby power where the logs have voltages and the supply (:func:`measured_electrics`)."""
+    standby power where the logs have voltages and the supply (:func:`measured_electrics`).
+
+    Raises
+    ------
+    KinergyError
+        Logs spanning less than :data:`MIN_SECONDS` together, with signals no robot logs or
+        without motion (:mod:`kinergy.identify.sanity`); nothing is written.
+    """
+    check_signals(datas)
+    check_motion(datas)
+    seconds = sum(float(d.t[-1] - d.t[0]) for d in datas)
+    if seconds < MIN_SECONDS:
+        raise KinergyError(
+            f"the logs span {seconds:.2f} s: identification needs at least {MIN_SECONDS:g} s of "
+            "motion (a few periods of every joint's excitation)"
+        )
     if method == "sequential":
         result = identify_sequential(robot, list(datas), friction=friction)
     elif method == "nursing":
@@ -176,6 +195,7 @@ def identify_payload_model(
     robot: Robot, datas: Sequence[IdentData], out: str | os.PathLike[str]
 ) -> tuple[Payload, PayloadEstimate]:
     """Identify the payload of ``robot`` (the model without it) and write the model with it."""
+    check_signals(datas)
     payload, report = identify_payload(robot, list(datas))
     what = f"{robot.name} with the payload identified"
     save_robot(robot.with_payload(payload), out, header=_header(what, [d.path for d in datas]))

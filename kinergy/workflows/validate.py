@@ -8,7 +8,9 @@ from pathlib import Path
 from typing import Any
 
 from kinergy.identify.preprocess import IdentData
-from kinergy.identify.result import Validation, predict, validation_metrics
+from kinergy.identify.result import predict
+from kinergy.identify.sanity import check_signals
+from kinergy.identify.validation import ValidationReport, validation_report
 from kinergy.model.robot import Robot
 from kinergy.report.plots import error_boxplot, save, time_series
 
@@ -17,10 +19,12 @@ __all__ = ["validate_logs", "write_validation_plots"]
 
 def validate_logs(
     robot: Robot, datas: Sequence[IdentData], *, plots: str | os.PathLike[str] | None = None
-) -> Validation:
-    """UR5e Tables V and VII for ``datas`` (:func:`validation_metrics`); with ``plots``, also
-    write the measured-against-predicted figures to that folder."""
-    report = validation_metrics(robot, list(datas))
+) -> ValidationReport:
+    """UR5e Tables V and VII for ``datas``, pooled and per log, moving and holding apart
+    (:func:`~kinergy.identify.validation.validation_report`); with ``plots``, also write the
+    measured-against-predicted figures to that folder."""
+    check_signals(datas)
+    report = validation_report(robot, list(datas))
     if plots is not None:
         write_validation_plots(robot, datas, plots)
     return report
