@@ -22,10 +22,12 @@ import click
 from kinergy.errors import KinergyError
 from kinergy.files import Terminated, terminate_on_signals
 
-__all__ = ["COMMANDS", "QUIET", "LazyGroup", "cli", "main", "one_line", "run"]
+__all__ = ["COMMANDS", "NOTES", "QUIET", "LazyGroup", "cli", "main", "one_line", "run"]
 
 #: key in click's ``ctx.meta``: the global ``--quiet`` was given (no progress on stderr)
 QUIET = "kinergy.quiet"
+#: key in the context object :func:`main` passes: the notes held back until the command succeeds
+NOTES = "kinergy.notes"
 
 #: command name -> "module:attribute" of its click command, in the order ``--help`` lists them
 COMMANDS = {
@@ -81,12 +83,14 @@ def one_line(message: str) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point: run the CLI, turning user errors into one line and a non-zero exit."""
+    notes: list[str] = []
     try:
         with terminate_on_signals():
             cli.main(
                 args=list(argv) if argv is not None else None,
                 prog_name="kinergy",
                 standalone_mode=False,
+                obj={NOTES: notes},
             )
     except KinergyError as exc:
         click.echo(f"kinergy: error: {one_line(str(exc))}", err=True)
@@ -107,6 +111,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return exc.exit_code
     except BrokenPipeError:
         return 0
+    for message in notes:
+        click.echo(f"kinergy: note: {one_line(message)}", err=True)
     return 0
 
 

@@ -14,7 +14,7 @@ import numpy as np
 from rich.console import Console
 from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElapsedColumn
 
-from kinergy.cli.app import QUIET
+from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_output, check_outputs
 from kinergy.model import Robot, load_robot, parse_payload
@@ -176,8 +176,14 @@ def progress(*, quiet: bool = False) -> Iterator[Callable[[str], None]]:
 
 
 def note(message: str) -> None:
-    """A note for the user on stderr (what reading a file changed)."""
-    click.echo(f"kinergy: note: {message}", err=True)
+    """A note for the user on stderr (what reading a file changed). Under :func:`kinergy.cli.main`
+    the notes are held back and shown when the command succeeds: a refusal stays one line."""
+    ctx = click.get_current_context(silent=True)
+    held = ctx.find_object(dict) if ctx is not None else None
+    if held is not None and NOTES in held:
+        held[NOTES].append(message)
+    else:
+        click.echo(f"kinergy: note: {message}", err=True)
 
 
 def print_tables(tables: Mapping[str, Sequence[Any]], keys: Sequence[str]) -> None:

@@ -248,6 +248,8 @@ class _Reader:
             if "t" not in args:
                 raise KinergyError("sleep: the time is missing")
             duration = self.values.number(args["t"])
+            if not 0.0 <= duration <= 3600.0:  # an hour: longer is a typo, and overflows the plan
+                raise KinergyError(f"sleep: the time must be from 0 to 3600 s, got {duration:g}")
             self.steps.append(Event("sleep", duration, line, text))
         elif name == "sync":
             self.steps.append(Event("sync", _SYNC, line, text))
