@@ -5,8 +5,8 @@ The corpus is generated here, not checked in: robot files with one field made wr
 task files and URScript programs that are malformed, out-of-range flags, and outputs that would
 destroy an input or each other. Each case runs in-process through :func:`kinergy.cli.main`
 (:func:`clicase.run_case`): no traceback, exit non-zero with exactly one line on stderr, no file
-changed, under 10 s. Cases the log reader still gets wrong are marked xfail(strict=True) naming
-the ``speed`` branch (issue 16), which owns the reader.
+changed, under 10 s. (Cases the log reader got wrong were marked xfail(strict=True) naming the
+``speed`` branch, issue 16; with it merged, none is left.)
 """
 
 from __future__ import annotations
@@ -27,9 +27,6 @@ from kinergy.io.rtde import write_log
 from kinergy.model import load_robot, robot_to_dict
 from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.programs import paper_trajectory
-
-#: reason for the cases the log reader (io/rtde.py, io/log.py) still gets wrong
-SPEED = "log reader: fixed on the speed branch (issue 16)"
 
 
 @dataclass
@@ -258,13 +255,7 @@ def _log_cases() -> Iterator[Case]:
             "wide-line",
             lambda: "timestamp " + " ".join(f"c{i}" for i in range(200_000)) + "\n0\n",
             True,
-            (
-                pytest.mark.xfail(
-                    strict=True,
-                    run=False,
-                    reason=SPEED + "; takes 45 s here (quadratic column grouping)",
-                ),
-            ),
+            (),
         ),
     ]
     for label, content, refuse, marks in logs:
@@ -290,7 +281,6 @@ def _log_cases() -> Iterator[Case]:
         "log-columns-huge",
         ["energy", "ur5e", "h.csv", "--columns", "timestamp,actual_q:999999999"],
         {"h.csv": "0 1 2 3\n1 1 2 3\n"},
-        marks=(pytest.mark.xfail(strict=True, run=False, reason=SPEED + "; takes over 60 s here"),),
     )
     for label, spec in {
         "empty": "",
@@ -579,18 +569,7 @@ def _materialise(folder: Path, files: dict[str, Any]) -> None:
             os.mkfifo(path)
 
 
-#: cases the log reader makes too slow to run at all: a one-hour gap is integrated as motion
-_NOT_RUN = {"log-hour-gap-identify": SPEED + "; a one-hour gap is resampled as motion (50 s here)"}
-
-
-def _param(case: Case) -> Any:
-    marks = case.marks
-    if case.id in _NOT_RUN:
-        marks = (pytest.mark.xfail(strict=True, run=False, reason=_NOT_RUN[case.id]),)
-    return pytest.param(case, id=case.id, marks=marks)
-
-
-@pytest.mark.parametrize("case", [_param(c) for c in CASES])
+@pytest.mark.parametrize("case", [pytest.param(c, id=c.id, marks=c.marks) for c in CASES])
 def test_bad_input_is_one_line_and_changes_nothing(case: Case, tmp_path: Path) -> None:
     _materialise(tmp_path, case.files)
     run_case(case.args, tmp_path, outputs=case.outputs, refuse=case.refuse)
