@@ -22,7 +22,11 @@ from clicase import snapshot
 from kinergy.cli import main
 from kinergy.files import MARKER
 
-_RUN = "import sys; from kinergy.cli import run; sys.argv[0] = 'kinergy'; run()"
+#: the child restores Python's Ctrl-C handler: a shell's background job starts with SIGINT ignored
+_RUN = (
+    "import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+    "from kinergy.cli import run; sys.argv[0] = 'kinergy'; run()"
+)
 
 #: command -> (arguments, its declared outputs)
 COMMANDS = {
