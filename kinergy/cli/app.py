@@ -33,6 +33,7 @@ COMMANDS = {
     "nursing": "kinergy.cli.nursing:nursing",
     "report": "kinergy.cli.report:report",
     "demo": "kinergy.cli.demo:demo",
+    "record": "kinergy.cli.record:record",
 }
 
 
