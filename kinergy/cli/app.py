@@ -34,6 +34,7 @@ COMMANDS = {
     "report": "kinergy.cli.report:report",
     "demo": "kinergy.cli.demo:demo",
     "record": "kinergy.cli.record:record",
+    "monitor": "kinergy.cli.monitor:monitor",
 }
 
 
