@@ -36,8 +36,8 @@ def program(robot) -> Motion:
     way = np.vstack(
         [
             UR_HOME,
-            UR_HOME + [0.8, 0.3, -0.5, 0.2, 0.6, 0.0],
-            UR_HOME + [-0.5, 0.2, 0.4, 0, 0, 1],
+            UR_HOME + np.array([0.8, 0.3, -0.5, 0.2, 0.6, 0.0]),
+            UR_HOME + np.array([-0.5, 0.2, 0.4, 0, 0, 1]),
             UR_HOME,
         ]
     )

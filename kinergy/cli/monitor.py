@@ -40,7 +40,7 @@ def monitor(
     """
     robot = load(model, None)
     say = progress()
-    shown = []
+    shown: list[CycleEnergy] = []
 
     def show(cycle: CycleEnergy) -> None:
         if not shown and not as_json:
