@@ -35,6 +35,7 @@ COMMANDS = {
     "demo": "kinergy.cli.demo:demo",
     "record": "kinergy.cli.record:record",
     "monitor": "kinergy.cli.monitor:monitor",
+    "fleet": "kinergy.cli.fleet:fleet",
 }
 
 
