@@ -4,19 +4,21 @@ For one robot running one program, a figure per cycle (energy, or the motor work
 takes) is summarised per day. Two things can move it:
 
 - a **step change**: a new payload, a new gripper, a changed program speed -- the level jumps
-  from one day to the next and stays. It is found by binary segmentation: the split of the days
-  into two levels that explains the most, accepted when the jump is more than
-  :data:`STEP_SIGMAS` spreads and two levels fit the days better than a straight line does;
-  the parts are searched again (at most :data:`MAX_CHANGES` changes).
+  from one day to the next and stays. It is found by binary segmentation: a line with a step
+  (``a + b x + J [day >= k]``) is fitted for every split day ``k``; the best fit's step is a
+  change when ``|J|`` is more than :data:`STEP_SIGMAS` spreads (a steady trend gives ``J``
+  near 0, so a ramp is not mistaken for steps); the parts are searched again (at most
+  :data:`MAX_CHANGES` changes).
 - **drift**: the level creeps up day after day inside one stretch between changes (a wearing
   gearbox). A line is fitted over at least :data:`MIN_DAYS` days; the stretch drifts when its
   rise from the first to the last day is more than :data:`DRIFT_SIGMAS` spreads *and* more than
   ``min_rise`` (5 %) of its first level.
 
-The spread is the figure's own: the larger of the scatter of the cycles within a day (pooled)
-and of the day-to-day scatter (the median absolute residual of the daily means about the better
-of a line and two levels, so neither a steady trend nor a step inflates it, scaled to a standard
-deviation), with a floor of 0.2 % of the level.
+The spread is the figure's own: the largest of the scatter of the cycles within a day (pooled)
+and of two robust estimates of the day-to-day scatter, neither inflated by a steady trend or a
+step: the median absolute residual of the daily means about the better of a line and a line
+with a step, and the median absolute deviation of the day-to-day differences about their median
+(over ``sqrt 2``), each scaled to a standard deviation; with a floor of 0.2 % of the level.
 """
 
 from __future__ import annotations
@@ -37,6 +39,8 @@ STEP_SIGMAS = 6.0
 DRIFT_SIGMAS = 4.0
 MIN_DAYS = 3
 MAX_CHANGES = 3
+#: days each side of a step needs for a slope of its own
+SLOPE_DAYS = 4
 
 
 @dataclass(frozen=True)
@@ -78,57 +82,87 @@ class Trend:
     rise: float = 0.0
 
 
-def _line_sse(x: Array, y: Array) -> float:
-    if y.size < 3:
-        return 0.0
-    coef = np.polyfit(x, y, 1)
-    return float(np.sum((y - np.polyval(coef, x)) ** 2))
+def _step_fit(x: Array, y: Array, k: int) -> tuple[float, float, float]:
+    """A step between days ``k - 1`` and ``k``: its jump, the jump's standard error per unit
+    spread and the fit's own spread (residual standard deviation).
+
+    Each side is its own line when both have :data:`SLOPE_DAYS` days, else one slope is shared
+    (a level for :data:`MIN_DAYS` days or fewer in all); the jump is read half-way between the
+    two days, so a steady trend gives a jump near 0 and a ramp is not mistaken for steps.
+    """
+    left = np.arange(x.size) < k
+    centre = x - 0.5 * (x[k - 1] + x[k])
+    columns = [np.ones_like(x), (~left).astype(float)]
+    if min(k, x.size - k) >= SLOPE_DAYS:
+        columns += [centre * left, centre * ~left]
+    elif x.size > MIN_DAYS:
+        columns.append(centre)
+    design = np.column_stack(columns)
+    coef = np.linalg.lstsq(design, y, rcond=None)[0]
+    dof = x.size - design.shape[1]
+    own = float(np.sqrt(np.sum((y - design @ coef) ** 2) / dof)) if dof > 0 else 0.0
+    return float(coef[1]), float(np.sqrt(np.linalg.pinv(design.T @ design)[1, 1])), own
 
 
-def _residuals(x: Array, y: Array) -> Array:
-    """Residuals of the better of a line and two levels (the best split) through ``y``."""
-    best = y - np.polyval(np.polyfit(x, y, 1), x)
-    for k in range(2, y.size - 1):
-        step = np.concatenate([y[:k] - y[:k].mean(), y[k:] - y[k:].mean()])
-        if np.sum(step**2) < np.sum(best**2):
-            best = step
-    return best
+def _best_step(x: Array, y: Array) -> tuple[int, float, float, float] | None:
+    """The most significant step (the day it starts and :func:`_step_fit`'s figures); None for
+    fewer than two days."""
+    fits = [(k, *_step_fit(x, y, k)) for k in range(1, y.size)]
+    return max(fits, key=lambda fit: abs(fit[1]) / fit[2]) if fits else None
 
 
 def _spread(groups: Sequence[Array], x: Array, means: Array) -> float:
     within = [g - g.mean() for g in groups if g.size > 1]
     dof = sum(g.size - 1 for g in groups)
     pooled = float(np.sqrt(sum(float(np.sum(w**2)) for w in within) / dof)) if dof else 0.0
-    daily = 0.0
-    if means.size >= 4:  # robust scatter of the days about a line or two levels
-        residuals = np.abs(_residuals(x, means))
-        daily = float(1.4826 * np.median(residuals) * np.sqrt(means.size / (means.size - 2)))
+    step = _best_step(x, means) if means.size > MIN_DAYS + 1 else None
+    daily = 0.0 if step is None else step[3]  # the days about the best line with a step
     return max(pooled, daily, 0.002 * float(np.mean(np.abs(means))))
-
-
-def _best_step(x: Array, y: Array, spread: float) -> int | None:
-    """Where two levels fit ``y`` best, if that is a real step (see the module docstring)."""
-    if y.size < 2:
-        return None
-    sse = [
-        float(np.sum((y[:k] - y[:k].mean()) ** 2) + np.sum((y[k:] - y[k:].mean()) ** 2))
-        for k in range(1, y.size)
-    ]
-    k = 1 + int(np.argmin(sse))
-    jump = abs(y[k:].mean() - y[:k].mean())
-    if jump <= STEP_SIGMAS * spread or sse[k - 1] >= _line_sse(x, y):
-        return None
-    return k
 
 
 def _steps(x: Array, y: Array, spread: float, offset: int = 0) -> list[int]:
     """Indices where a new level starts (binary segmentation)."""
-    k = _best_step(x, y, spread)
-    if k is None:
+    step = _best_step(x, y)
+    if step is None or abs(step[1]) <= STEP_SIGMAS * spread * step[2]:
         return []
+    k = step[0]
     left = _steps(x[:k], y[:k], spread, offset)
     right = _steps(x[k:], y[k:], spread, offset + k)
     return sorted([*left, offset + k, *right])[:MAX_CHANGES]
+
+
+def _rise(x: Array, y: Array) -> tuple[float, float]:
+    """Rise of the line through ``y`` from its first to its last day: absolute, relative."""
+    first, last = np.polyval(np.polyfit(x, y, 1), [x[0], x[-1]])
+    return float(last - first), float((last - first) / first) if first else 0.0
+
+
+def _drifts(x: Array, y: Array, spread: float, min_rise: float) -> bool:
+    """Whether a stretch of days drifts (see the module docstring)."""
+    if y.size < MIN_DAYS:
+        return False
+    rise, relative = _rise(x, y)
+    return rise > DRIFT_SIGMAS * spread and relative > min_rise
+
+
+def _two_levels(x: Array, y: Array) -> int | None:
+    """Where two levels fit ``y`` better than a line does (a step a line would read as a rise)."""
+    line = float(np.sum((y - np.polyval(np.polyfit(x, y, 1), x)) ** 2))
+    sse = [float(np.sum((y[:k] - y[:k].mean()) ** 2) + np.sum((y[k:] - y[k:].mean()) ** 2))
+           for k in range(1, y.size)]  # fmt: skip
+    k = int(np.argmin(sse))
+    return k + 1 if sse[k] < line else None
+
+
+def _with_level_steps(
+    x: Array, y: Array, spread: float, min_rise: float, starts: list[int]
+) -> list[int]:
+    """``starts`` and the day of every stretch that would drift but is two levels, not a line."""
+    found = list(starts)
+    for a, b in itertools.pairwise([0, *starts, y.size]):
+        k = _two_levels(x[a:b], y[a:b]) if _drifts(x[a:b], y[a:b], spread, min_rise) else None
+        found += [] if k is None else [a + k]
+    return sorted(found)[:MAX_CHANGES]
 
 
 def trend(
@@ -153,17 +187,10 @@ def trend(
     means = np.array([g.mean() for g in groups])
     x = np.array([(d - days[0]).days for d in days], dtype=float)
     spread = _spread(groups, x, means)
-    starts = _steps(x, means, spread)
+    starts = _with_level_steps(x, means, spread, min_rise, _steps(x, means, spread))
     changes = [Change(days[k], float(means[k - 1]), float(means[k])) for k in starts]
-    drift, rise = False, 0.0
-    bounds = [0, *starts, len(days)]
-    for a, b in itertools.pairwise(bounds):
-        if b - a < MIN_DAYS:
-            continue
-        coef = np.polyfit(x[a:b], means[a:b], 1)
-        first, last = np.polyval(coef, [x[a], x[b - 1]])
-        stretch_rise = float((last - first) / first) if first else 0.0
-        rise = max(rise, stretch_rise)
-        if last - first > DRIFT_SIGMAS * spread and stretch_rise > min_rise:
-            drift = True
+    stretches = [(x[a:b], means[a:b]) for a, b in itertools.pairwise([0, *starts, len(days)])]
+    long = [(sx, sy) for sx, sy in stretches if sy.size >= MIN_DAYS]
+    drift = any(_drifts(sx, sy, spread, min_rise) for sx, sy in long)
+    rise = max([0.0, *(_rise(sx, sy)[1] for sx, sy in long)])
     return Trend(list(days), means.tolist(), spread, changes, drift, rise)

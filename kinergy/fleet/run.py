@@ -10,6 +10,8 @@ core (the compiled dynamics run on one thread inside each, :func:`kinergy.dynami
 from __future__ import annotations
 
 import os
+import socket
+import urllib.parse
 from collections.abc import Callable, Sequence
 
 from kinergy.errors import KinergyError
@@ -19,11 +21,28 @@ from kinergy.fleet.manifest import FleetLog
 __all__ = ["run_on_dask"]
 
 
+def _reachable(scheduler: str) -> None:
+    """Fail at once, in one line, when nothing listens at a TCP scheduler address (Dask's
+    client would retry until its timeout)."""
+    where = urllib.parse.urlsplit(scheduler if "://" in scheduler else f"tcp://{scheduler}")
+    try:
+        host, port = where.hostname, where.port
+    except ValueError as exc:
+        raise KinergyError(f"--scheduler {scheduler}: not an address ({exc})") from None
+    if where.scheme not in ("tcp", "tls") or host is None or port is None:
+        return  # another transport: leave it to Dask
+    try:
+        socket.create_connection((host, port), timeout=5.0).close()
+    except OSError as exc:
+        raise KinergyError(f"--scheduler {scheduler}: cannot reach it ({exc})") from None
+
+
 def _client(scheduler: str | None, workers: int | None) -> tuple[object, object | None, int]:
     """A Dask client (and the local cluster it owns, if any) and its worker count."""
     from distributed import Client, LocalCluster  # the fleet extra: pip install 'kinergy[fleet]'
 
     if scheduler is not None:
+        _reachable(scheduler)
         try:
             client = Client(scheduler, timeout="10s")
         except (OSError, TimeoutError, ValueError) as exc:
