@@ -8,7 +8,7 @@ Energy accounting, validation, the twin and the optimiser all predict through
 2. motor side: ``wm = N qd`` and the torque the motor delivers to the load ``tau_load = N^-T tau_sim``
    (``tau_sim / i`` for a UR joint);
 3. friction on the motor side (eqs 11-16, or the joint's model), whose power-flow direction is the
-   sign of ``wm * tau_load``;
+   sign of ``wm * tau_load``, at the joint temperatures when given (temperature-dependent models);
 4. motor torque ``tau_m = tau_load + tau_f`` and current ``I = tau_m / k_t`` (eqs 10, 17, 20);
 5. voltage ``V = R I + k_b wm`` (eq 19) and electrical power
    ``W = tau_m^2 / k_m^2 + (k_b / k_t) wm tau_m`` (eqs 21-23), with ``R = (k_t / k_m)^2`` and
@@ -90,6 +90,7 @@ def drive_state(
     qdd: ArrayLike,
     *,
     wrench: ArrayLike | None = None,
+    temperature: ArrayLike | None = None,
 ) -> DriveState:
     """Run the drive model over a motion (UR5e eqs 1-2, 10-23).
 
@@ -100,6 +101,9 @@ def drive_state(
         Joint angles (rad), speeds (rad/s), accelerations (rad/s^2).
     wrench : array_like, shape (6,) or (N, 6), optional
         Wrench the flange exerts on its environment (see :func:`kinergy.rnea`).
+    temperature : array_like, shape like ``q``, optional
+        Joint temperatures, deg C (a log's ``joint_temperatures``), for temperature-dependent
+        friction; without them such models take their reference temperature.
 
     Returns
     -------
@@ -115,7 +119,8 @@ def drive_state(
     wm = qd_ @ n_mat.T
     dwm = qdd_ @ n_mat.T
     tau_load = np.asarray(np.linalg.solve(n_mat.T, tau_sim.T).T, dtype=float)
-    tau_friction = friction_torques(robot, wm, tau_load, dwm)
+    temp = None if temperature is None else np.broadcast_to(temperature, wm.shape).astype(float)
+    tau_friction = friction_torques(robot, wm, tau_load, dwm, temp)
     tau_m = tau_load + tau_friction
     current = tau_m / torque_constants(robot)
     voltage = winding_resistances(robot) * current + back_emf_constants(robot) * wm

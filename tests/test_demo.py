@@ -26,7 +26,7 @@ class _Images(HTMLParser):
 @pytest.fixture(scope="module")
 def demo_run(tmp_path_factory: pytest.TempPathFactory):
     out = tmp_path_factory.mktemp("demo")
-    return out, run_demo(out)
+    return out, run_demo(out, mismatch="none")  # the twin is the UR5e doc's model
 
 
 def test_demo_writes_a_report_whose_images_all_exist(demo_run) -> None:
@@ -95,6 +95,13 @@ def test_cli_demo_and_report(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     ):
         assert caption in text
     assert re.search(r"report: .*report\.html \(\d+\.\d s\)", text)
+    # the default twin is not the model: truth against identified, an honest held-out R^2
+    assert "The twin is not the model: truth against identified" in text
+    assert "The held-out current R² is below 1 because" in text
+    truth_rows = text.split("truth against identified")[1].splitlines()[2:8]
+    held_out_r2 = [float(row.split()[-1]) for row in truth_rows]
+    assert all(0.9 < r2 < 1.0 for r2 in held_out_r2)
+    assert "The twin is not the model" in (out / "report.html").read_text()
     model = tmp_path / "id.toml"
     logs = out / "logs"
     assert main(["identify", str(logs / "test-a.csv"), "--robot", "ur5e", "--out", str(model)]) == 0

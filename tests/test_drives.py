@@ -12,6 +12,7 @@ import dataclasses
 import numpy as np
 import pytest
 from conftest import random_state
+from test_friction_models import NEW_MODELS
 
 import kinergy
 from kinergy.accounting.energy import energy
@@ -63,6 +64,7 @@ PARAMS = {
         "viscous": 2e-4,
         "smoothing": 1e-3,
     },
+    **NEW_MODELS,
 }
 
 

@@ -31,13 +31,13 @@ from click.testing import CliRunner
 import kinergy
 from kinergy.cli import main as cli_main
 from kinergy.cli.excite import excite
-from kinergy.experiments.excitation import (
+from kinergy.experiments.excitation_design import (
     Excitation,
-    ExcitationProblem,
     design_excitation,
-    excitation_problem,
     random_feasible,
 )
+from kinergy.experiments.excitation_limits import excitation_limits
+from kinergy.experiments.excitation_problem import ExcitationProblem, excitation_problem
 from kinergy.identify.full import identify_full
 from kinergy.identify.physical import parameter_scale
 from kinergy.identify.preprocess import prepare
@@ -132,7 +132,7 @@ def test_any_unknowns_meet_the_boundary_conditions(problem: ExcitationProblem, s
     np.testing.assert_allclose(qd, 0.0, atol=1e-12)
     np.testing.assert_allclose(qdd, 0.0, atol=1e-12)
     # the problem's own states are nursing eq 22 with these coefficients
-    q, qd, qdd = fourier_series(problem.t, q0, a, b, problem.base_frequency)
+    q, qd, qdd = fourier_series(problem.grid.t, q0, a, b, problem.base_frequency)
     for mine, eq22 in zip(problem.states(z), (q, qd, qdd), strict=True):
         np.testing.assert_allclose(mine, eq22, atol=1e-12)
 
@@ -239,12 +239,20 @@ def test_d_optimality_and_bad_options(ur5e: kinergy.Robot) -> None:
         ({"harmonics": 0}, "harmonics must be >= 2"),
         ({"period": 0.0}, "period must be > 0"),
         ({"criterion": "e-opt"}, "unknown criterion"),
-        ({"floor": 2.0}, "not above the floor"),
-        ({"start": [0.0] * 5}, "start pose"),
         ({"samples": 5}, "samples must be"),
+        ({"limits": excitation_limits(kinergy.load_robot("panda"))}, "limits for 7 joints"),
     ):
         with pytest.raises(kinergy.KinergyError, match=message):
             excitation_problem(ur5e, **kwargs)
+    for kwargs, message in (
+        ({"floor": 2.0}, "not above the floor"),
+        ({"start": [0.0] * 5}, "start pose"),
+        ({"speed": 0.0}, "speed limit of joint 1"),
+        ({"position_range": -1.0}, "position range must be > 0"),
+        ({"floor_frames": "tool"}, "unknown floor_frames"),
+    ):
+        with pytest.raises(kinergy.KinergyError, match=message):
+            excitation_limits(ur5e, **kwargs)
 
 
 # ----------------------------------------------------------------------------- identification
@@ -394,14 +402,24 @@ def test_cli_text_output_reports_condition_and_margins(tmp_path: Path) -> None:
         ["ur5e", "--period", "-3"],
         ["ur5e", "--floor", "1.5"],
         ["ur5e", "--start-deg", "0,0,0"],
+        ["ur5e", "--start-deg", "0,-90,zero,-90,0,0"],
+        ["ur5e", "--periods", "0"],
+        ["ur5e", "--compare", "-1"],
+        ["ur5e", "--range-deg", "0"],
+        ["ur5e", "--speed", "nan"],
         ["panda", "--urscript", "never-written.script"],
     ],
 )
-def test_cli_errors_are_one_line_and_leave_no_file(tmp_path: Path, args: list[str]) -> None:
+def test_cli_errors_are_one_line_and_leave_no_file(
+    tmp_path: Path, args: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Through the entry point (:func:`kinergy.cli.main`), which turns a KinergyError into one
+    line and exit status 1."""
     out = tmp_path / "m.csv"
-    result = CliRunner().invoke(excite, [*_FAST, *args, "--out", str(out)])
-    assert result.exit_code == 1
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("kinergy: error: "), result.stderr
-    assert result.stdout == ""
+    status = cli_main(["excite", *_FAST, *args, "--out", str(out)])
+    captured = capsys.readouterr()
+    assert status == 1
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("kinergy: error: "), captured.err
+    assert captured.out == ""
     assert not out.exists() and not Path("never-written.script").exists()

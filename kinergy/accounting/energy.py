@@ -17,9 +17,14 @@ Coriolis/centrifugal terms and the rotor inertia), and ``W_elec`` is the copper 
 where each motion part includes its share of the non-copper motor losses (the ``k_b / k_t`` factor).
 Integrals run over each stretch of unbroken sampling (:mod:`kinergy.io.segments`), never
 across a gap in the time stamps. They are signed by default, as in the seed: braking energy
-returns to the DC bus and is counted negative. ``recovery=False`` clips negative power: per joint for the joint figures, and on
-the summed bus power for the total (joints braking can still feed joints driving; the supply takes
-nothing back).
+returns to the DC bus and is counted negative. ``recovery=False`` clips negative power: per
+joint for the joint figures, and on the summed bus power for the total (joints braking can still
+feed joints driving; the supply takes nothing back).
+
+What the arm draws from its supply -- the answer to "how much did it cost" -- is the report's
+``supply`` (:mod:`kinergy.accounting.supply`): the joints' powers shared on the DC bus, the
+surplus burnt in the shunt, plus standby. Where a log measured its supply, ``measured`` holds that
+figure beside it.
 """
 
 from __future__ import annotations
@@ -31,8 +36,10 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import trapezoid
 
+from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy, supply_energy
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.io.segments import segment_bounds
+from kinergy.jsonable import to_jsonable
 from kinergy.model.robot import Robot
 from kinergy.predict import DriveState, drive_state
 from kinergy.trajectory.motion import Motion
@@ -69,6 +76,10 @@ class EnergyReport:
         Whether braking energy was counted as returned to the bus.
     drive : DriveState
         The drive model's torques, currents, voltages over the motion.
+    supply : SupplyEnergy
+        What the arm draws from its supply (bus model; module docstring).
+    measured : MeasuredSupply or None
+        The supply energy the log measured, where it did.
     """
 
     robot: str
@@ -85,6 +96,8 @@ class EnergyReport:
     total_e_elec: float
     recovery: bool
     drive: DriveState = field(repr=False)
+    supply: SupplyEnergy
+    measured: MeasuredSupply | None = None
 
     @property
     def duration(self) -> float:
@@ -137,10 +150,27 @@ class EnergyReport:
                 "peak_power": float(np.max(bus)),
                 "breakdown": {k: float(v.sum()) for k, v in self.breakdown.items()},
             },
+            "supply": to_jsonable(self.supply),
+            **({"measured": self.measured_dict()} if self.measured is not None else {}),
         }
 
+    def measured_dict(self) -> dict[str, Any]:
+        """The ``measured`` object of the JSON: the log's supply energy and the predicted one's
+        error against it (%)."""
+        assert self.measured is not None
+        out = to_jsonable(self.measured)
+        if self.measured.drawn:
+            out["error"] = 100.0 * (self.supply.drawn / self.measured.drawn - 1.0)
+        return dict(out)
 
-def energy(robot: Robot, motion: Motion, *, recovery: bool = True) -> EnergyReport:
+
+def energy(
+    robot: Robot,
+    motion: Motion,
+    *,
+    recovery: bool = True,
+    temperature: Array | None = None,
+) -> EnergyReport:
     """Per-joint and total mechanical and electrical energy of ``motion`` (UR5e eqs 23-26).
 
     Parameters
@@ -152,12 +182,15 @@ def energy(robot: Robot, motion: Motion, *, recovery: bool = True) -> EnergyRepo
     recovery : bool
         True (default, as the seed): signed integrals, braking energy returns to the bus.
         False: negative power is clipped (see the module docstring).
+    temperature : ndarray, shape (N, n), optional
+        Joint temperatures over the motion, deg C (a log's ``joint_temperatures``), for
+        temperature-dependent friction.
 
     Returns
     -------
     EnergyReport
     """
-    state = drive_state(robot, motion.q, motion.qd, motion.qdd)
+    state = drive_state(robot, motion.q, motion.qd, motion.qdd, temperature=temperature)
     t = motion.t
     p_mech = state.p_mech
     p_elec = state.power
@@ -206,4 +239,5 @@ def energy(robot: Robot, motion: Motion, *, recovery: bool = True) -> EnergyRepo
         total_e_elec=total_elec,
         recovery=recovery,
         drive=state,
+        supply=supply_energy(t, state.power, robot.standby_power),
     )

@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from kinergy.cli.common import print_tables, progress
+from kinergy.simulate import MISMATCHES
 from kinergy.workflows.demo import run_demo
 
 __all__ = ["demo"]
@@ -21,9 +22,18 @@ __all__ = ["demo"]
     show_default=True,
     help="Folder for the logs, figures and report.html.",
 )
-def demo(out: str) -> None:
+@click.option(
+    "--mismatch",
+    type=click.Choice(MISMATCHES),
+    default="realistic",
+    show_default=True,
+    help="realistic: the twin's true robot differs from the model identified; none: the twin is "
+    "the UR5e doc's model itself.",
+)
+def demo(out: str, mismatch: str) -> None:
     """The UR5e study on the built-in twin: simulate tests A and B, identify on A, validate on A
-    and B, compute the energy, print UR5e Tables IV-VIII and write an HTML report."""
-    tables, report, seconds = run_demo(Path(out), progress())
-    print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown", "timing"])
+    and B, compute the energy, print UR5e Tables IV-VIII (and the twin's truth against the
+    identified values) and write an HTML report."""
+    tables, report, seconds = run_demo(Path(out), progress(), mismatch=mismatch)
+    print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown", "timing", "truth"])
     click.echo(f"\nreport: {report} ({seconds:.1f} s)")

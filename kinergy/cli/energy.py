@@ -1,4 +1,5 @@
-"""``kinergy energy``: per-joint mechanical and electrical energy of a logged or planned motion."""
+"""``kinergy energy``: what a logged or planned motion draws from the arm's supply, per joint
+mechanical and electrical energy, and the log's measured supply energy beside the prediction."""
 
 from __future__ import annotations
 
@@ -6,10 +7,10 @@ from typing import Any
 
 import click
 
-from kinergy.accounting.energy import energy as account
+from kinergy.accounting.supply import MEASURED_INCLUDES, PREDICTED_INCLUDES
 from kinergy.cli.common import columns_option, load, payload_option, table
 from kinergy.jsonable import dumps
-from kinergy.workflows.logs import read_motion
+from kinergy.workflows.energy import energy_of_log
 
 __all__ = ["energy", "energy_text"]
 
@@ -29,8 +30,31 @@ def _row(name: str, e: dict[str, Any], efficiency: float | None, mean_power: flo
     ]
 
 
+def _supply_lines(report: dict[str, Any]) -> list[str]:
+    """What the arm draws from its supply, predicted and (where logged) measured."""
+    sup = report["supply"]
+    lines = [
+        f"Drawn from the arm's supply: {sup['drawn']:.1f} J predicted (motors {sup['motors']:.1f} J "
+        f"+ standby {sup['standby']:.1f} J; {sup['shunt']:.1f} J of braking burnt in the shunt), "
+        f"mean {sup['mean_power']:.1f} W, peak {sup['peak_power']:.1f} W.",
+    ]
+    measured = report.get("measured")
+    if measured is not None:
+        error = measured.get("error")
+        lines.append(
+            f"Measured by the log: {measured['drawn']:.1f} J (mean {measured['mean_power']:.1f} W)"
+            + ("" if error is None else f"; predicted {error:+.1f} %")
+            + "."
+        )
+    lines += [f"  predicted: {PREDICTED_INCLUDES}."]
+    if measured is not None:
+        lines.append(f"  measured: {MEASURED_INCLUDES}.")
+    return lines
+
+
 def energy_text(report: dict[str, Any]) -> str:
-    """The ``energy`` table: one row per joint and the total, with what the figures include."""
+    """The ``energy`` answer: what the arm draws from its supply (predicted, and measured where
+    logged), then one row per joint and the total, with what each figure includes."""
     rows = [_row(j["name"], j, j["efficiency"], j["mean_power"]) for j in report["joints"]]
     tot = report["total"]
     rows.append(_row("total", tot, tot["efficiency"], tot["e_elec"] / report["duration"]))
@@ -43,16 +67,13 @@ def energy_text(report: dict[str, Any]) -> str:
     headers += [f"{k} [J]" for k in _PARTS]
     lines = [
         head,
+        *_supply_lines(report),
         "",
         table(headers, rows),
         "",
         "E_mech = int tau_m wm dt, E_elec = int W_elec dt (UR5e eqs 23, 25, 26); eta = E_mech / E_elec.",
         "E_elec = inertial + gravity + friction + copper (each motion part includes its k_b/k_t share).",
     ]
-    if tot["standby"]:
-        lines.append(
-            f"standby: {tot['standby']:.1f} J; total drawn {tot['e_elec_with_standby']:.1f} J"
-        )
     return "\n".join(lines)
 
 
@@ -81,12 +102,14 @@ def energy(
     source: str,
     payload: str | None,
 ) -> None:
-    """Per-joint mechanical and electrical energy of a logged or planned motion.
+    """What a logged or planned motion draws from the arm's supply, and per-joint mechanical and
+    electrical energy; a log's measured supply energy beside the prediction.
 
     MODEL is a built-in name or a model file; LOG_OR_MOTION a log (record.py layout, or headerless
     with --columns) or a motion file.
     """
     r = load(model, payload)
-    motion = read_motion(motion_path, n_joints=r.n, columns=columns, source=source)
-    report = account(r, motion, recovery=not no_recovery).to_dict()
+    report = energy_of_log(
+        r, motion_path, columns=columns, source=source, recovery=not no_recovery
+    ).to_dict()
     click.echo(dumps(report) if as_json else energy_text(report))

@@ -1,80 +1,133 @@
 """``kinergy excite``: an optimised Fourier excitation for identification, written as a motion file
 and optionally as a URScript servoj program.
 
-Designs the trajectory with :func:`kinergy.experiments.excitation.design_excitation` (nursing eqs
-22-23: Fourier series, zero speed and acceleration at both ends, joint, speed, acceleration and
-floor limits, minimum condition number or D-optimality of the stacked regressor), reports its
-condition number and constraint margins, and writes ``--periods`` repeats of it at 500 Hz in
-UR's record.py layout (``timestamp target_q_* target_qd_* target_qdd_*``), the motion file
-``kinergy simulate ROBOT --trajectory FILE`` runs on the twin. ``--compare N`` also draws N random
-feasible Fourier trajectories of the same size and prints their median condition number.
+Parses the flags into :class:`~kinergy.workflows.excite.ExciteOptions` (each checked here: one
+line per bad flag), runs :func:`kinergy.workflows.excite.run_excite` (nursing eqs 22-23: Fourier
+series, zero speed and acceleration at both ends, joint, speed, acceleration and floor limits,
+minimum condition number or D-optimality of the stacked regressor; ``--compare N`` also draws N
+random feasible Fourier trajectories of the same size) and prints its condition number and
+constraint margins, as text or JSON.
 """
 
 from __future__ import annotations
 
-import functools
-import json
 import math
-import time
-from collections.abc import Callable
-from pathlib import Path
+from collections.abc import Mapping
 from typing import Any
 
 import click
 import numpy as np
 
+from kinergy.cli.common import progress
 from kinergy.errors import KinergyError
+from kinergy.experiments.excitation_regression import CRITERIA
+from kinergy.jsonable import dumps
+from kinergy.model import Robot, load_robot
+from kinergy.workflows.excite import ExciteOptions, ExciteRun, run_excite
 
-__all__ = ["excite"]
+__all__ = ["excite", "excite_options", "excite_text"]
 
-#: report progress every this many SLSQP iterations
-_PROGRESS_EVERY = 10
-
-
-class _OneLineError(click.ClickException):
-    """A user error shown as one ``kinergy: error: ...`` line (exit status 1), the same whether
-    the command runs under ``kinergy.cli.main`` or on its own."""
-
-    def show(self, file: Any = None) -> None:
-        click.echo(f"kinergy: error: {self.format_message()}", err=True)
+#: flags that count something, and the least each may be
+_AT_LEAST = {"periods": 1, "starts": 1, "maxiter": 1, "compare": 0}
+#: flags that must be > 0 when given
+_POSITIVE = ("period", "range_deg", "speed", "acceleration")
 
 
-def _one_line_errors(func: Callable[..., None]) -> Callable[..., None]:
-    """Turn a :class:`KinergyError` into :class:`_OneLineError`."""
-
-    @functools.wraps(func)
-    def wrapper(*args: Any, **kwargs: Any) -> None:
-        try:
-            func(*args, **kwargs)
-        except KinergyError as exc:
-            raise _OneLineError(str(exc)) from None
-
-    return wrapper
+def _flag(name: str) -> str:
+    """``range_deg`` -> ``--range-deg``."""
+    return "--" + name.replace("_", "-")
 
 
-def _degrees(option: str, text: str | None, n: int) -> np.ndarray | None:
-    """``"0,-90,0,-90,0,0"`` (deg) -> rad, shape (n,)."""
+def _degrees(option: str, text: str | None, n: int) -> tuple[float, ...] | None:
+    """``"0,-90,0,-90,0,0"`` (deg) -> rad, n entries."""
     if text is None:
         return None
+    message = f"{option}: expected {n} comma-separated angles in deg, got {text!r}"
     try:
         values = np.radians([float(x) for x in text.split(",")])
     except ValueError:
-        raise KinergyError(
-            f"{option}: expected {n} comma-separated angles in deg, got {text!r}"
-        ) from None
+        raise KinergyError(message) from None
     if values.shape != (n,) or not np.all(np.isfinite(values)):
-        raise KinergyError(f"{option}: expected {n} comma-separated angles in deg, got {text!r}")
-    return values
+        raise KinergyError(message)
+    return tuple(float(v) for v in values)
 
 
-def _positive(option: str, value: float | None) -> None:
-    if value is not None and not (math.isfinite(value) and value > 0.0):
-        raise KinergyError(f"{option}: must be > 0, got {value:g}")
+def _check_flags(robot: Robot, flags: Mapping[str, Any]) -> None:
+    """Counts, positive numbers, a finite floor, URScript only for a 6-joint arm."""
+    for name, least in _AT_LEAST.items():
+        if flags[name] < least:
+            raise KinergyError(f"{_flag(name)}: must be >= {least}, got {flags[name]}")
+    for name in _POSITIVE:
+        value = flags[name]
+        if value is not None and not (math.isfinite(value) and value > 0.0):
+            raise KinergyError(f"{_flag(name)}: must be > 0, got {value:g}")
+    if not math.isfinite(flags["floor"]):
+        raise KinergyError(f"--floor: must be a height in m, got {flags['floor']}")
+    if flags["urscript"] is not None and robot.n != 6:
+        raise KinergyError(f"--urscript: URScript runs 6-joint UR arms; {robot.name} has {robot.n}")
 
 
-def _fmt_margins(margins: dict[str, float]) -> str:
+def excite_options(robot: Robot, flags: Mapping[str, Any]) -> ExciteOptions:
+    """The command line's flags (by parameter name) as the workflow's options, SI units.
+
+    Raises
+    ------
+    KinergyError
+        One line naming the first bad flag.
+    """
+    _check_flags(robot, flags)
+    return ExciteOptions(
+        out=flags["out"],
+        urscript=flags["urscript"],
+        harmonics=flags["harmonics"],
+        period=flags["period"],
+        periods=flags["periods"],
+        criterion=flags["criterion"],
+        seed=flags["seed"],
+        starts=flags["starts"],
+        maxiter=flags["maxiter"],
+        samples=flags["samples"],
+        floor=None if flags["no_floor"] else flags["floor"],
+        floor_frames="flange" if flags["flange_only"] else "links",
+        start=_degrees("--start-deg", flags["start_deg"], robot.n),
+        position_range=math.radians(flags["range_deg"]),
+        speed=flags["speed"],
+        acceleration=flags["acceleration"],
+        include_drives=not flags["no_drives"],
+        compare=flags["compare"],
+    )
+
+
+def _fmt_margins(margins: Mapping[str, float]) -> str:
     units = {"position": "rad", "speed": "rad/s", "acceleration": "rad/s^2", "floor": "m"}
     return ", ".join(f"{k} {margins[k]:.4g} {u}" for k, u in units.items() if k in margins)
+
+
+def excite_text(run: ExciteRun) -> str:
+    """The ``excite`` report: size, condition number (against the random median), margins,
+    optimiser effort, the files written."""
+    best, motion, options = run.best, run.motion, run.options
+    condition = (
+        f"condition number {best.condition:.4g} ({run.problem.columns} columns, "
+        f"criterion {options.criterion}"
+    )
+    if run.median is not None:
+        condition += (
+            f"; median of {len(run.randoms)} random feasible trajectories {run.median:.4g}, "
+            f"{run.median / best.condition:.1f}x higher"
+        )
+    return "\n".join(
+        [
+            f"{run.robot.name}: {best.harmonics} harmonics, period {best.period:g} s, "
+            f"{options.periods} period(s) ({motion.duration:.3f} s, {len(motion)} samples at "
+            f"{1.0 / run.problem.dt:g} Hz)",
+            condition + ")",
+            f"margins to the limits: {_fmt_margins(best.margins)}",
+            f"optimised in {best.seconds:.1f} s ({options.starts} start(s), best after "
+            f"{best.iterations} iterations)",
+            "wrote " + " and ".join(str(p) for p in (options.out, options.urscript) if p),
+        ]
+    )
 
 
 @click.command()
@@ -107,7 +160,7 @@ def _fmt_margins(margins: dict[str, float]) -> str:
 )
 @click.option(
     "--criterion",
-    type=click.Choice(["cond", "dopt"]),
+    type=click.Choice(CRITERIA),
     default="cond",
     show_default=True,
     help="Minimise the condition number or -log det (D-optimality) of the scaled regressor.",
@@ -175,31 +228,7 @@ def _fmt_margins(margins: dict[str, float]) -> str:
     help="Also draw N random feasible trajectories of the same size and report their median.",
 )
 @click.option("--quiet", is_flag=True, help="No progress on stderr.")
-@_one_line_errors
-def excite(
-    robot_name: str,
-    harmonics: int,
-    period: float,
-    periods: int,
-    out: str,
-    as_json: bool,
-    urscript: str | None,
-    criterion: str,
-    seed: int,
-    starts: int,
-    maxiter: int,
-    samples: int,
-    floor: float,
-    no_floor: bool,
-    flange_only: bool,
-    start_deg: str | None,
-    range_deg: float,
-    speed: float | None,
-    acceleration: float | None,
-    no_drives: bool,
-    compare: int,
-    quiet: bool,
-) -> None:
+def excite(robot_name: str, as_json: bool, quiet: bool, **flags: Any) -> None:
     """Design an excitation trajectory for identification (nursing eqs 22-23) and write it.
 
     ROBOT is a built-in name or a model file. The trajectory is a Fourier series of N harmonics
@@ -207,133 +236,7 @@ def excite(
     condition number of the stacked base regressor within the joint, speed, acceleration and
     floor limits. Progress goes to stderr.
     """
-    from kinergy.experiments.excitation import (
-        design_excitation,
-        excitation_problem,
-        random_feasible,
-    )
-    from kinergy.io.rtde import write_log
-    from kinergy.io.urscript import servoj_program, write_script
-    from kinergy.model import load_robot
-
-    if periods < 1:
-        raise KinergyError(f"--periods: must be >= 1, got {periods}")
-    if starts < 1:
-        raise KinergyError(f"--starts: must be >= 1, got {starts}")
-    if maxiter < 1:
-        raise KinergyError(f"--maxiter: must be >= 1, got {maxiter}")
-    if compare < 0:
-        raise KinergyError(f"--compare: must be >= 0, got {compare}")
-    _positive("--period", period)
-    _positive("--range-deg", range_deg)
-    _positive("--speed", speed)
-    _positive("--acceleration", acceleration)
-    if not math.isfinite(floor):
-        raise KinergyError(f"--floor: must be a height in m, got {floor}")
     robot = load_robot(robot_name)
-    if urscript is not None and robot.n != 6:
-        raise KinergyError(f"--urscript: URScript runs 6-joint UR arms; {robot.name} has {robot.n}")
-    problem = excitation_problem(
-        robot,
-        harmonics=harmonics,
-        period=period,
-        start=_degrees("--start-deg", start_deg, robot.n),
-        position_range=math.radians(range_deg),
-        speed=speed,
-        acceleration=acceleration,
-        floor=None if no_floor else floor,
-        floor_frames="flange" if flange_only else "links",
-        criterion=criterion,
-        include_drives=not no_drives,
-        samples=samples,
-    )
-    clock = time.perf_counter()
-
-    def progress(start: int, iteration: int, condition: float) -> None:
-        if quiet or iteration % _PROGRESS_EVERY:
-            return
-        click.echo(
-            f"[{time.perf_counter() - clock:6.1f} s] start {start}/{starts}, "
-            f"iteration {iteration}: condition number {condition:.4g}",
-            err=True,
-        )
-
-    best = design_excitation(problem, starts=starts, seed=seed, maxiter=maxiter, progress=progress)
-    randoms = []
-    if compare:
-        if not quiet:
-            click.echo(f"drawing {compare} random feasible trajectories", err=True)
-        randoms = [
-            e.condition for e in random_feasible(problem, np.random.default_rng(seed + 1), compare)
-        ]
-    median = float(np.median(randoms)) if randoms else None
-
-    motion = best.repeated(periods)
-    script = None
-    if urscript is not None:
-        script = servoj_program(
-            motion.t,
-            motion.q,
-            name="kinergy_excitation",
-            comments=[
-                f"{robot.name}: excitation of {best.harmonics} harmonics, period "
-                f"{best.period:g} s, {periods} period(s); condition number {best.condition:.4g}"
-            ],
-        )
-    written: list[Path] = []
-    try:
-        write_log(
-            out,
-            motion.t,
-            {"target_q": motion.q, "target_qd": motion.qd, "target_qdd": motion.qdd},
-        )
-        written.append(Path(out))
-        if script is not None and urscript is not None:
-            written.append(write_script(urscript, script))
-    except BaseException:
-        for path in written:
-            path.unlink(missing_ok=True)
-        raise
-
-    if as_json:
-        report: dict[str, Any] = {
-            "robot": robot.name,
-            **best.to_dict(),
-            "periods": periods,
-            "samples": len(motion),
-            "duration": motion.duration,
-            "columns": problem.columns,
-            "limits": {
-                "lower": problem.lower.tolist(),
-                "upper": problem.upper.tolist(),
-                "speed": problem.speed.tolist(),
-                "acceleration": problem.acceleration.tolist(),
-                "floor": problem.floor,
-            },
-            "random": None
-            if median is None
-            else {"count": len(randoms), "median": median, "conditions": randoms},
-            "ratio": None if median is None else median / best.condition,
-            "out": out,
-            "urscript": urscript,
-        }
-        click.echo(json.dumps(report, indent=2))
-        return
-    click.echo(
-        f"{robot.name}: {best.harmonics} harmonics, period {best.period:g} s, {periods} period(s) "
-        f"({motion.duration:.3f} s, {len(motion)} samples at {1.0 / problem.dt:g} Hz)"
-    )
-    line = (
-        f"condition number {best.condition:.4g} ({problem.columns} columns, criterion {criterion}"
-    )
-    if median is not None:
-        line += (
-            f"; median of {len(randoms)} random feasible trajectories {median:.4g}, "
-            f"{median / best.condition:.1f}x higher"
-        )
-    click.echo(line + ")")
-    click.echo(f"margins to the limits: {_fmt_margins(best.margins)}")
-    click.echo(
-        f"optimised in {best.seconds:.1f} s ({starts} start(s), best after {best.iterations} iterations)"
-    )
-    click.echo(f"wrote {out}" + (f" and {urscript}" if urscript else ""))
+    options = excite_options(robot, flags)
+    run = run_excite(robot, options, progress=None if quiet else progress())
+    click.echo(dumps(run.to_dict()) if as_json else excite_text(run))

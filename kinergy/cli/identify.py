@@ -25,6 +25,31 @@ def _payload_text(report: PayloadEstimate, out: str) -> str:
     return "\n".join(lines)
 
 
+def _choice_text(result: IdentificationResult) -> list[str]:
+    """``--friction auto``: the model each joint chose and how much its cross-validated current
+    RMS beats Coulomb + viscous and the runner-up (empty for a fixed model)."""
+    choices = getattr(result.fit, "friction_choice", None)
+    if not choices:
+        return []
+    rows = []
+    for name, c in zip(result.robot.joint_names, choices, strict=True):
+        if c is None:
+            continue
+        gain, margin = c.gain_over_viscous_coulomb, c.margin
+        rows.append(
+            [
+                name,
+                c.model,
+                f"{c.cv_rms[c.model]:.4f}",
+                "-" if gain is None else f"{gain:.1f}",
+                "-" if margin is None else f"{margin:.1f}",
+            ]
+        )
+    headers = ["joint", "chosen", "CV RMS [A]", "vs Coulomb+viscous [%]", "vs runner-up [%]"]
+    title = "\nFriction chosen per joint (--friction auto: 5-block cross-validated current RMS)"
+    return [title, table(headers, rows)]
+
+
 def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     rows = []
     for j in result.joints:
@@ -44,6 +69,7 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
         f"{result.robot.name}: {result.method} identification from {logs} log(s), {samples} samples",
         table(headers, rows),
     ]
+    lines += _choice_text(result)
     text = validation_text(result.fit, result.robot.joint_names)
     if text:
         lines.append("\nFit on the identification logs\n" + text)
@@ -82,7 +108,9 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     "friction",
     default=None,
     metavar="MODEL",
-    help="Friction model for every joint (default: the model's own).",
+    help="Friction model for every joint (default: the model's own), e.g. power_law, "
+    "load_coulomb, thermal_viscous; auto: per joint, the model with the lowest "
+    "cross-validated current RMS (sequential method).",
 )
 @click.option(
     "--target",

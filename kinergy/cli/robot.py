@@ -1,15 +1,19 @@
-"""``kinergy robot list`` and ``kinergy robot show``: the built-in library and robot files."""
+"""``kinergy robot list``, ``show`` and ``import-calibration``: the built-in library and robot
+files."""
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 
 import click
 import numpy as np
 
 from kinergy.cli.common import fmt, fmt_vector, load, table
+from kinergy.files import check_outputs
 from kinergy.jsonable import dumps
 from kinergy.model import SOURCE_CATEGORIES, Robot, library_names, load_robot, robot_to_dict
+from kinergy.workflows.calibration import CalibrationImport, import_calibration
 
 __all__ = ["robot"]
 
@@ -40,7 +44,8 @@ def robot_list(as_json: bool) -> None:
     """List the built-in robots and where each model's parameters come from.
 
     published: the maker's data; seed: a reference paper's tables; identified: fitted by kinergy
-    from logs; nominal: an estimate, identify before trusting.
+    from logs; calibration: fitted to the maker's joint calibration; nominal: an estimate,
+    identify before trusting.
     """
     robots = [load_robot(name) for name in library_names()]
     if as_json:
@@ -190,3 +195,92 @@ def robot_show(robot_name: str, as_json: bool, payload: str | None) -> None:
     """Show a robot model: a built-in name (ur5e) or a robot file (.toml, .urdf)."""
     r = load(robot_name, payload)
     click.echo(dumps(robot_to_dict(r)) if as_json else show_text(r))
+
+
+def _calibration_text(result: CalibrationImport, out: str, points: bool) -> str:
+    rows = []
+    for j in result.joints:
+        measured = np.array([p.friction for p in j.points])
+        tol = np.maximum(0.05 * np.abs(measured), 0.005)
+        model = np.array([p.friction_model for p in j.points])
+        contrast = np.array([p.friction_contrast for p in j.points])
+        u = np.array([p.voltage for p in j.points])
+        u_model = np.array([p.voltage_model for p in j.points])
+        params = " ".join(f"{k}={v:.4g}" for k, v in j.friction.params.items() if k != "smoothing")
+        rows.append(
+            [
+                j.name,
+                f"{j.torque_constant:.4f}",
+                f"{j.friction.model} {params}",
+                f"{100 * np.max(np.abs(model / measured - 1)):.1f}",
+                "yes" if np.all(np.abs(model - measured) <= tol) else "NO",
+                f"{100 * np.max(np.abs(contrast / measured - 1)):.1f}",
+                f"{j.electrics.resistance:.3f}",
+                f"{j.electrics.back_emf:.4f}",
+                f"{j.kt_over_kb:.3f}",
+                f"{100 * np.max(np.abs(u_model / u - 1)):.1f}",
+            ]
+        )
+    headers = ["joint", "k_t [N m/A]", "friction (motor side)", "max err [%]", "within 5 %"]
+    headers += ["Coulomb+viscous max err [%]", "R [ohm]", "k_b [V s/rad]", "k_t/k_b"]
+    headers += ["U max err [%]"]
+    lines = [
+        f"{result.robot.name}: drives from the joint calibration {result.file}",
+        table(headers, rows),
+        "",
+        "Friction: the chosen model (cross-validated, leave one point out) against the "
+        "calibration's Tau at every speed; 'within 5 %': every point within 5 % or 0.005 N m.",
+        "R, k_b: the equivalent DC motor (UR5e eq 19; the file's U is the controller's dq "
+        "voltage, V = 1.5 U); U max err: the model's U against the file's.",
+    ]
+    if points:
+        for j in result.joints:
+            lines += ["", f"{j.name}: speed points (speed joint side, torques motor side)"]
+            lines.append(
+                table(
+                    ["speed [rad/s]", "Tau [N m]", "model", "Coulomb+viscous", "U [V]", "model U"],
+                    [
+                        [
+                            f"{p.speed:+.2f}",
+                            f"{p.friction:+.4f}",
+                            f"{p.friction_model:+.4f}",
+                            f"{p.friction_contrast:+.4f}",
+                            f"{p.voltage:.3f}",
+                            f"{p.voltage_model:.3f}",
+                        ]
+                        for p in j.points
+                    ],
+                )
+            )
+    lines.append(f"\nwrote {out}")
+    return "\n".join(lines)
+
+
+@robot.command("import-calibration")
+@click.argument("robot_name", metavar="ROBOT")
+@click.argument("calibration", metavar="CALIBRATION.txt", type=click.Path(dir_okay=False))
+@click.option(
+    "--out", "out", required=True, type=click.Path(dir_okay=False), help="Robot file to write."
+)
+@click.option(
+    "--friction",
+    default="auto",
+    show_default=True,
+    metavar="auto|MODEL",
+    help="Friction model to fit; auto: the one that cross-validates best on the points.",
+)
+@click.option("--points", is_flag=True, help="Print every speed point with the models' values.")
+@click.option("--json", "as_json", is_flag=True, help="Print the import as JSON.")
+def robot_import_calibration(
+    robot_name: str, calibration: str, out: str, friction: str, points: bool, as_json: bool
+) -> None:
+    """Drives from a UR joint calibration summary: torque constants, friction and the motor
+    electrics, written into ROBOT as a robot file (provenance 'calibration').
+
+    The summary's speeds are joint side, its friction torques motor side; its U is the
+    controller's dq voltage (docs/FRICTION.md).
+    """
+    inputs = [calibration] + ([robot_name] if os.path.exists(robot_name) else [])
+    check_outputs([("--out", out)], inputs)
+    result = import_calibration(load_robot(robot_name), calibration, friction=friction, out=out)
+    click.echo(dumps(result) if as_json else _calibration_text(result, out, points))

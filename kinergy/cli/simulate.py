@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import os
+
 import click
 
 from kinergy.cli.common import columns_option, load, payload_option
-from kinergy.simulate import TwinSettings
+from kinergy.files import check_outputs
+from kinergy.simulate import MISMATCHES, TwinSettings
 from kinergy.workflows.twin import simulate_to_file
 
 __all__ = ["simulate"]
@@ -20,6 +23,22 @@ __all__ = ["simulate"]
     help="The UR5e doc's test programs, or a motion file (record.py layout with target_q).",
 )
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Log to write.")
+@click.option(
+    "--mismatch",
+    type=click.Choice(MISMATCHES),
+    default="none",
+    show_default=True,
+    help="none: ROBOT itself is the truth; realistic: a true robot that differs from ROBOT "
+    "(inertias, k_t, electrics, concave load- and temperature-dependent friction) with a real "
+    "controller's current steps, voltage noise and supply ripple.",
+)
+@click.option(
+    "--truth",
+    "truth_out",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Write the twin's true robot file here (with --mismatch realistic).",
+)
 @click.option("--exact", is_flag=True, help="No lag and no noise: the model's equations exactly.")
 @click.option("--lag", type=float, default=None, help="Real motion behind the target, s [0.004].")
 @click.option(
@@ -28,37 +47,66 @@ __all__ = ["simulate"]
 @click.option(
     "--current-noise", type=float, default=None, help="Measured current noise std, A [0.04]."
 )
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the noise.")
+@click.option("--ambient", type=float, default=25.0, show_default=True, help="Air, deg C.")
+@click.option(
+    "--initial-temperature",
+    type=float,
+    default=None,
+    help="The joints' temperature at the start, deg C [the ambient: a cold start].",
+)
+@click.option(
+    "--seed", type=int, default=0, show_default=True, help="Seed of the noise (and truth)."
+)
 @payload_option
 @columns_option
 def simulate(
     robot_name: str,
     trajectory: str,
     out: str,
+    mismatch: str,
+    truth_out: str | None,
     exact: bool,
     lag: float | None,
     speed_noise: float | None,
     current_noise: float | None,
+    ambient: float,
+    initial_temperature: float | None,
     seed: int,
     payload: str | None,
     columns: str | None,
 ) -> None:
     """Run the digital twin: write the log a UR controller would record (record.py layout, 500 Hz).
 
-    ROBOT is a built-in name or a model file; it is the twin's "true" model.
+    ROBOT is a built-in name or a model file: the model the twin's truth is (--mismatch none) or
+    differs from (--mismatch realistic).
     """
+    inputs = [p for p in (robot_name, trajectory) if os.path.exists(p)]
+    check_outputs([("--out", out), ("--truth", truth_out)], inputs)
     r = load(robot_name, payload)
-    base = TwinSettings.exact() if exact else TwinSettings()
+    if exact:
+        base = TwinSettings.exact()
+    elif mismatch == "realistic":
+        base = TwinSettings.realistic(seed)
+    else:
+        base = TwinSettings()
     settings = TwinSettings(
         lag=base.lag if lag is None else lag,
         speed_noise=base.speed_noise if speed_noise is None else speed_noise,
         position_noise=base.position_noise,
         current_noise=base.current_noise if current_noise is None else current_noise,
         seed=seed,
+        current_step=base.current_step,
+        voltage_noise=base.voltage_noise,
+        ripple=base.ripple,
+        ambient=ambient,
+        initial_temperature=initial_temperature,
     )
-    t = simulate_to_file(r, trajectory, out, settings, columns=columns).t
+    t = simulate_to_file(
+        r, trajectory, out, settings, columns=columns, mismatch=mismatch, truth_out=truth_out
+    ).t
     click.echo(
         f"wrote {out}: {len(t)} samples, {t[-1] - t[0]:.3f} s, {r.name}, trajectory {trajectory}, "
-        f"lag {settings.lag * 1e3:g} ms, speed noise {settings.speed_noise:g} rad/s, "
-        f"current noise {settings.current_noise:g} A"
+        f"mismatch {mismatch}, lag {settings.lag * 1e3:g} ms, speed noise "
+        f"{settings.speed_noise:g} rad/s, current noise {settings.current_noise:g} A"
+        + (f"; true robot: {truth_out}" if truth_out else "")
     )

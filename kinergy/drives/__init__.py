@@ -1,1 +1,2 @@
-"""Drives: transmissions (coupled joints too) and the motor's electrical model (motor side)."""
+"""Drives: transmissions (coupled joints too), the motors' electrical model, the joints' thermal
+model and the DC bus that supplies them (motor side)."""

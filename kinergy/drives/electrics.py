@@ -14,6 +14,18 @@ For a motion ``q, qd, qdd`` (joint side), UR5e section 3-5:
 5. voltage ``V = R I + k_b wm`` (eq 19) and electrical power
    ``W = tau_m^2 / k_m^2 + (k_b / k_t) wm tau_m`` (eqs 21-23), with ``R = (k_t / k_m)^2`` and
    ``k_b = k_t / (k_t/k_b)``; a drive's ``winding_resistance``, when given, replaces ``R``.
+
+Voltage conventions
+-------------------
+UR5e eqs 19-23 describe each brushless motor as its equivalent DC motor (Park-Clarke), whose
+power is ``V I`` and whose torque is ``k_t I``; kinergy's ``R``, ``k_b`` and voltages are that
+motor's. A UR controller's own voltages -- ``actual_joint_voltage`` in its logs and ``U`` in its
+joint calibration (``robot import-calibration``) -- are amplitude-invariant dq quantities, with
+the same current ``I`` (``actual_current``, the calibration's ``I``: ``Tau = K_tau I``) but power
+``3/2 u I``: ``V = 3/2 u`` (:data:`DQ_VOLTAGE_FACTOR`). The calibration file shows it: its
+``K_tau / Km`` is 1.40 (joints 1-3) and 1.48 (joints 4-6), where a motor that does not create
+energy needs ``k_t / k_b <= 1``; read with the 3/2, ``k_t / k_b`` = 0.92 and 0.97 (the UR5e doc's
+catalogue conversion: 0.89). docs/FRICTION.md has the whole reconciliation.
 """
 
 from __future__ import annotations
@@ -25,8 +37,11 @@ from kinergy.friction.registry import friction_torque
 from kinergy.model.robot import Robot
 
 __all__ = [
+    "DQ_VOLTAGE_FACTOR",
     "back_emf_constants",
+    "controller_voltage",
     "electrical_power",
+    "equivalent_voltage",
     "friction_torques",
     "motor_constants",
     "torque_constants",
@@ -34,6 +49,9 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
+
+#: equivalent DC motor voltage per volt of the controller's dq voltage (module docstring)
+DQ_VOLTAGE_FACTOR = 1.5
 
 
 def torque_constants(robot: Robot) -> Array:
@@ -70,12 +88,36 @@ def electrical_power(robot: Robot, tau_m: ArrayLike, wm: ArrayLike) -> Array:
     return tau_m**2 / motor_constants(robot) ** 2 + np.asarray(wm, dtype=float) * tau_m / kt_over_kb
 
 
-def friction_torques(robot: Robot, wm: Array, tau_load: Array, dwm: Array | None = None) -> Array:
-    """Motor-side friction of every joint, (N, n), N m (``dwm``: motor accelerations, for
-    friction held through standstill)."""
+def controller_voltage(voltage: ArrayLike) -> Array:
+    """The voltage a UR controller logs (``actual_joint_voltage``, dq) for an equivalent DC motor
+    voltage ``V`` (UR5e eq 19): ``V / 1.5``, V, shape like ``voltage``."""
+    return np.asarray(voltage, dtype=float) / DQ_VOLTAGE_FACTOR
+
+
+def equivalent_voltage(logged: ArrayLike) -> Array:
+    """The equivalent DC motor voltage (UR5e eq 19) of a controller's logged dq voltage:
+    ``1.5 u``, V, shape like ``logged``."""
+    return np.asarray(logged, dtype=float) * DQ_VOLTAGE_FACTOR
+
+
+def friction_torques(
+    robot: Robot,
+    wm: Array,
+    tau_load: Array,
+    dwm: Array | None = None,
+    temperature: Array | None = None,
+) -> Array:
+    """Motor-side friction of every joint, (N, n), N m.
+
+    ``dwm``: motor accelerations (rad/s^2), for friction held through standstill;
+    ``temperature``: joint temperatures (deg C, (N, n)), for temperature-dependent friction.
+    """
     out = np.empty_like(wm)
     for i, joint in enumerate(robot.joints):
         fr = joint.drive.friction
         acc = None if dwm is None else dwm[:, i]
-        out[:, i] = friction_torque(fr.model, fr.params, wm[:, i], tau_load[:, i], acc)
+        temp = None if temperature is None else temperature[:, i]
+        out[:, i] = friction_torque(
+            fr.model, fr.params, wm[:, i], tau_load[:, i], acc, temperature=temp
+        )
     return out

@@ -13,7 +13,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Columns", "FrictionModel", "Torque"]
+from kinergy.errors import KinergyError
+
+__all__ = ["Columns", "FrictionModel", "Torque", "needed"]
 
 Array = NDArray[np.float64]
 
@@ -23,6 +25,13 @@ Array = NDArray[np.float64]
 Torque = Callable[[Mapping[str, float], Array, Array | None, Array | None], Array]
 #: ``columns(params, wm, tau_load, temperature) -> (N, k)``: ``torque == columns @ linear values``.
 Columns = Callable[[Mapping[str, float], Array, Array | None, Array | None], Array]
+
+
+def needed(signal: Array | None, model: str, what: str) -> Array:
+    """``signal`` as a float array; a model that cannot do without it says so in one line."""
+    if signal is None:
+        raise KinergyError(f"friction model {model!r} needs {what}")
+    return np.asarray(signal, dtype=float)
 
 
 def _by_name(model: FrictionModel, params: Mapping[str, float]) -> Array:
@@ -65,7 +74,11 @@ class FrictionModel:
     needs_load : bool
         Whether ``torque`` needs the load torque (power-flow or load-dependent friction).
     needs_temperature : bool
-        Whether ``torque`` needs the joint temperature (temperature-dependent friction).
+        Whether ``torque`` uses the joint temperature (temperature-dependent friction; without
+        one such a model is evaluated at its ``reference_temperature``).
+    search : mapping of str to (float, float)
+        Shape parameters that fits find by a 1-D search inside these bounds (``power_law``'s
+        ``exponent``); the linear parameters are solved for at every trial value.
     citation : str
         Where the model comes from (``UR5e eqs 11-16``).
     linear_values, with_linear : callable, optional
@@ -82,6 +95,7 @@ class FrictionModel:
     shape_defaults: Mapping[str, float] = field(default_factory=dict)
     needs_load: bool = False
     needs_temperature: bool = False
+    search: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     citation: str = ""
     linear_values: Callable[[FrictionModel, Mapping[str, float]], Array] = _by_name
     with_linear: Callable[[FrictionModel, Mapping[str, float], Array], dict[str, float]] = (

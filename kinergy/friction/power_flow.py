@@ -10,19 +10,14 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import NDArray
 
-from kinergy.errors import KinergyError
-from kinergy.friction.model import FrictionModel
+from kinergy.friction.model import FrictionModel, needed
 from kinergy.friction.viscous_coulomb import sign
 
 Array = NDArray[np.float64]
 
 
 def _load(tau_load: Array | None) -> Array:
-    if tau_load is None:
-        raise KinergyError(
-            "friction model 'power_flow' needs the load torque to tell the direction of power flow"
-        )
-    return np.asarray(tau_load, dtype=float)
+    return needed(tau_load, "power_flow", "the load torque to tell the direction of power flow")
 
 
 def _torque(

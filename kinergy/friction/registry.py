@@ -13,11 +13,16 @@ from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
 from kinergy.friction import (
+    directional_power_law,
+    load_coulomb,
+    load_thermal_power_law,
     makkar,
     motor_reducer,
     none,
     power_flow,
+    power_law,
     stribeck,
+    thermal_viscous,
     viscous_coulomb,
 )
 from kinergy.friction.model import FrictionModel
@@ -39,7 +44,19 @@ Array = NDArray[np.float64]
 #: every friction model, by the name robot files use
 MODELS: dict[str, FrictionModel] = {
     m.MODEL.name: m.MODEL
-    for m in (none, viscous_coulomb, motor_reducer, power_flow, makkar, stribeck)
+    for m in (
+        none,
+        viscous_coulomb,
+        motor_reducer,
+        power_flow,
+        makkar,
+        stribeck,
+        power_law,
+        directional_power_law,
+        load_coulomb,
+        thermal_viscous,
+        load_thermal_power_law,
+    )
 }
 
 

@@ -66,6 +66,12 @@ class IdentData:
         Estimated lag of the real motion behind the commanded one, s.
     source : str
         How the real motion was obtained: ``"delayed target"`` or ``"filtered actual"``.
+    temperature : ndarray or None
+        ``joint_temperatures``, deg C.
+    voltage : ndarray or None
+        ``actual_joint_voltage``, V (as the controller logs it).
+    supply_voltage, supply_current : ndarray, shape (N,), or None
+        ``actual_robot_voltage`` (V) and ``actual_robot_current`` (A): the arm's supply.
     """
 
     path: str
@@ -81,6 +87,10 @@ class IdentData:
     torque: Array | None
     lag: float
     source: str
+    temperature: Array | None = None
+    voltage: Array | None = None
+    supply_voltage: Array | None = None
+    supply_current: Array | None = None
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -109,6 +119,10 @@ class IdentData:
             cut(self.torque),
             self.lag,
             self.source,
+            cut(self.temperature),
+            cut(self.voltage),
+            cut(self.supply_voltage),
+            cut(self.supply_current),
         )
 
 
@@ -220,6 +234,8 @@ _JOINT_SIGNALS = (
     "actual_qd",
     "target_moment",
     "actual_current",
+    "joint_temperatures",
+    "actual_joint_voltage",
 )
 
 
@@ -320,4 +336,13 @@ def prepare(
         torque=torque,
         lag=lag,
         source=source,
+        temperature=_signal(log, "joint_temperatures"),
+        voltage=_signal(log, "actual_joint_voltage"),
+        supply_voltage=_signal(log, "actual_robot_voltage"),
+        supply_current=_signal(log, "actual_robot_current"),
     )
+
+
+def _signal(log: Log, name: str) -> Array | None:
+    """A measured signal of the log, or None when it lacks it."""
+    return np.asarray(log[name], dtype=float) if name in log else None

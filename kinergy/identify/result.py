@@ -138,7 +138,7 @@ def predict(robot: Robot, data: IdentData) -> Prediction:
         torque = drive_state(robot, data.q_cmd, data.qd_cmd, data.qdd_cmd).tau_sim
     current = joint = None
     if data.current is not None or data.torque is not None:
-        state = drive_state(robot, data.q, data.qd, data.qdd)
+        state = drive_state(robot, data.q, data.qd, data.qdd, temperature=data.temperature)
         current = state.current if data.current is not None else None
         joint = joint_torque(robot, state.tau_m) if data.torque is not None else None
     return Prediction(torque, current, joint)

@@ -21,6 +21,7 @@ each joint's fit is made holding 0, 25, 50, 75 and 100 % of its friction through
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -37,6 +38,7 @@ from kinergy.friction.registry import (
     with_linear_parameters,
 )
 from kinergy.identify.columns import rotor_columns
+from kinergy.identify.friction_curve import search_shape
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import (
     DriveEstimate,
@@ -49,7 +51,14 @@ from kinergy.jsonable import OPTIONAL
 from kinergy.linalg import scaled_lstsq
 from kinergy.model.robot import Friction, Joint, Robot, Source
 
-__all__ = ["SequentialFit", "SequentialJoint", "identify_sequential", "rotor_inertias"]
+__all__ = [
+    "AUTO_CANDIDATES",
+    "FrictionChoice",
+    "SequentialFit",
+    "SequentialJoint",
+    "identify_sequential",
+    "rotor_inertias",
+]
 
 Array = NDArray[np.float64]
 
@@ -63,6 +72,21 @@ HOLDINGS = (0.0, 0.25, 0.5, 0.75, 1.0)
 MIN_GAIN = 0.005
 #: relative standard deviation of 1/k_t above which the torque constant counts as unidentified
 MAX_KT_SPREAD = 0.1
+#: the models ``friction="auto"`` tries (those the logs support, :func:`_candidates`)
+AUTO_CANDIDATES = (
+    "viscous_coulomb",
+    "power_flow",
+    "power_law",
+    "directional_power_law",
+    "stribeck",
+    "load_coulomb",
+    "thermal_viscous",
+    "load_thermal_power_law",
+)
+#: temperature-dependent models are tried on a joint whose temperature spans this much, K
+MIN_TEMPERATURE_SPAN = 3.0
+#: contiguous blocks of the cross-validation that chooses a friction model
+FOLDS = 5
 
 
 def _stack(datas: Sequence[IdentData], name: str) -> Array:
@@ -89,6 +113,9 @@ class SequentialFit(Fit):
 
     condition_rotor_inertia: float | None = field(default=None, metadata=OPTIONAL)
     friction_holding: tuple[float | None, ...] | None = field(default=None, metadata=OPTIONAL)
+    friction_choice: tuple[FrictionChoice | None, ...] | None = field(
+        default=None, metadata=OPTIONAL
+    )
 
 
 def rotor_inertias(
@@ -154,6 +181,23 @@ def _diagnose_motion(robot: Robot, datas: Sequence[IdentData]) -> dict[int, str]
 
 
 @dataclass(frozen=True, eq=False)
+class _Signals:
+    """One motor's signals for eq 18, motor side, each (N,): load torque ``tau_load`` (N m),
+    speed ``wm`` (rad/s), acceleration ``dwm`` (rad/s^2), measured ``current`` (A) and the
+    joint ``temperature`` (deg C, None when not logged)."""
+
+    tau_load: Array
+    wm: Array
+    dwm: Array
+    current: Array
+    temperature: Array | None = None
+
+    def rows(self, keep: NDArray[np.bool_]) -> _Signals:
+        t = None if self.temperature is None else self.temperature[keep]
+        return _Signals(self.tau_load[keep], self.wm[keep], self.dwm[keep], self.current[keep], t)
+
+
+@dataclass(frozen=True, eq=False)
 class _CurrentFit:
     """Eq 18 for one motor: ``x = [1/k_t, values/k_t]`` with standard errors, the condition
     number, the squared current error, and whether ``k_t`` was held at the model's."""
@@ -167,30 +211,44 @@ class _CurrentFit:
     fixed: bool
 
 
-def _current_fit(
-    model: str,
-    params: dict[str, float],
-    signals: tuple[Array, Array, Array, Array],
-    kt_prior: float,
-) -> _CurrentFit:
-    """Eq 18 for one motor: ``I = [tau_load, friction columns] @ [1/k_t, values/k_t]``.
+def _columns(model: str, params: dict[str, float], signals: _Signals) -> Array:
+    """Eq 18's regressor ``[tau_load, friction columns]`` (N, 1 + k)."""
+    s = signals
+    cols = friction_columns(model, params, s.wm, s.tau_load, s.dwm, temperature=s.temperature)
+    return np.column_stack([s.tau_load, cols])
 
-    ``signals`` = (``tau_load`` N m, ``wm`` rad/s, ``dwm`` rad/s^2, ``current`` A), each (N,),
-    motor side. When the load torque is too small against the friction and noise to pin ``1/k_t``
-    down (relative standard deviation above :data:`MAX_KT_SPREAD`, or a non-positive estimate),
-    ``k_t`` is fixed at ``kt_prior`` and only the friction is fitted.
-    """
-    tau_load, wm, dwm, current = signals
-    cols = friction_columns(model, params, wm, tau_load, dwm)
-    a = np.column_stack([tau_load, cols])
+
+def _solve_current(
+    model: str, params: dict[str, float], signals: _Signals, kt_prior: float
+) -> _CurrentFit:
+    """Eq 18 for one motor with the model's shape parameters held (:func:`_current_fit`)."""
+    a = _columns(model, params, signals)
+    current = signals.current
     x, std, cond = scaled_lstsq(a, current)
     fixed = not (x[0] > 0 and std[0] < MAX_KT_SPREAD * x[0])
     if fixed:
-        rest, rest_std, cond = scaled_lstsq(cols, current - tau_load / kt_prior)
+        rest, rest_std, cond = scaled_lstsq(a[:, 1:], current - signals.tau_load / kt_prior)
         x = np.concatenate([[1.0 / kt_prior], rest])
         std = np.concatenate([[0.0], rest_std])
     sse = float(np.sum((current - a @ x) ** 2))
     return _CurrentFit(model, params, x, std, cond, sse, fixed)
+
+
+def _current_fit(
+    model: str, params: dict[str, float], signals: _Signals, kt_prior: float
+) -> _CurrentFit:
+    """Eq 18 for one motor: ``I = [tau_load, friction columns] @ [1/k_t, values/k_t]``.
+
+    When the load torque is too small against the friction and noise to pin ``1/k_t`` down
+    (relative standard deviation above :data:`MAX_KT_SPREAD`, or a non-positive estimate),
+    ``k_t`` is fixed at ``kt_prior`` and only the friction is fitted. Shape parameters the model
+    searches (``power_law``'s exponent) are found by a 1-D search on the squared current error
+    (:func:`kinergy.identify.friction_curve.search_shape`).
+    """
+    if not get_model(model).search:
+        return _solve_current(model, params, signals, kt_prior)
+    shaped = search_shape(model, params, lambda p: _solve_current(model, p, signals, kt_prior).sse)
+    return _solve_current(model, shaped, signals, kt_prior)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -243,24 +301,46 @@ def _with_rotor_inertias(robot: Robot, rotor: Array, warnings: list[str]) -> Rob
 # Step 3: torque constants and friction (UR5e eqs 17-18)
 
 
-def _motor_signals(
-    robot: Robot, rotor: Array, logs: Sequence[IdentData]
-) -> tuple[Array, Array, Array, Array]:
-    """Motor-side load torque of ``robot`` with rotor inertias ``rotor`` (N m), motor speed
-    (rad/s), acceleration (rad/s^2) and the measured current (A), each (N, n), on the real
-    motion of ``logs``."""
+def _motor_signals(robot: Robot, rotor: Array, logs: Sequence[IdentData]) -> list[_Signals]:
+    """Per motor: the load torque of ``robot`` with rotor inertias ``rotor``, the motor speed and
+    acceleration, the measured current and the joint temperature (when every log has it), on
+    the real motion of ``logs`` (:class:`_Signals`)."""
     q, qd, qdd = _stack(logs, "q"), _stack(logs, "qd"), _stack(logs, "qdd")
     n_mat = transmission_matrix(robot)
     tau_sim = rnea(robot, q, qd, qdd) + qdd @ (n_mat.T @ (rotor[:, None] * n_mat)).T
     tau_load = np.asarray(np.linalg.solve(n_mat.T, tau_sim.T).T, dtype=float)
-    return tau_load, qd @ n_mat.T, qdd @ n_mat.T, _stack(logs, "current")
+    wm, dwm, current = qd @ n_mat.T, qdd @ n_mat.T, _stack(logs, "current")
+    temps = None
+    if all(d.temperature is not None for d in logs):
+        temps = _stack(logs, "temperature")
+    return [
+        _Signals(
+            tau_load[:, m],
+            wm[:, m],
+            dwm[:, m],
+            current[:, m],
+            None if temps is None else temps[:, m],
+        )
+        for m in range(robot.n)
+    ]
+
+
+def _start(joint: Joint, model: str, standstill: float, holding: float) -> dict[str, float]:
+    """Parameters to fit ``model`` from, holding ``holding`` of the friction through standstill."""
+    params = start_parameters(model, joint.drive.friction.model, joint.drive.friction.params)
+    params.pop("standstill", None)
+    params.pop("holding", None)
+    if holding > 0.0:
+        params["standstill"] = standstill
+        params["holding"] = holding
+    return params
 
 
 def _best_hold(
     joint: Joint,
     model: str,
     standstill: float,
-    signals: tuple[Array, Array, Array, Array],
+    signals: _Signals,
     holdings: Sequence[float],
 ) -> _CurrentFit:
     """Eq 18 with each fraction of ``holdings`` of the friction held through standstill (below
@@ -268,17 +348,76 @@ def _best_hold(
     :data:`MIN_GAIN`."""
     best: _CurrentFit | None = None
     for holding in holdings:
-        params = start_parameters(model, joint.drive.friction.model, joint.drive.friction.params)
-        params.pop("standstill", None)
-        params.pop("holding", None)
-        if holding > 0.0:
-            params["standstill"] = standstill
-            params["holding"] = holding
+        params = _start(joint, model, standstill, holding)
         fit = _current_fit(model, params, signals, joint.drive.torque_constant)
         if best is None or fit.sse < best.sse * (1.0 - MIN_GAIN):
             best = fit
     assert best is not None
     return best
+
+
+@dataclass(frozen=True)
+class FrictionChoice:
+    """How ``friction="auto"`` chose a joint's model: each candidate's cross-validated current
+    RMS (A, :data:`FOLDS` contiguous blocks), the winner, and how much lower its RMS is than
+    Coulomb + viscous's and than the runner-up's (%)."""
+
+    model: str
+    cv_rms: dict[str, float]
+    gain_over_viscous_coulomb: float | None
+    margin: float | None
+
+
+def _candidates(signals: _Signals) -> list[str]:
+    """The models of :data:`AUTO_CANDIDATES` this joint's logs can support: temperature-dependent
+    ones only where its temperature spans :data:`MIN_TEMPERATURE_SPAN`."""
+    t = signals.temperature
+    warm = t is not None and float(np.ptp(t)) >= MIN_TEMPERATURE_SPAN
+    return [m for m in AUTO_CANDIDATES if warm or not get_model(m).needs_temperature]
+
+
+def _cv_rms(fit: _CurrentFit, signals: _Signals, kt_prior: float) -> float:
+    """Current RMS (A) of ``fit``'s model (its shape held) on each of :data:`FOLDS` contiguous
+    blocks of the samples, fitted on the others."""
+    index = np.arange(signals.current.size)
+    edges = np.linspace(0, index.size, FOLDS + 1).astype(int)
+    a = _columns(fit.model, fit.params, signals)
+    squared = 0.0
+    for lo, hi in itertools.pairwise(edges):
+        held = (index >= lo) & (index < hi)
+        train = _solve_current(fit.model, fit.params, signals.rows(~held), kt_prior)
+        squared += float(np.sum((signals.current[held] - a[held] @ train.x) ** 2))
+    return float(np.sqrt(squared / index.size))
+
+
+def _auto_fit(
+    joint: Joint, standstill: float, signals: _Signals, holdings: Sequence[float]
+) -> tuple[_CurrentFit, FrictionChoice]:
+    """``friction="auto"``: the standstill hold chosen with the joint's own model, then every
+    candidate model fitted with it and scored by cross-validation; the lowest held-out RMS wins.
+    Candidates whose regression is singular on these logs are left out."""
+    own = _best_hold(joint, joint.drive.friction.model, standstill, signals, holdings)
+    holding = float(own.params.get("holding", 0.0))
+    kt = joint.drive.torque_constant
+    fits, scores = {}, {}
+    for model in _candidates(signals):
+        fit = _current_fit(model, _start(joint, model, standstill, holding), signals, kt)
+        if fit.cond <= MAX_CONDITION:
+            fits[model], scores[model] = fit, _cv_rms(fit, signals, kt)
+    ranked = sorted(scores, key=scores.__getitem__)
+    best = ranked[0]
+
+    def lower(other: str) -> float:
+        return 100.0 * (1.0 - scores[best] / scores[other])
+
+    vc = scores.get("viscous_coulomb")
+    choice = FrictionChoice(
+        model=best,
+        cv_rms=scores,
+        gain_over_viscous_coulomb=None if vc is None else lower("viscous_coulomb"),
+        margin=lower(ranked[1]) if len(ranked) > 1 else None,
+    )
+    return fits[best], choice
 
 
 @dataclass(frozen=True)
@@ -332,31 +471,38 @@ def _current_step(
     problems: dict[int, str],
     options: tuple[str | None, str | bool],
     warnings: list[str],
-) -> tuple[Robot, list[_CurrentStats], tuple[float | None, ...]]:
+) -> tuple[Robot, list[_CurrentStats], tuple[float | None, ...], tuple[FrictionChoice | None, ...]]:
     """Torque constants and friction of every identifiable motor from the currents (eqs 17-18);
-    ``options`` = (friction model or None, hold). Returns the robot, each joint's statistics and
-    the friction fraction held through standstill (None where not fitted)."""
+    ``options`` = (friction model, ``"auto"`` or None; hold). Returns the robot, each joint's
+    statistics, the friction fraction held through standstill and, with ``"auto"``, how each
+    joint's model was chosen (None where not fitted)."""
     friction, hold = options
     signals = _motor_signals(staged, rotor, logs)
     holdings = HOLDINGS if hold == "auto" else ((1.0,) if hold else (0.0,))
     joints: list[Joint] = []
     stats: list[_CurrentStats] = []
     held: list[float | None] = []
+    chosen: list[FrictionChoice | None] = []
     for m, joint in enumerate(staged.joints):
+        choice = None
         if m in problems:
             joints.append(joint)
             stats.append(_CurrentStats())
             held.append(None)
+            chosen.append(None)
             continue
-        model = friction or joint.drive.friction.model
         standstill = STILL_SPEED * abs(joint.drive.gear_ratio)
-        tau_load, wm, dwm, current = (s[:, m] for s in signals)
-        fit = _best_hold(joint, model, standstill, (tau_load, wm, dwm, current), holdings)
+        if friction == "auto":
+            fit, choice = _auto_fit(joint, standstill, signals[m], holdings)
+        else:
+            model = friction or joint.drive.friction.model
+            fit = _best_hold(joint, model, standstill, signals[m], holdings)
         held.append(float(fit.params.get("holding", 0.0)))
+        chosen.append(choice)
         new, stat = _apply_current_fit(m, joint, fit, warnings)
         joints.append(new)
         stats.append(stat)
-    return staged.with_joints(joints), stats, tuple(held)
+    return staged.with_joints(joints), stats, tuple(held), tuple(chosen)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -422,6 +568,8 @@ def identify_sequential(
     friction : str, optional
         Friction model for every joint (default: each joint's model in ``robot``); it must be
         linear in its parameters (all of kinergy's are, given their shape parameters).
+        ``"auto"``: per joint, the model of :data:`AUTO_CANDIDATES` the logs support with the
+        lowest cross-validated current RMS (``fit.friction_choice`` says which won, by how much).
     hold : {"auto", True, False}
         Hold friction through standstill (see the module docstring); ``auto`` keeps whichever
         fits the currents better.
@@ -453,10 +601,10 @@ def identify_sequential(
     rotor, rotor_std, cond = _rotor_step(robot, ref_logs, active, warnings)
     staged = _with_rotor_inertias(robot, rotor, warnings)
     stats: list[_CurrentStats] = [_CurrentStats() for _ in range(robot.n)]
-    held = None
+    held = choices = None
     if current_logs:
         options = (friction, hold)
-        staged, stats, held = _current_step(
+        staged, stats, held, choices = _current_step(
             staged, rotor, current_logs, problems, options, warnings
         )
     else:
@@ -473,6 +621,7 @@ def identify_sequential(
         warnings=tuple(warnings),
         condition_rotor_inertia=cond,
         friction_holding=held,
+        friction_choice=choices if friction == "auto" else None,
     )
     joints = _joints(identified, (rotor, rotor_std), problems, stats)
     return IdentificationResult(identified, "sequential", joints, fit)

@@ -13,6 +13,7 @@ from kinergy.model.robot import (
     Payload,
     Robot,
     Source,
+    Thermal,
     inertia_matrix,
 )
 from kinergy.model.toml import (
@@ -35,6 +36,7 @@ __all__ = [
     "Payload",
     "Robot",
     "Source",
+    "Thermal",
     "inertia_matrix",
     "library_names",
     "load_robot",

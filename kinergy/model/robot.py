@@ -35,6 +35,7 @@ __all__ = [
     "Payload",
     "Robot",
     "Source",
+    "Thermal",
     "inertia_matrix",
 ]
 
@@ -56,10 +57,13 @@ SOURCE_CATEGORIES = (
     "friction",
     "motor_constant",
     "limits",
+    "thermal",
+    "supply",
 )
 #: ``published`` by the maker, from a ``seed`` paper's tables, ``identified`` from logs by kinergy,
+#: ``calibration`` (fitted to the maker's joint calibration, ``robot import-calibration``),
 #: ``nominal`` (an estimate: identify before trusting), or ``user`` (a file that does not say).
-SOURCE_STATUSES = ("published", "seed", "identified", "nominal", "user")
+SOURCE_STATUSES = ("published", "seed", "identified", "calibration", "nominal", "user")
 
 
 def _vector(value: Any, length: int, what: str) -> Array:
@@ -179,6 +183,32 @@ class Friction:
 
 
 @dataclass(frozen=True, eq=False)
+class Thermal:
+    """A joint's first-order thermal model (:mod:`kinergy.drives.thermal`): one heat capacity
+    warmed by the drive's losses and cooled to ambient through one thermal resistance.
+
+    Attributes
+    ----------
+    capacity : float
+        C, J/K, > 0: the heat that warms the joint by one kelvin.
+    resistance : float
+        R_th, K/W, > 0: the joint's steady temperature rise per watt of loss.
+    """
+
+    capacity: float
+    resistance: float
+
+    def __post_init__(self) -> None:
+        for name in ("capacity", "resistance"):
+            object.__setattr__(self, name, _number(getattr(self, name), name, low=0.0))
+
+    @property
+    def time_constant(self) -> float:
+        """``C R_th``, s: how fast the joint approaches its steady temperature."""
+        return self.capacity * self.resistance
+
+
+@dataclass(frozen=True, eq=False)
 class Drive:
     """A joint drive: motor, reducer and their friction, described on the motor side.
 
@@ -198,6 +228,8 @@ class Drive:
         Motor-side friction model.
     winding_resistance : float or None
         R, ohm, > 0, when known; overrides ``motor_constant`` in the electrical model.
+    thermal : Thermal or None
+        The joint's thermal model, when known (the twin warms its joints with it).
     """
 
     gear_ratio: float
@@ -208,6 +240,7 @@ class Drive:
     kt_over_kb: float
     friction: Friction
     winding_resistance: float | None = None
+    thermal: Thermal | None = None
 
     def __post_init__(self) -> None:
         ratio = _number(self.gear_ratio, "gear_ratio")
@@ -228,6 +261,8 @@ class Drive:
             )
         if not isinstance(self.friction, Friction):
             raise KinergyError("friction must be a Friction")
+        if self.thermal is not None and not isinstance(self.thermal, Thermal):
+            raise KinergyError("thermal must be a Thermal")
 
     @property
     def rotor_inertia(self) -> float:
@@ -348,8 +383,9 @@ class Robot:
         Provenance of each parameter group (:data:`SOURCE_CATEGORIES`).
     description : str
     standby_power : float
-        Constant power the controller and the brakes draw whatever the motion, W (default 0:
-        the seed's energy figures are the motors' alone).
+        Constant power the arm's electronics and brakes draw from its supply whatever the
+        motion, W (default 0: the seed's energy figures are the motors' alone; nominal until
+        ``kinergy identify`` measures it from ``actual_robot_current``).
     bus_voltage : float
         DC bus voltage the joints are supplied from, V (48 V on UR e-Series).
     """

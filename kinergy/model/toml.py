@@ -6,7 +6,7 @@ A robot file is TOML with the same structure as :func:`robot_to_dict` (which is 
     name = "ur5e"
     convention = "dh"                 # or "mdh"
     gravity = [0.0, 0.0, -9.81]       # optional
-    standby_power = 0.0               # optional, W: controller and brakes, drawn whatever the motion
+    standby_power = 0.0               # optional, W: the arm's electronics and brakes, drawn whatever the motion
     bus_voltage = 48.0                # optional, V: DC bus of the joints
     description = "..."               # optional
     coupling = [[...], ...]           # optional, n x n (differential joints)
@@ -38,6 +38,9 @@ A robot file is TOML with the same structure as :func:`robot_to_dict` (which is 
     [joints.drive.friction]
     model = "power_flow"
     ...
+    [joints.drive.thermal]            # optional: first-order thermal model (drives/thermal.py)
+    capacity = 1000.0                 # J/K
+    resistance = 1.2                  # K/W
     [joints.limits]
     position = [-6.283185307179586, 6.283185307179586]
     speed = 3.141592653589793
@@ -70,6 +73,7 @@ from kinergy.model.robot import (
     Payload,
     Robot,
     Source,
+    Thermal,
 )
 
 __all__ = [
@@ -106,6 +110,7 @@ _DRIVE_KEYS = {
     "kt_over_kb",
     "friction",
     "winding_resistance",
+    "thermal",
 }
 _LIMIT_KEYS = {"position", "speed", "torque", "acceleration"}
 
@@ -163,6 +168,7 @@ def _joint_from_dict(data: Any, index: int) -> Joint:
     if model is None:
         raise KinergyError(f"{fwhere}: missing field 'model'")
     friction = _at(fwhere, lambda: Friction(model=model, params=fric_data))
+    thermal = _thermal_from_dict(drive_data.get("thermal"), f"{dwhere}.thermal")
     drive = _at(
         dwhere,
         lambda: Drive(
@@ -174,6 +180,7 @@ def _joint_from_dict(data: Any, index: int) -> Joint:
             kt_over_kb=_take(drive_data, "kt_over_kb", dwhere),
             friction=friction,
             winding_resistance=drive_data.get("winding_resistance"),
+            thermal=thermal,
         ),
     )
     lwhere = f"{where}.limits"
@@ -199,6 +206,19 @@ def _joint_from_dict(data: Any, index: int) -> Joint:
             link=link,
             drive=drive,
             limits=limits,
+        ),
+    )
+
+
+def _thermal_from_dict(data: Any, where: str) -> Thermal | None:
+    if data is None:
+        return None
+    data = _table(data, where)
+    _no_unknown(data, {"capacity", "resistance"}, where)
+    return _at(
+        where,
+        lambda: Thermal(
+            capacity=_take(data, "capacity", where), resistance=_take(data, "resistance", where)
         ),
     )
 
@@ -295,7 +315,7 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
     """The plain-dict form of a robot: TOML file content and the ``robot show --json`` shape.
 
     Optional items that are absent (no payload, identity flange, no coupling, no winding
-    resistance, no acceleration limit) are left out.
+    resistance, no thermal model, no acceleration limit) are left out.
     """
     out: dict[str, Any] = {
         "name": robot.name,
@@ -335,6 +355,11 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         if j.drive.winding_resistance is not None:
             drive["winding_resistance"] = j.drive.winding_resistance
         drive["friction"] = {"model": j.drive.friction.model, **j.drive.friction.params}
+        if j.drive.thermal is not None:
+            drive["thermal"] = {
+                "capacity": j.drive.thermal.capacity,
+                "resistance": j.drive.thermal.resistance,
+            }
         limits: dict[str, Any] = {
             "position": _floats(j.limits.position),
             "speed": j.limits.speed,

@@ -52,6 +52,15 @@ Array = NDArray[np.float64]
 DPI = 110
 """Resolution :func:`save` writes at, dots per inch: a 11 x 8 in figure is 1210 x 880 px."""
 
+_BOX_STYLE: dict[str, Any] = {
+    "medianprops": {"color": "black", "linewidth": 1.5},
+    "whiskerprops": {"color": "0.2"},
+    "capprops": {"color": "0.2"},
+    "flierprops": {"marker": ".", "markersize": 3.0, "markerfacecolor": "0.3",
+                   "markeredgecolor": "none", "alpha": 0.5},
+}  # fmt: skip
+"""Box-plot artists' style besides the box colour (:func:`error_boxplot`)."""
+
 # Font sizes, points. Set on every artist rather than through rcParams, which are global.
 _TITLE = 11
 _SUPTITLE = 13
@@ -129,6 +138,15 @@ def _names(joint_names: Sequence[str]) -> list[str]:
 
 
 # -- layout helpers ------------------------------------------------------------------------------
+
+
+def _joint_signals(
+    t: ArrayLike, joint_names: Sequence[str], **signals: ArrayLike
+) -> tuple[list[str], Array, list[Array]]:
+    """Checked joint names (n), times ``(N,)`` and each signal as ``(N, n)``, in keyword order."""
+    names = _names(joint_names)
+    ts = _time(t)
+    return names, ts, [_matrix(v, key, ts.size, len(names)) for key, v in signals.items()]
 
 
 def _figure(width: float, height: float) -> Figure:
@@ -225,11 +243,8 @@ def time_series(
         If the shapes disagree, the number of names is not ``n``, ``t`` does not increase or a
         value is not finite.
     """
-    names = _names(joint_names)
+    names, ts, (y, p) = _joint_signals(t, joint_names, measured=measured, predicted=predicted)
     n = len(names)
-    ts = _time(t)
-    y = _matrix(measured, "measured", ts.size, n)
-    p = _matrix(predicted, "predicted", ts.size, n)
     r2 = r_squared(y, p)
 
     fig = _figure(*_grid_size(n))
@@ -305,16 +320,7 @@ def error_boxplot(
             patch_artist=True,
             widths=0.6,
             boxprops={"facecolor": colours[i], "alpha": 0.45, "edgecolor": "0.2"},
-            medianprops={"color": "black", "linewidth": 1.5},
-            whiskerprops={"color": "0.2"},
-            capprops={"color": "0.2"},
-            flierprops={
-                "marker": ".",
-                "markersize": 3.0,
-                "markerfacecolor": "0.3",
-                "markeredgecolor": "none",
-                "alpha": 0.5,
-            },
+            **_BOX_STYLE,
         )
         ax.set_title(name, fontsize=_TITLE)
         ax.set_xlabel("Joint", fontsize=_LABEL)
@@ -354,10 +360,8 @@ def power_energy(t: ArrayLike, power: ArrayLike, *, joint_names: Sequence[str]) 
         If the shapes disagree, the number of names is not ``n``, ``t`` does not increase or a
         value is not finite.
     """
-    names = _names(joint_names)
+    names, ts, (w,) = _joint_signals(t, joint_names, power=power)
     n = len(names)
-    ts = _time(t)
-    w = _matrix(power, "power", ts.size, n)
     e = cumulative_trapezoid(w, ts, axis=0, initial=0.0)
 
     fig = _figure(11.0, 7.5)
@@ -451,6 +455,50 @@ def _pareto_front(x: Array, y: Array) -> NDArray[np.intp]:
     return np.asarray(front, dtype=np.intp)
 
 
+def _pareto_inputs(
+    cycle_times: ArrayLike,
+    energies: ArrayLike,
+    marked: Mapping[str, tuple[float, float]] | None,
+) -> tuple[Array, Array, dict[str, tuple[float, float]]]:
+    """Checked ``(x (M,), y (M,), named points)`` of :func:`pareto`."""
+    x = _vector(cycle_times, "cycle_times")
+    y = _vector(energies, "energies")
+    if x.size != y.size:
+        raise KinergyError(f"energies: expected shape ({x.size},) like cycle_times, got {y.shape}")
+    if x.size == 0:
+        raise KinergyError("cycle_times: no candidate given")
+    points: dict[str, tuple[float, float]] = {}
+    for name, xy in (marked or {}).items():
+        v = _vector(xy, f"marked[{name!r}]")
+        if v.size != 2:
+            raise KinergyError(
+                f"marked[{name!r}]: expected (cycle time, energy), got {v.size} values"
+            )
+        points[str(name)] = (float(v[0]), float(v[1]))
+    return x, y, points
+
+
+def _star(
+    ax: Axes, name: str, xy: tuple[float, float], middle: tuple[float, float], colour: str
+) -> None:
+    """A named point as a star, its label pointing away from the edges nearest to it."""
+    px, py = xy
+    ax.scatter([px], [py], s=140, marker="*", color=colour, edgecolors="black",
+               linewidths=0.6, zorder=5)  # fmt: skip
+    right, up = px <= middle[0], py <= middle[1]
+    ax.annotate(
+        f"{name}\n{px:.2f} s, {py:.1f} J",
+        (px, py),
+        xytext=(10 if right else -10, 10 if up else -10),
+        textcoords="offset points",
+        ha="left" if right else "right",
+        va="bottom" if up else "top",
+        fontsize=_LEGEND,
+        bbox={"boxstyle": "round,pad=0.25", "facecolor": "white", "alpha": 0.85, "lw": 0.5},
+        zorder=6,
+    )
+
+
 def pareto(
     cycle_times: ArrayLike,
     energies: ArrayLike,
@@ -482,65 +530,20 @@ def pareto(
     KinergyError
         If the two arrays differ in length, are empty, or a value is not finite.
     """
-    x = _vector(cycle_times, "cycle_times")
-    y = _vector(energies, "energies")
-    if x.size != y.size:
-        raise KinergyError(f"energies: expected shape ({x.size},) like cycle_times, got {y.shape}")
-    if x.size == 0:
-        raise KinergyError("cycle_times: no candidate given")
-    points: dict[str, tuple[float, float]] = {}
-    for name, xy in (marked or {}).items():
-        v = _vector(xy, f"marked[{name!r}]")
-        if v.size != 2:
-            raise KinergyError(
-                f"marked[{name!r}]: expected (cycle time, energy), got {v.size} values"
-            )
-        points[str(name)] = (float(v[0]), float(v[1]))
-
+    x, y, points = _pareto_inputs(cycle_times, energies, marked)
     fig = _figure(8.0, 5.5)
     ax = fig.subplots()
     ax.scatter(x, y, s=18, color="0.55", alpha=0.7, label="candidates", zorder=2)
     front = _pareto_front(x, y)
     if front.size > 1:
-        ax.step(
-            x[front],
-            y[front],
-            where="post",
-            color="tab:blue",
-            linewidth=1.4,
-            label="Pareto front",
-            zorder=3,
-        )
+        ax.step(x[front], y[front], where="post", color="tab:blue", linewidth=1.4,
+                label="Pareto front", zorder=3)  # fmt: skip
     # Labels point into the plot, away from the nearest edges, so none leaves the axes.
     xs = np.concatenate([x, [p[0] for p in points.values()]])
     ys = np.concatenate([y, [p[1] for p in points.values()]])
-    x_mid = 0.5 * (xs.min() + xs.max())
-    y_mid = 0.5 * (ys.min() + ys.max())
-    for i, (name, (px, py)) in enumerate(points.items()):
-        colour = f"C{(i + 1) % 10}"
-        ax.scatter(
-            [px],
-            [py],
-            s=140,
-            marker="*",
-            color=colour,
-            edgecolors="black",
-            linewidths=0.6,
-            zorder=5,
-        )
-        right = px <= x_mid
-        up = py <= y_mid
-        ax.annotate(
-            f"{name}\n{px:.2f} s, {py:.1f} J",
-            (px, py),
-            xytext=(10 if right else -10, 10 if up else -10),
-            textcoords="offset points",
-            ha="left" if right else "right",
-            va="bottom" if up else "top",
-            fontsize=_LEGEND,
-            bbox={"boxstyle": "round,pad=0.25", "facecolor": "white", "alpha": 0.85, "lw": 0.5},
-            zorder=6,
-        )
+    middle = (0.5 * (xs.min() + xs.max()), 0.5 * (ys.min() + ys.max()))
+    for i, (name, xy) in enumerate(points.items()):
+        _star(ax, name, xy, middle, f"C{(i + 1) % 10}")
     ax.set_xlabel("Cycle time [s]", fontsize=_LABEL)
     ax.set_ylabel("Energy [J]", fontsize=_LABEL)
     ax.set_title("Energy against cycle time", fontsize=_TITLE)

@@ -118,8 +118,8 @@ def _parameters_section(study: Study) -> tuple[Section, list[Table]]:
         f"Model: {model.name}, {model.n} joints. "
         + (f"Identified by the {study.result.method} method. " if study.result else "")
         + (
-            "The logs come from kinergy's digital twin, built with the UR5e doc's parameters, so "
-            "identified values can be checked against the truth."
+            "The logs come from kinergy's digital twin, so identified values can be checked "
+            "against the robot it was built with (its truth)."
             if study.truth is not None
             else ""
         )
@@ -162,6 +162,17 @@ _TWIN_TORQUE_NOTE = (
 )
 
 
+def _same_links(model: Robot, truth: Robot) -> bool:
+    """Whether the twin's truth has the model's link data (then its target_moment is the
+    model's eq 7 exactly)."""
+    return all(
+        a.link.mass == b.link.mass
+        and np.array_equal(a.link.com, b.link.com)
+        and np.array_equal(a.link.inertia, b.link.inertia)
+        for a, b in zip(model.joints, truth.joints, strict=True)
+    )
+
+
 def _accuracy_section(
     study: Study, key: str, comparisons: Mapping[str, Comparison], figdir: Path
 ) -> tuple[Section, list[Table]]:
@@ -199,7 +210,8 @@ def _accuracy_section(
         names,
         published if paper else None,
     )
-    text = info["text"] + (_TWIN_TORQUE_NOTE if key == "torque" and study.truth else "")
+    exact = study.truth is not None and _same_links(study.model, study.truth)
+    text = info["text"] + (_TWIN_TORQUE_NOTE if key == "torque" and exact else "")
     return Section(info["title"], text, tables, figures), tables
 
 

@@ -85,8 +85,8 @@ def parameter_tables(model: Robot, truth: Robot | None = None) -> list[Table]:
     note_vi = "Motor side (UR5e eqs 11-17)."
     if truth is not None:
         inertia_headers += ["twin J_m (Table IV)", "J_m + J_r error [%]"]
-        note_iv += " The twin was built with the UR5e doc's Table IV."
-        note_vi += " In brackets: the value the twin was built with (the UR5e doc's Table VI)."
+        note_iv += " 'twin': the value the twin was built with (its true robot)."
+        note_vi += " In brackets: the value the twin was built with (its true robot)."
     return [
         Table("Motor and reducer inertia (UR5e Table IV)", inertia_headers, inertia_rows, note_iv),
         Table(

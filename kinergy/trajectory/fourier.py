@@ -4,6 +4,9 @@
 
 with base frequency ``w_f`` (rad/s; the period is ``2 pi / w_f``). Speeds and accelerations are the
 exact derivatives. The series is periodic, so a run can repeat it for cycle averaging (nursing eq 24).
+The series is linear in its coefficients: :func:`fourier_basis` gives the columns that multiply
+them, which :func:`fourier_series` evaluates and the excitation design optimises over
+(:mod:`kinergy.experiments.excitation_series`).
 """
 
 from __future__ import annotations
@@ -14,9 +17,45 @@ from numpy.typing import ArrayLike, NDArray
 from kinergy.errors import KinergyError
 from kinergy.trajectory.motion import Motion
 
-__all__ = ["fourier_motion", "fourier_series"]
+__all__ = ["fourier_basis", "fourier_motion", "fourier_series"]
 
 Array = NDArray[np.float64]
+
+
+def fourier_basis(
+    t: Array, base_frequency: float, harmonics: int, *, from_start: bool = False
+) -> tuple[Array, Array, Array]:
+    """Nursing eq 22 per unit coefficient: the columns that multiply ``[a_1..a_L, b_1..b_L]``.
+
+    ::
+
+        q - q0 = sum_l a_l sin(w_l t) / w_l - b_l cos(w_l t) / w_l,   w_l = w_f l
+        qd     = sum_l a_l cos(w_l t)       + b_l sin(w_l t)
+        qdd    = sum_l -a_l w_l sin(w_l t)  + b_l w_l cos(w_l t)
+
+    Parameters
+    ----------
+    t : ndarray, shape (N,)
+        Time, s.
+    base_frequency : float
+        ``w_f``, rad/s.
+    harmonics : int
+        ``L``.
+    from_start : bool
+        ``pq`` gives ``q(t) - q(0)`` instead of ``q(t) - q0``: the ``b`` columns are
+        ``(1 - cos(w_l t)) / w_l`` (a series anchored at its start pose,
+        ``q0 = q(0) + sum_l b_l / w_l``).
+
+    Returns
+    -------
+    pq, pqd, pqdd : ndarray, shape (N, 2 L)
+        rad, rad/s and rad/s^2 per unit coefficient (rad/s).
+    """
+    w = base_frequency * np.arange(1, harmonics + 1)  # (L,)
+    phase = t[:, None] * w[None, :]  # (N, L)
+    s, c = np.sin(phase), np.cos(phase)
+    pq = np.hstack([s / w, (1.0 - c) / w if from_start else -c / w])
+    return pq, np.hstack([c, s]), np.hstack([-s * w, c * w])
 
 
 def fourier_series(
@@ -50,13 +89,9 @@ def fourier_series(
         )
     if not (np.isfinite(base_frequency) and base_frequency > 0):
         raise KinergyError(f"base frequency must be > 0, got {base_frequency}")
-    w = base_frequency * np.arange(1, a.shape[1] + 1)  # (L,)
-    phase = t[:, None] * w[None, :]  # (N, L)
-    s, c = np.sin(phase), np.cos(phase)
-    q = q0 + (s / w) @ a.T - (c / w) @ b.T
-    qd = c @ a.T + s @ b.T
-    qdd = -(s * w) @ a.T + (c * w) @ b.T
-    return q, qd, qdd
+    pq, pqd, pqdd = fourier_basis(t, base_frequency, a.shape[1])
+    ab = np.hstack([a, b]).T  # (2L, n)
+    return q0 + pq @ ab, pqd @ ab, pqdd @ ab
 
 
 def fourier_motion(
@@ -73,7 +108,7 @@ def fourier_motion(
     Examples
     --------
     >>> m = fourier_motion([0.0], [[0.2]], [[0.0]], base_frequency=0.2 * np.pi, dt=0.1)
-    >>> round(m.duration, 6), round(float(m.q[0, 0]), 6), round(float(m.q[-1, 0]), 6)
+    >>> round(m.duration, 6), abs(round(float(m.q[0, 0]), 6)), abs(round(float(m.q[-1, 0]), 6))
     (10.0, 0.0, 0.0)
     """
     if periods < 1:

@@ -2,10 +2,17 @@
 
 from __future__ import annotations
 
+import dataclasses
 import datetime
 import os
 from collections.abc import Sequence
 
+import numpy as np
+
+from kinergy.drives.electrics import equivalent_voltage
+from kinergy.drives.transmission import transmission_matrix
+from kinergy.errors import KinergyError
+from kinergy.identify.electrics import ElectricsFit, fit_electrics, fit_standby, with_electrics
 from kinergy.identify.full import identify_full
 from kinergy.identify.nursing import identify_nursing
 from kinergy.identify.payload import PayloadEstimate, identify_payload
@@ -13,8 +20,16 @@ from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult
 from kinergy.identify.sequential import identify_sequential
 from kinergy.model import Payload, Robot, save_robot
+from kinergy.model.robot import Source
+from kinergy.predict import drive_state
 
-__all__ = ["METHODS", "identify_model", "identify_payload_model"]
+__all__ = [
+    "METHODS",
+    "identify_model",
+    "identify_payload_model",
+    "measured_electrics",
+    "run_method",
+]
 
 #: identification methods by the name ``--method`` takes
 METHODS = ("sequential", "full", "nursing")
@@ -38,7 +53,28 @@ def identify_model(
     solver: str = "ols",
     ridge: float = 0.0,
 ) -> IdentificationResult:
-    """Identify ``robot`` from prepared logs by ``method`` and write the model to ``out``."""
+    """Identify ``robot`` from prepared logs by ``method`` (:func:`run_method`) and write the
+    model to ``out``."""
+    result = run_method(
+        robot, datas, method=method, friction=friction, target=target, solver=solver, ridge=ridge
+    )
+    what = f"{robot.name} identified ({result.method} method)"
+    save_robot(result.robot, out, header=_header(what, [d.path for d in datas]))
+    return result
+
+
+def run_method(
+    robot: Robot,
+    datas: Sequence[IdentData],
+    *,
+    method: str = "sequential",
+    friction: str | None = None,
+    target: str = "auto",
+    solver: str = "ols",
+    ridge: float = 0.0,
+) -> IdentificationResult:
+    """Identify ``robot`` from prepared logs by ``method``, then the motor electrics and the
+    standby power where the logs have voltages and the supply (:func:`measured_electrics`)."""
     if method == "sequential":
         result = identify_sequential(robot, list(datas), friction=friction)
     elif method == "nursing":
@@ -47,9 +83,93 @@ def identify_model(
         result = identify_full(
             robot, list(datas), target=target, solver=solver, ridge=ridge, friction=friction
         )
-    what = f"{robot.name} identified ({result.method} method)"
-    save_robot(result.robot, out, header=_header(what, [d.path for d in datas]))
-    return result
+    return measured_electrics(result, datas)
+
+
+def _motion(
+    logs: Sequence[IdentData],
+) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray | None]:
+    """The logs' real motion (q, qd, qdd), stacked, and their joint temperatures (None unless
+    every log has them)."""
+    q, qd, qdd = (np.vstack([getattr(d, k) for d in logs]) for k in ("q", "qd", "qdd"))
+    temps = [d.temperature for d in logs if d.temperature is not None]
+    return (q, qd, qdd), (np.vstack(temps) if len(temps) == len(logs) else None)
+
+
+def _electrics_fits(
+    robot: Robot, logs: Sequence[IdentData], notes: list[str]
+) -> list[ElectricsFit | None]:
+    """Each motor's R and k_b from the logs' voltages, currents and motor speeds (None where
+    they cannot separate the two, with a note)."""
+    n_mat = transmission_matrix(robot)
+    current = np.vstack([d.current for d in logs if d.current is not None])
+    voltage = equivalent_voltage(np.vstack([d.voltage for d in logs if d.voltage is not None]))
+    (q, qd, qdd), temperature = _motion(logs)
+    # the identified model's current, free of the log's noise: the instrument of the fit
+    predicted = drive_state(robot, q, qd, qdd, temperature=temperature).current
+    wm = qd @ n_mat.T
+    fits: list[ElectricsFit | None] = []
+    for m, joint in enumerate(robot.joints):
+        try:
+            fits.append(
+                fit_electrics(current[:, m], voltage[:, m], wm[:, m], instrument=predicted[:, m])
+            )
+        except KinergyError as exc:
+            notes.append(f"joint {m + 1} ({joint.name}): electrics kept from the model: {exc}")
+            fits.append(None)
+    return fits
+
+
+def _supply_power(data: IdentData) -> np.ndarray:
+    """``actual_robot_voltage * actual_robot_current`` of a log that has both, W."""
+    assert data.supply_voltage is not None and data.supply_current is not None
+    return np.asarray(data.supply_voltage * data.supply_current, dtype=float)
+
+
+def _standby(robot: Robot, logs: Sequence[IdentData]) -> float:
+    """The standby power (W) that the logs' supply power leaves over the model's motors."""
+    motion, temperature = _motion(logs)
+    supply = np.concatenate([_supply_power(d) for d in logs])
+    fit = fit_standby(robot, motion, supply, temperature=temperature, dt=logs[0].dt)
+    return max(fit.standby, 0.0)
+
+
+def measured_electrics(
+    result: IdentificationResult, datas: Sequence[IdentData]
+) -> IdentificationResult:
+    """``result`` with the motor electrics fitted to the logs' joint voltages (UR5e eq 19,
+    :func:`kinergy.identify.electrics.fit_electrics`) and the standby power to their supply
+    power (:func:`kinergy.identify.electrics.fit_standby`), when every log has them; the fit's
+    warnings say what was written into the model. Unchanged for logs without them."""
+    robot, notes = result.robot, list[str]()
+    sources = dict(robot.sources)
+    if datas and all(d.voltage is not None and d.current is not None for d in datas):
+        fits = _electrics_fits(robot, datas, notes)
+        robot = with_electrics(robot, fits)
+        ref = "kinergy identify: R and k_b from actual_joint_voltage (UR5e eq 19)"
+        sources["motor_constant"] = Source("identified", ref)
+        for j, motor in enumerate(fits):
+            if motor is not None:
+                notes.append(
+                    f"joint {j + 1} ({robot.joints[j].name}): R = {motor.resistance:.4g} ohm, "
+                    f"k_b = {motor.back_emf:.4g} V s/rad from the logged joint voltages (voltage "
+                    f"RMS error {motor.rms:.3g} V), written into the model"
+                )
+    if datas and all(d.supply_voltage is not None and d.supply_current is not None for d in datas):
+        standby = _standby(robot, datas)
+        robot = dataclasses.replace(robot, standby_power=standby)
+        sources["supply"] = Source(
+            "identified", "kinergy identify: standby power from actual_robot_current"
+        )
+        notes.append(
+            f"standby power {standby:.3g} W from the logged supply power (actual_robot_voltage "
+            "x actual_robot_current, less the motors' predicted draw), written into the model"
+        )
+    if not notes:
+        return result
+    robot = dataclasses.replace(robot, sources=sources)
+    fit = dataclasses.replace(result.fit, warnings=(*result.fit.warnings, *notes))
+    return dataclasses.replace(result, robot=robot, fit=fit)
 
 
 def identify_payload_model(

@@ -15,7 +15,7 @@ from kinergy.identify.result import IdentificationResult, predict
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.task import Task
 from kinergy.model.robot import Robot
-from kinergy.report.html import Table, write_report
+from kinergy.report.html import Section, Table, write_report
 from kinergy.report.study import Comparison, Study, Timing, study_sections
 from kinergy.trajectory.motion import Motion
 from kinergy.workflows.logs import prepared_logs, read_motion
@@ -95,8 +95,10 @@ def write_study(
     title: str,
     subtitle: str,
     meta: Mapping[str, str],
+    extra: Sequence[Section] = (),
 ) -> tuple[Path, dict[str, list[Table]]]:
-    """Write the study's figures and ``folder/report.html``; return its path and the tables."""
+    """Write the study's figures and ``folder/report.html`` (with the ``extra`` sections after the
+    study's first); return its path and the tables."""
     from kinergy import __version__
 
     sections, tables = study_sections(study, Path(folder))
@@ -104,7 +106,7 @@ def write_study(
         Path(folder) / "report.html",
         title=title,
         subtitle=subtitle,
-        sections=sections,
+        sections=[*sections[:1], *extra, *sections[1:]],
         meta={**meta, "kinergy": __version__, "date": time.strftime("%Y-%m-%d %H:%M")},
     )
     return Path(path), tables

@@ -7,11 +7,25 @@ import os
 from kinergy.io.log import Log
 from kinergy.io.rtde import write_log
 from kinergy.model.robot import Robot
-from kinergy.simulate import TwinSettings, simulate
+from kinergy.model.toml import save_robot
+from kinergy.simulate import TwinSettings, realistic_truth, simulate
+from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import TEST_TRAJECTORIES, paper_trajectory
 from kinergy.workflows.logs import read_motion
 
-__all__ = ["simulate_to_file"]
+__all__ = ["simulate_to_file", "twin_truth"]
+
+
+def twin_truth(robot: Robot, mismatch: str, seed: int) -> Robot:
+    """The twin's true robot for ``--mismatch``: the model itself (``none``) or
+    :func:`kinergy.simulate.realistic_truth` of it, seeded (``realistic``)."""
+    return realistic_truth(robot, seed) if mismatch == "realistic" else robot
+
+
+def _target(robot: Robot, trajectory: str, columns: str | None) -> Motion:
+    if trajectory in TEST_TRAJECTORIES:
+        return paper_trajectory(robot, trajectory)
+    return read_motion(trajectory, n_joints=robot.n, columns=columns, source="target")
 
 
 def simulate_to_file(
@@ -21,13 +35,20 @@ def simulate_to_file(
     settings: TwinSettings,
     *,
     columns: str | None = None,
+    mismatch: str = "none",
+    truth_out: str | os.PathLike[str] | None = None,
 ) -> Log:
     """Simulate ``trajectory`` (``test-a``, ``test-b`` or a motion file's target motion) on the
-    twin ``robot`` and write the log to ``out`` (record.py layout, atomically)."""
-    if trajectory in TEST_TRAJECTORIES:
-        motion = paper_trajectory(robot, trajectory)
-    else:
-        motion = read_motion(trajectory, n_joints=robot.n, columns=columns, source="target")
-    twin = simulate(robot, motion, settings, name=os.fspath(out))
+    twin of ``robot`` and write the log to ``out`` (record.py layout, atomically).
+
+    ``mismatch``: ``none`` runs the model itself, ``realistic`` a true robot that differs from
+    it (:func:`twin_truth`, seeded with ``settings.seed``), whose robot file goes to
+    ``truth_out`` when given. The program is planned on the model, as a user would.
+    """
+    truth = twin_truth(robot, mismatch, settings.seed)
+    motion = _target(robot, trajectory, columns)
+    twin = simulate(truth, motion, settings, name=os.fspath(out))
     write_log(out, twin.t, twin.signals)
+    if truth_out is not None:
+        save_robot(truth, truth_out, header=truth.description)
     return twin

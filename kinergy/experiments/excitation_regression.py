@@ -1,0 +1,213 @@
+"""What an excitation is designed for: the regression matrix of the full identification and its
+conditioning criterion.
+
+The regression the full identification solves (:mod:`kinergy.identify.full`)::
+
+    tau = Y_b(q, qd, qdd) pi_b + N^T diag(J) N qdd + N^T F(wm) phi
+
+stacked over a grid of samples gives ``W`` (samples x n rows). Its columns are the link base
+columns ``Y_b`` (:func:`kinergy.dynamics.regressor.base_parameters`) and, with the drives, every
+motor's rotor-inertia column (``N[m, j] (N qdd)_m``, UR5e eq 2; ``N`` and ``wm = N qd`` from
+:mod:`kinergy.drives.transmission`) and its friction columns: the registry's
+``viscous_coulomb`` columns (:func:`kinergy.friction.registry.friction_columns`; viscous ``wm``,
+Coulomb ``tanh(wm / (|i| * 0.05 rad/s))``, a smooth sign), reflected to the joints by ``N^T``.
+A drive column that is a combination of the link base columns for every motion (on a UR arm
+``J_1`` multiplies the same ``qdd_1`` on joint 1 as the ``Iyy1`` group) is left out: no trajectory
+can separate it (the full method merges it and says so).
+
+``W``'s columns are scaled to unit norm (the units of the parameters do not matter) and the
+criterion is
+
+- ``"cond"``: the condition number ``s_max / s_min`` of the scaled ``W`` (nursing section 4.2's
+  "minimum condition number"; optimised as its logarithm);
+- ``"dopt"``: D-optimality, ``-log det(W_s^T W_s)`` (the log volume of the parameters'
+  confidence ellipsoid, up to a constant).
+
+Its gradient is exact in the criterion (eigen-decomposition of ``W_s^T W_s``, the column scaling
+included) and uses one forward difference of the regressor per joint and signal (``3 n`` extra
+regressor evaluations in one batch, instead of one per unknown).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import NDArray
+
+from kinergy.drives.transmission import motor_speed, transmission_matrix
+from kinergy.dynamics.regressor import BaseParameters, base_parameters, regressor
+from kinergy.friction.registry import friction_columns
+from kinergy.linalg import column_scale, pivoted_rank
+from kinergy.model.robot import Robot
+
+__all__ = [
+    "COULOMB_SMOOTHING",
+    "CRITERIA",
+    "ExcitationRegression",
+    "criterion",
+    "excitation_regression",
+    "scaled_condition",
+]
+
+Array = NDArray[np.float64]
+
+#: optimisation criteria: condition number, D-optimality
+CRITERIA = ("cond", "dopt")
+#: joint-side speed (rad/s) of the tanh that stands in for the Coulomb column's sign
+COULOMB_SMOOTHING = 0.05
+#: the friction model whose columns stand for every motor's friction (viscous and Coulomb)
+_FRICTION = "viscous_coulomb"
+#: a drive column whose part independent of the link base columns is below this is dependent
+_DEPENDENT_TOL = 1e-8
+#: forward-difference step of the regressor derivatives (rad, rad/s, rad/s^2)
+_FD_STEP = 1e-6
+
+
+def _drive_columns(robot: Robot, smoothing: Array, qd: Array, qdd: Array) -> Array:
+    """Rotor-inertia, viscous and Coulomb columns of every motor, joint side, (N, n, 3 n).
+
+    Motor ``m`` reaches joint ``j`` through ``N[m, j]``: ``N[m, j] (N qdd)_m`` and
+    ``N[m, j] F_m(wm_m)``, ``F_m`` the registry's viscous and Coulomb columns at smoothing
+    ``smoothing[m]`` (rad/s, motor side).
+    """
+    wm, dwm = motor_speed(robot, qd), motor_speed(robot, qdd)  # rad/s, rad/s^2
+    friction = [
+        friction_columns(_FRICTION, {"viscous": 0.0, "coulomb": 0.0, "smoothing": s}, wm[:, m])
+        for m, s in enumerate(smoothing)
+    ]  # each (N, 2): viscous, Coulomb
+    motor = np.concatenate([dwm[:, None, :], np.stack(friction, axis=2)], axis=1)  # (N, 3, n)
+    reach = np.tile(transmission_matrix(robot).T, 3)  # [j, k n + m] = N[m, j]
+    return reach[None, :, :] * motor.reshape(len(wm), 1, -1)
+
+
+def _independent_drive_columns(
+    robot: Robot, base: BaseParameters, smoothing: Array
+) -> NDArray[np.intp]:
+    """Indices (into the 3 n drive columns) not in the span of the link base columns and of each
+    other (Gautier's pivoted QR rank), on seeded random states (the states
+    :func:`base_parameters` uses)."""
+    rng = np.random.default_rng(0)
+    lo = np.array([max(j.limits.position[0], -np.pi) for j in robot.joints])
+    hi = np.array([min(j.limits.position[1], np.pi) for j in robot.joints])
+    q = rng.uniform(lo, hi, (300, robot.n))
+    qd = rng.standard_normal((300, robot.n))
+    qdd = rng.standard_normal((300, robot.n))
+    link = base.regressor(regressor(robot, q, qd, qdd)).reshape(-1, base.size)
+    extra = _drive_columns(robot, smoothing, qd, qdd).reshape(-1, 3 * robot.n)
+    basis, _ = scipy.linalg.qr(link / column_scale(link), mode="economic")
+    extra = extra / column_scale(extra)
+    rest = extra - basis @ (basis.T @ extra)
+    return pivoted_rank(rest, atol=_DEPENDENT_TOL).independent
+
+
+@dataclass(frozen=True, eq=False)
+class ExcitationRegression:
+    """The columns of ``W`` (module docstring) for a robot.
+
+    Attributes
+    ----------
+    robot : Robot
+    base : BaseParameters
+        The link base parameters.
+    drive_columns : ndarray of int
+        The drive columns in ``W``, indices into [rotor inertia, viscous, Coulomb] x motors.
+    smoothing : ndarray, shape (n,)
+        Each motor's Coulomb smoothing speed, rad/s, motor side.
+    """
+
+    robot: Robot
+    base: BaseParameters = field(repr=False)
+    drive_columns: NDArray[np.intp]
+    smoothing: Array = field(repr=False)
+
+    @property
+    def size(self) -> int:
+        """Columns of ``W``: link base parameters plus the independent drive columns."""
+        return self.base.size + int(self.drive_columns.size)
+
+    def matrix(self, q: Array, qd: Array, qdd: Array) -> Array:
+        """``W`` for states (N, n): (N, n, size), link base columns then drive columns."""
+        link = self.base.regressor(regressor(self.robot, q, qd, qdd))
+        if self.drive_columns.size == 0:
+            return link
+        drives = _drive_columns(self.robot, self.smoothing, qd, qdd)[..., self.drive_columns]
+        return np.concatenate([link, drives], axis=2)
+
+    def flat(self, q: Array, qd: Array, qdd: Array) -> Array:
+        """``W`` for states (N, n) as (N n, size), rows (sample, joint)."""
+        return self.matrix(q, qd, qdd).reshape(q.size, -1)
+
+    def criterion_gradient(
+        self, q: Array, qd: Array, qdd: Array, kind: str
+    ) -> tuple[float, Array, float]:
+        """The criterion of ``W`` on the states (N, n), its gradient with respect to them
+        (3, N, n: ``q``, ``qd``, ``qdd``) and the condition number.
+
+        The regressor's derivatives are forward differences: every sample's ``q``, ``qd`` or
+        ``qdd`` of one joint pushed by one step at once (``1 + 3 n`` regressor batches in one).
+        """
+        big_n, n = q.shape
+        stack = np.empty((1 + 3 * n, 3, big_n, n))
+        stack[:] = np.stack([q, qd, qdd])[None]
+        for kind_x in range(3):
+            for j in range(n):
+                stack[1 + kind_x * n + j, kind_x, :, j] += _FD_STEP
+        flat = stack.transpose(1, 0, 2, 3).reshape(3, -1, n)
+        w_all = self.matrix(flat[0], flat[1], flat[2]).reshape(1 + 3 * n, big_n, n, -1)
+        w0 = w_all[0]
+        value, grad_w, cond = criterion(w0.reshape(big_n * n, -1), kind)
+        grad_w = grad_w.reshape(w0.shape)
+        # dF/dx[s, j] for x in (q, qd, qdd): sum over rows of sample s and columns
+        sens = np.einsum("sik,xsik->xs", grad_w, w_all[1:] - w0[None]) / _FD_STEP
+        return value, sens.reshape(3, n, big_n).transpose(0, 2, 1), cond
+
+
+def excitation_regression(robot: Robot, *, include_drives: bool = True) -> ExcitationRegression:
+    """The columns of ``W`` for ``robot``: its link base parameters and, with ``include_drives``,
+    the rotor-inertia and friction columns no trajectory confounds with them."""
+    smoothing = np.abs(np.diag(transmission_matrix(robot))) * COULOMB_SMOOTHING
+    smoothing = np.where(smoothing > 0, smoothing, COULOMB_SMOOTHING)
+    base = base_parameters(robot)
+    drives = (
+        _independent_drive_columns(robot, base, smoothing)
+        if include_drives
+        else np.zeros(0, dtype=np.intp)
+    )
+    return ExcitationRegression(robot, base, drives, smoothing)
+
+
+def criterion(w: Array, kind: str) -> tuple[float, Array, float]:
+    """Criterion of the column-scaled ``w`` (rows, m), its gradient with respect to ``w``, and
+    the condition number.
+
+    ``"cond"``: ``log cond(W_s) = (log lambda_max - log lambda_min) / 2`` of ``G = W_s^T W_s``;
+    ``"dopt"``: ``-log det G``. With ``W_s = W D^-1`` (``D`` the column norms) and ``Phi`` the
+    gradient with respect to ``W_s``, the gradient with respect to ``W`` is, column by column,
+    ``(Phi_k - (Phi_k . W_s,k) W_s,k) / d_k`` (the scaling moves with ``W``).
+    """
+    d = column_scale(w)
+    ws = w / d
+    # einsum and SciPy's LAPACK: on a busy machine numpy's threaded BLAS and eigh wait tens of
+    # milliseconds for their worker threads in every call of the optimisation loop
+    lam, vec = scipy.linalg.eigh(np.einsum("ij,ik->jk", ws, ws))
+    lam = np.maximum(lam, 1e-300 * max(float(lam[-1]), 1e-300))
+    if kind == "cond":
+        value = 0.5 * float(np.log(lam[-1]) - np.log(lam[0]))
+        hi, lo = vec[:, -1], vec[:, 0]
+        phi = np.outer(ws @ hi, hi) / lam[-1] - np.outer(ws @ lo, lo) / lam[0]
+    else:
+        value = -float(np.sum(np.log(lam)))
+        phi = -2.0 * np.einsum("ij,jk->ik", ws, (vec / lam) @ vec.T)
+    grad = (phi - ws * np.sum(phi * ws, axis=0)) / d
+    return value, grad, float(np.sqrt(lam[-1] / lam[0]))
+
+
+def scaled_condition(w: Array) -> tuple[float, float]:
+    """Condition number and ``-log det(W_s^T W_s)`` of the column-scaled ``w`` (rows, m), from
+    its singular values (inf when rank deficient)."""
+    s = scipy.linalg.svdvals(w / column_scale(w))
+    if s[-1] <= 0:
+        return float("inf"), float("inf")
+    return float(s[0] / s[-1]), float(-2.0 * np.sum(np.log(s)))

@@ -1,0 +1,59 @@
+"""``power_law``: Coulomb friction plus a speed term that grows as a power of the motor speed:
+``(coulomb + viscous |wm|^exponent) tanh(wm / smoothing)``.
+
+With ``exponent`` 1 this is ``viscous_coulomb``; real harmonic-drive joints are concave in speed:
+a UR5e's factory calibration (``datasets/ur5e-calibration``) follows it with exponents 0.52-0.65
+on every joint, where a straight line is 6-30 % off (docs/FRICTION.md). The model is linear in
+``coulomb`` and ``viscous`` for a fixed exponent; fits find the exponent by a 1-D search
+(:attr:`~kinergy.friction.model.FrictionModel.search`).
+
+Units (motor side): ``coulomb`` N m, ``viscous`` N m (s/rad)^exponent, ``exponent`` 1,
+``smoothing`` rad/s.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kinergy.friction.model import FrictionModel
+from kinergy.friction.viscous_coulomb import sign
+
+__all__ = ["MODEL", "speed_power"]
+
+Array = NDArray[np.float64]
+
+
+def speed_power(wm: Array, exponent: float) -> Array:
+    """``|wm|^exponent`` (rad/s to the power), shape like ``wm``: the speed term of the power-law
+    models."""
+    return np.asarray(np.abs(wm) ** exponent, dtype=float)
+
+
+def _torque(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
+    return (p["coulomb"] + p["viscous"] * speed_power(wm, p["exponent"])) * sign(wm, p["smoothing"])
+
+
+def _columns(
+    p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
+) -> Array:
+    s = sign(wm, p["smoothing"])
+    return np.column_stack([s, s * speed_power(wm, p["exponent"])])
+
+
+MODEL = FrictionModel(
+    name="power_law",
+    parameters=("coulomb", "viscous", "exponent", "smoothing"),
+    torque=_torque,
+    linear=("coulomb", "viscous"),
+    columns=_columns,
+    positive=frozenset({"smoothing", "exponent"}),
+    bounds={"coulomb": (0.0, np.inf), "viscous": (0.0, np.inf)},
+    shape_defaults={"smoothing": 1e-3, "exponent": 0.6},
+    search={"exponent": (0.2, 1.5)},
+    citation="power-law speed term (docs/FRICTION.md; fitted to a UR5e's factory calibration)",
+)

@@ -1,0 +1,99 @@
+"""The arm's supply: the bus model (motors shared on the DC bus, surplus to the shunt, standby),
+the measured supply energy of a log beside the predicted one, and the electrics fit that keeps
+the logged current's noise out of the resistance."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import kinergy
+from kinergy.accounting.supply import measured_supply, supply_energy
+from kinergy.cli import main
+from kinergy.drives.bus import supply_power
+from kinergy.identify.electrics import fit_electrics
+from kinergy.io.rtde import write_log
+from kinergy.simulate import TwinSettings, simulate
+from kinergy.trajectory.programs import paper_trajectory
+from kinergy.workflows.energy import energy_of_log
+
+
+def test_joints_share_the_bus_and_the_surplus_goes_to_the_shunt() -> None:
+    power = np.array([[100.0, -30.0], [20.0, -50.0], [-10.0, -5.0]])
+    bus = supply_power(power, standby=12.0)
+    assert bus.bus.tolist() == [70.0, -30.0, -15.0]
+    assert bus.motors.tolist() == [70.0, 0.0, 0.0]
+    assert bus.shunt.tolist() == [0.0, 30.0, 15.0]
+    assert bus.supply.tolist() == [82.0, 12.0, 12.0]
+
+
+def test_supply_energy_of_constant_powers_is_closed_form() -> None:
+    t = np.linspace(0.0, 10.0, 501)
+    power = np.column_stack([np.full(t.size, 40.0), np.where(t < 5.0, 10.0, -60.0)])
+    e = supply_energy(t, power, standby_power=20.0)
+    assert e.standby == pytest.approx(200.0)
+    # 50 W for 5 s, then -20 W (to the shunt) for 5 s; the step is one sample wide
+    assert e.motors == pytest.approx(250.0, abs=2.0)
+    assert e.shunt == pytest.approx(100.0, abs=2.0)
+    assert e.drawn == pytest.approx(e.motors + e.standby)
+    assert e.mean_power == pytest.approx(e.drawn / 10.0)
+    assert "shunt" in e.includes and "standby" in e.includes
+    m = measured_supply(t, np.full(t.size, 48.0), np.full(t.size, 2.0))
+    assert m.drawn == pytest.approx(960.0) and m.mean_power == pytest.approx(96.0)
+    assert "actual_robot_voltage" in m.includes
+
+
+@pytest.fixture(scope="module")
+def exact_log(tmp_path_factory: pytest.TempPathFactory, ur5e: kinergy.Robot) -> Path:
+    path = tmp_path_factory.mktemp("supply") / "a.csv"
+    # the model itself is the truth
+    twin = simulate(ur5e, paper_trajectory(ur5e, "test-a", dt=0.004), TwinSettings.exact())
+    write_log(path, twin.t, twin.signals)
+    return path
+
+
+def test_exact_twin_supply_is_predicted_exactly(ur5e: kinergy.Robot, exact_log: Path) -> None:
+    report = energy_of_log(ur5e, exact_log)
+    assert report.measured is not None
+    assert report.supply.drawn == pytest.approx(report.measured.drawn, rel=1e-6)
+    # with braking surplus in the shunt the supply draws more than the signed bus integral
+    assert report.supply.shunt > 0.0
+    assert report.supply.motors == pytest.approx(
+        report.total_e_elec + report.supply.shunt, rel=1e-6
+    )
+    out = report.to_dict()
+    assert abs(out["measured"]["error"]) < 1e-4
+    assert {"drawn", "motors", "standby", "shunt", "includes"} <= set(out["supply"])
+
+
+def test_cli_energy_prints_predicted_against_measured(
+    ur5e: kinergy.Robot, exact_log: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["energy", "ur5e", str(exact_log)]) == 0
+    text = capsys.readouterr().out
+    assert "Drawn from the arm's supply" in text and "Measured by the log" in text
+    assert "predicted: " in text and "measured: " in text and "not the control box" in text
+    # a log without supply columns: only the prediction, saying what it includes
+    motion = tmp_path / "m.csv"
+    twin = simulate(ur5e, paper_trajectory(ur5e, "test-b", dt=0.004), TwinSettings.exact())
+    write_log(motion, twin.t, {k: twin[k] for k in ("target_q", "actual_q", "actual_qd")})
+    assert main(["energy", "ur5e", str(motion), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert "measured" not in out and out["supply"]["drawn"] > 0
+
+
+def test_the_instrument_keeps_current_noise_out_of_the_resistance() -> None:
+    rng = np.random.default_rng(4)
+    t = np.linspace(0.0, 20.0, 10_000)
+    wm = 40.0 * np.sin(0.7 * t)
+    current = 0.3 * np.sin(1.3 * t + 0.4) + 0.1 * np.sign(wm)
+    voltage = 1.3 * current + 0.083 * wm
+    noisy = current + 0.1 * rng.standard_normal(t.size)
+    ols = fit_electrics(noisy, voltage, wm)
+    iv = fit_electrics(noisy, voltage, wm, instrument=current)
+    assert ols.resistance < 1.3 * 0.95  # errors in variables: ordinary least squares is low
+    assert iv.resistance == pytest.approx(1.3, rel=0.01)
+    assert iv.back_emf == pytest.approx(0.083, rel=0.01)
