@@ -95,7 +95,7 @@ def test_parquet_rows_add_up(result):
         assert rows["measured"].sum() == pytest.approx(by[name]["energy_J"], rel=1e-9)
         assert rows["predicted"].sum() == pytest.approx(by[name]["predicted_J"], rel=1e-9)
         assert len(rows[rows["cycle"] >= 0]) == by[name]["cycles"]
-    parts = table[["inertial", "gravity", "friction", "copper", "standby"]].sum(axis=1)
+    parts = table[["inertial", "gravity", "friction", "copper", "standby", "shunt"]].sum(axis=1)
     np.testing.assert_allclose(parts, table["predicted"], rtol=1e-9, atol=1e-9)
     unworn = table[table["robot"] == "robot-01"]
     np.testing.assert_allclose(unworn["predicted"], unworn["measured"], rtol=0.02)

@@ -45,6 +45,7 @@ def _log(robot: str, day: int, level: float, work: float) -> tuple[FleetLog, Log
             friction=0.25 * level * w,
             copper=0.1 * level,
             standby=0.14 * level,
+            shunt=0.0,
             motor_work=work * w,
         )
         for k, w in enumerate(wobble)

@@ -7,7 +7,9 @@ figures, never the log's arrays. For each segment of the log (:mod:`kinergy.io.s
    a segment with no repeat is one row covering it;
 2. the model over the logged motion (:func:`kinergy.accounting.energy.energy`): the joints'
    electrical power (UR5e eq 23) split into inertial, gravity, friction and copper parts
-   (framework Fig. 4), plus standby; summed over the joints this is the predicted supply power;
+   (framework Fig. 4), plus standby; on the DC bus the joints share power and a braking surplus
+   is burnt in the shunt (:func:`kinergy.drives.bus.supply_power`): the predicted supply power
+   is the parts plus that shunt power;
 3. the measured supply power ``actual_robot_voltage * actual_robot_current``, when logged;
 4. the measured motor work ``sum_j k_t,j I_j wm_j`` from ``actual_current`` and ``actual_qd``
    (UR5e eqs 17, 25): over a whole cycle the load's work nets to zero (the arm ends where it
@@ -32,6 +34,7 @@ from numpy.typing import NDArray
 from scipy.integrate import cumulative_trapezoid
 
 from kinergy.accounting.energy import energy
+from kinergy.drives.bus import supply_power
 from kinergy.drives.electrics import torque_constants
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.dynamics.threads import kernel_threads
@@ -71,6 +74,7 @@ class CycleRecord:
     friction: float
     copper: float
     standby: float
+    shunt: float
     motor_work: float | None
 
 
@@ -120,10 +124,12 @@ def _robot(model: str) -> Robot:
 def _powers(robot: Robot, part: Log) -> dict[str, Array | None]:
     """Power over time of every figure a cycle row holds (W, shape (N,))."""
     report = energy(robot, motion_from_log(part, n_joints=robot.n))
+    bus = supply_power(report.p_elec, robot.standby_power)
     powers: dict[str, Array | None] = {
-        "predicted": report.p_elec.sum(axis=1) + robot.standby_power,
+        "predicted": bus.supply,
         **{k: report.part_power[k].sum(axis=1) for k in PARTS},
         "standby": np.full(len(part), robot.standby_power),
+        "shunt": bus.shunt,
         "measured": None,
         "motor_work": None,
     }
@@ -168,6 +174,7 @@ def _segment_cycles(
                 friction=value["friction"],
                 copper=value["copper"],
                 standby=value["standby"],
+                shunt=value["shunt"],
                 motor_work=value.get("motor_work"),
             )
         )

@@ -14,7 +14,8 @@ __all__ = ["COLUMNS", "write_cycles"]
 #: the table's columns: who, when, which cycle, and its energies (J) and times (s)
 COLUMNS = (
     "robot", "log", "date", "program", "segment", "cycle", "start", "duration", "measured",
-    "predicted", "inertial", "gravity", "friction", "copper", "standby", "motor_work",
+    "predicted", "inertial", "gravity", "friction", "copper", "standby", "shunt",
+    "motor_work",
 )  # fmt: skip
 
 
@@ -22,7 +23,7 @@ def write_cycles(path: str | os.PathLike[str], rows: Sequence[dict[str, object]]
     """Write one row per cycle (:func:`kinergy.fleet.summary.cycles_table`) to ``path``.
 
     Energies are J (supply side: ``measured`` from the logged supply, ``predicted`` by the
-    model, its ``inertial``/``gravity``/``friction``/``copper`` parts and ``standby``;
+    model: its ``inertial``/``gravity``/``friction``/``copper`` parts, ``standby`` and ``shunt``;
     ``motor_work`` from the currents), ``start`` is controller time and ``duration`` s; ``cycle``
     is -1 for a stretch with no repeating program. Missing measurements are nulls.
     """

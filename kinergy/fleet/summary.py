@@ -228,7 +228,9 @@ def _robot(name: str, model: str, logs: list[LogResult], min_rise: float) -> Rob
         energy_J=predicted if measured is None else measured,
         measured_J=measured,
         predicted_J=predicted,
-        breakdown_J={k: float(sum(getattr(c, k) for c in cycles)) for k in (*PARTS, "standby")},
+        breakdown_J={
+            k: float(sum(getattr(c, k) for c in cycles)) for k in (*PARTS, "standby", "shunt")
+        },
         drift=any(p.energy_drift or p.friction_drift for p in programs),
         changes=sorted(changes, key=lambda c: (c.date, c.metric)),
         programs=programs,

@@ -11,8 +11,9 @@ as they come and
    period of where it is expected), so cycles do not drift by a fraction of a sample each;
 3. for each cycle, integrates the measured supply power ``actual_robot_voltage *
    actual_robot_current`` (when the controller logs them) and predicts the energy the model
-   draws for the cycle's commanded motion: the joints' electrical power on the DC bus plus
-   standby, signed (UR5e eqs 23, 26; :func:`kinergy.accounting.energy.energy`).
+   draws for the cycle's commanded motion: the joints' electrical power (UR5e eq 23) shared on
+   the DC bus, braking surplus burnt in the shunt, plus standby (``supply.drawn`` of
+   :func:`kinergy.accounting.energy.energy`).
 
 A gap in the stream (a reconnection) drops the cycle in progress; the next cycle starts at the
 first re-aligned boundary after it.
@@ -62,7 +63,7 @@ class CycleEnergy:
     measured : float or None
         Supply energy ``int V I dt``, J; None when the supply is not logged.
     predicted : float
-        The model's supply-side energy of the commanded motion (bus plus standby), J.
+        The model's supply energy of the commanded motion (bus model plus standby), J.
     """
 
     index: int
@@ -231,5 +232,5 @@ class CycleTracker:
             start=float(t[0]),
             duration=float(t[-1] - t[0]),
             measured=measured,
-            predicted=float(report.total_e_elec + report.standby),
+            predicted=report.supply.drawn,
         )

@@ -24,7 +24,7 @@ from kinergy.report.plots import save
 
 __all__ = ["fleet_figure", "robot_figure", "write_fleet_report"]
 
-_PARTS = ("inertial", "gravity", "friction", "copper", "standby")
+_PARTS = ("inertial", "gravity", "friction", "copper", "standby", "shunt")
 
 
 def _canvas(width: float, height: float, rows: int = 1) -> tuple[MplFigure, list]:
@@ -103,7 +103,7 @@ def _overview(result: FleetResult) -> Section:
         "Where the energy goes (model), per robot",
         ["Robot", *(f"{k} [kJ]" for k in _PARTS)],
         parts,
-        note="Joint electrical energy split as in framework Fig. 4, plus standby.",
+        note="Joint electrical energy split as in framework Fig. 4, plus standby and the braking surplus burnt in the shunt.",
     )
     drifting = [r.name for r in result.robots if r.drift] or ["none"]
     text = (
