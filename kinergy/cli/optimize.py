@@ -12,13 +12,15 @@ from collections.abc import Sequence
 
 import click
 
-from kinergy.cli.common import load, payload_option, table
+from kinergy.cli.common import load, payload_option, progress, table
 from kinergy.errors import KinergyError
 from kinergy.jsonable import dumps
 from kinergy.optimize import ParetoPoint, ProgramResult, TimingResult
+from kinergy.optimize.programs import Lever, supply
 from kinergy.workflows.optimize import OptimizeRun, run_optimize
+from kinergy.workflows.optimize_program import ProgramRun, run_program_optimize
 
-__all__ = ["optimize", "optimize_text"]
+__all__ = ["optimize", "optimize_text", "program_text"]
 
 _PARTS = ("friction", "copper", "inertial", "gravity")
 
@@ -142,6 +144,54 @@ def optimize_text(run: OptimizeRun) -> str:
     return "\n".join(lines)
 
 
+def _levers_table(levers: Sequence[Lever]) -> str:
+    rows = [
+        [
+            lv.name,
+            f"{lv.result.cycle_time:.3f}",
+            f"{supply(lv.result):.1f}",
+            f"{lv.result.e_elec:.1f}",
+            "yes" if lv.result.ok else "NO",
+            "yes" if lv.kept else "no",
+            lv.note,
+        ]
+        for lv in levers
+    ]
+    return table(
+        ["lever", "cycle [s]", "supply [J]", "motors [J]", "limits ok", "used", "note"], rows
+    )
+
+
+def program_text(run: ProgramRun) -> str:
+    """The ``optimize`` report of a URScript program: per move, per lever, the targets."""
+    result = run.result
+    own, opt = result.program.result, result.optimized.result
+    name = result.program.path.program.name
+    stops = [c for c in result.targets if c.stop]
+    lines = [
+        f"{run.robot.name}, program {name}: {own.speeds.size} moves, cycle time "
+        f"{opt.cycle_time:.3f} s (program as written {own.cycle_time:.3f} s)",
+        "",
+        "Per move: the program as written and the optimum (energies re-simulated at 500 Hz)",
+        _moves_table(own, opt),
+        "",
+        "Levers, each on the program before it, at the cycle time (supply energy: motors on the "
+        "DC bus, braking surplus lost, plus standby; model-predicted)",
+        _levers_table(result.levers),
+        "",
+        f"Saving: {100 * result.saving:.1f} % of the supply energy ({supply(own):.1f} J -> "
+        f"{supply(opt):.1f} J); the written program read back and simulated again: "
+        f"{run.readback:.1f} J ({100 * (run.readback / supply(opt) - 1.0):+.2f} %)",
+        f"Targets: {len(stops)} stops, worst {1e3 * max(c.distance for c in stops):.3f} mm, "
+        f"{math.degrees(max(c.angle for c in stops)):.3f} deg, joint speed "
+        f"{max(c.speed for c in stops):.2g} rad/s; "
+        + ("all met" if result.targets_met else "NOT all met (1 mm, 0.5 deg, at rest)"),
+        f"Within limits: {'yes' if opt.ok else 'NO: ' + '; '.join(opt.check.violations())}",
+    ]
+    lines += [f"note: {n}" for n in run.notes]
+    return "\n".join(lines)
+
+
 @click.command()
 @click.argument("model", metavar="MODEL")
 @click.argument("task_name", metavar="TASK")
@@ -194,6 +244,36 @@ def optimize_text(run: OptimizeRun) -> str:
     is_flag=True,
     help="Keep each move's share of the cycle time; choose only speeds and accelerations.",
 )
+@click.option(
+    "--configurations",
+    type=click.Choice(["keep", "free"]),
+    default="keep",
+    show_default=True,
+    help="URScript programs: the IK branch of a movej's pose target (free: any of the eight).",
+)
+@click.option(
+    "--tool-symmetry",
+    "tool_symmetry",
+    type=click.Choice(["none", "z", "z2", "z4"]),
+    default="none",
+    show_default=True,
+    help="URScript programs: the tool may turn about its z axis (any angle, 180 or 90 deg).",
+)
+@click.option("--no-blends", is_flag=True, help="URScript programs: no blend radii on via points.")
+@click.option(
+    "--standby",
+    type=click.FloatRange(min=0.0),
+    default=None,
+    help="URScript programs: standby power (W) counted over the cycle time [default: the robot "
+    "file's].",
+)
+@click.option(
+    "--motions",
+    type=click.Path(file_okay=False),
+    default=None,
+    metavar="DIR",
+    help="URScript programs: write program.csv and optimized.csv (500 Hz) to this folder.",
+)
 def optimize(
     model: str,
     task_name: str,
@@ -206,17 +286,44 @@ def optimize(
     a_max: float | None,
     points: int,
     fixed_shares: bool,
+    configurations: str,
+    tool_symmetry: str,
+    no_blends: bool,
+    standby: float | None,
+    motions: str | None,
 ) -> None:
     """Energy-optimal speeds and accelerations of a movej program at a cycle time.
 
-    MODEL is a built-in robot or a model file; TASK a task file (TOML: the movej's waypoints)
-    or test-a / test-b (the UR5e doc's test programs). Compares the optimum with the program as
-    written and with uniform time scaling to the same cycle time, all re-simulated at 500 Hz
-    with every speed, acceleration, torque and position limit checked at every sample.
+    MODEL is a built-in robot or a model file; TASK a task file (TOML: the movej's waypoints),
+    test-a / test-b (the UR5e doc's test programs), or a URScript program (*.script: its path
+    as well, with the levers --configurations, --tool-symmetry and blends). Compares the optimum
+    with the program as written and with uniform time scaling to the same cycle time, all
+    re-simulated at 500 Hz with every speed, acceleration, torque and position limit checked at
+    every sample.
     """
     budget = _cycle_time(cycle_time)
     _positive("--v-max", v_max)
     _positive("--a-max", a_max)
+    if task_name.endswith(".script"):
+        program = run_program_optimize(
+            load(model, payload),
+            task_name,
+            urscript=urscript,
+            motions=motions,
+            progress=progress(),
+            configurations=configurations,
+            tool_symmetry=tool_symmetry,
+            blends=not no_blends,
+            standby=standby,
+            cycle_time=budget,
+            v_max=v_max,
+            a_max=a_max,
+        )
+        click.echo(dumps(program.to_dict()) if as_json else program_text(program))
+        if not as_json:
+            for path in program.written:
+                click.echo(f"wrote {path}")
+        return
     if plot is not None and points < 2:
         raise KinergyError("--plot: needs a Pareto front (--pareto-points of at least 2)")
     run = run_optimize(

@@ -12,6 +12,17 @@ Geometry (see :mod:`kinergy.dynamics.chain`): the pose of link frame F_i in F_{i
 Joint i's motion subspace in F_i is ``S_i = (axis_i, axis_v_i)`` (angular, linear parts).
 Spatial quantities are (angular, linear) pairs expressed at the origin of F_i; gravity enters as a
 fictitious upward acceleration of the base (UR5e section 3.1).
+
+Argument groups (tuples, so each kernel's signature stays short):
+
+- ``geo = (A, B, C, pa, pb, pc, axis, axis_v)``: :func:`kinergy.dynamics.chain.kernel_geometry`;
+- ``body = (mass, first, inertia)``: (n,), (n, 3) ``m c``, (n, 3, 3) about the link origins;
+- ``ends = (base_rot, flange_pos, g0)``: (3, 3), (3,), (3,) gravity in frame 0;
+- ``state = (q, qd, qdd)``: (N, n) each.
+
+The ``*_rows`` functions fill rows ``lo:hi`` serially (called directly for small N); the
+``*_kernel`` functions split the samples over numba's threads. All stay ``fastmath=False``: a
+fresh compile and the on-disk cache must give the same bits.
 """
 
 from __future__ import annotations
@@ -22,7 +33,15 @@ from numpy.typing import NDArray
 
 Array = NDArray[np.float64]
 
-__all__ = ["regressor_kernel", "rnea_kernel"]
+__all__ = [
+    "GRADIENT_CHUNK",
+    "regressor_gradient_kernel",
+    "regressor_gradient_rows",
+    "regressor_kernel",
+    "regressor_rows",
+    "rnea_kernel",
+    "rnea_rows",
+]
 
 
 @njit(cache=True, fastmath=False, inline="always")
@@ -34,48 +53,44 @@ def _cross(a: Array, b: Array, out: Array) -> None:
 
 
 @njit(cache=True, fastmath=False, inline="always")
-def _motion_pass(
-    geo: tuple[Array, Array, Array, Array, Array, Array, Array, Array],
-    g0: Array,
-    q: Array,
-    qd: Array,
-    qdd: Array,
-    rot: Array,
-    pos: Array,
-    omega: Array,
-    vel: Array,
-    alpha: Array,
-    acl: Array,
-    work: Array,
-) -> None:
+def _rot_t(rot: Array, x: Array, r: int) -> float:
+    """Component r of ``R^T x``."""
+    return rot[0, r] * x[0] + rot[1, r] * x[1] + rot[2, r] * x[2]
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _rot(rot: Array, x: Array, r: int) -> float:
+    """Component r of ``R x``."""
+    return rot[r, 0] * x[0] + rot[r, 1] * x[1] + rot[r, 2] * x[2]
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _link_pose(geo, i: int, q: float, rot: Array, pos: Array) -> None:
+    """Pose of F_i in F_{i-1} at joint angle ``q``: fills rot[i] (3, 3) and pos[i] (3,)."""
+    a_mat, b_mat, c_mat, pa, pb, pc = geo[0], geo[1], geo[2], geo[3], geo[4], geo[5]
+    c = np.cos(q)
+    s = np.sin(q)
+    for r in range(3):
+        pos[i, r] = c * pa[i, r] + s * pb[i, r] + pc[i, r]
+        for k in range(3):
+            rot[i, r, k] = c * a_mat[i, r, k] + s * b_mat[i, r, k] + c_mat[i, r, k]
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _motion_pass(geo, g0, q, qd, qdd, rot, pos, omega, vel, alpha, acl, work) -> None:
     """Forward recursion for one sample: fills rot, pos (n,3,3), (n,3) and the link velocities
     omega, vel, accelerations alpha and classical linear acceleration acl (n, 3) in F_i.
     ``work`` is scratch space of shape (9, 3)."""
-    a_mat, b_mat, c_mat, pa, pb, pc, axis, axis_v = geo
-    n = q.shape[0]
-    w_p, v_p, al_p, ac_p, t1, t2, sw, sv, ac = (
-        work[0],
-        work[1],
-        work[2],
-        work[3],
-        work[4],
-        work[5],
-        work[6],
-        work[7],
-        work[8],
-    )
+    axis, axis_v = geo[6], geo[7]
+    w_p, v_p, al_p, ac_p, t1 = work[0], work[1], work[2], work[3], work[4]
+    t2, sw, sv, ac = work[5], work[6], work[7], work[8]
     for r in range(3):
         w_p[r] = 0.0
         v_p[r] = 0.0
         al_p[r] = 0.0
         ac_p[r] = -g0[r]
-    for i in range(n):
-        c = np.cos(q[i])
-        s = np.sin(q[i])
-        for r in range(3):
-            pos[i, r] = c * pa[i, r] + s * pb[i, r] + pc[i, r]
-            for k in range(3):
-                rot[i, r, k] = c * a_mat[i, r, k] + s * b_mat[i, r, k] + c_mat[i, r, k]
+    for i in range(q.shape[0]):
+        _link_pose(geo, i, q[i], rot, pos)
         # t1 = v_p + w_p x p ; t2 = ac_p + al_p x p   (spatial transform, parent coordinates)
         _cross(w_p, pos[i], t1)
         _cross(al_p, pos[i], t2)
@@ -85,22 +100,10 @@ def _motion_pass(
             sw[r] = axis[i, r] * qd[i]
             sv[r] = axis_v[i, r] * qd[i]
         for r in range(3):  # rotate into F_i with R^T
-            omega[i, r] = (
-                rot[i, 0, r] * w_p[0] + rot[i, 1, r] * w_p[1] + rot[i, 2, r] * w_p[2] + sw[r]
-            )
-            vel[i, r] = rot[i, 0, r] * t1[0] + rot[i, 1, r] * t1[1] + rot[i, 2, r] * t1[2] + sv[r]
-            alpha[i, r] = (
-                rot[i, 0, r] * al_p[0]
-                + rot[i, 1, r] * al_p[1]
-                + rot[i, 2, r] * al_p[2]
-                + axis[i, r] * qdd[i]
-            )
-            ac[r] = (
-                rot[i, 0, r] * t2[0]
-                + rot[i, 1, r] * t2[1]
-                + rot[i, 2, r] * t2[2]
-                + axis_v[i, r] * qdd[i]
-            )
+            omega[i, r] = _rot_t(rot[i], w_p, r) + sw[r]
+            vel[i, r] = _rot_t(rot[i], t1, r) + sv[r]
+            alpha[i, r] = _rot_t(rot[i], al_p, r) + axis[i, r] * qdd[i]
+            ac[r] = _rot_t(rot[i], t2, r) + axis_v[i, r] * qdd[i]
         # velocity-product terms: v_i x_m (S_i qd_i)
         _cross(omega[i], sw, t1)
         for r in range(3):
@@ -109,7 +112,6 @@ def _motion_pass(
         _cross(vel[i], sw, t2)
         for r in range(3):
             ac[r] += t1[r] + t2[r]
-        for r in range(3):
             w_p[r] = omega[i, r]
             v_p[r] = vel[i, r]
             al_p[r] = alpha[i, r]
@@ -119,134 +121,184 @@ def _motion_pass(
             acl[i, r] = ac[r] + t1[r]
 
 
-@njit(cache=True, fastmath=False)
-def _rnea_chunk(
-    lo: int,
-    hi: int,
-    geo: tuple[Array, Array, Array, Array, Array, Array, Array, Array],
-    base_rot: Array,
-    flange_pos: Array,
-    g0: Array,
-    mass: Array,
-    first: Array,
-    inertia: Array,
-    q: Array,
-    qd: Array,
-    qdd: Array,
-    wrench: Array,
-    use_wrench: bool,
-    tau: Array,
-) -> None:
-    """Fill rows lo:hi of ``tau`` (N, n) with the joint torques for states (N, n); ``inertia``
-    about the link origins (n, 3, 3)."""
+@njit(cache=True, fastmath=False, inline="always")
+def _link_wrench(body, i, omega, alpha, acl, force, moment, work) -> None:
+    """Link i's wrench at its origin (UR5e eqs 5-6): force = m acl + alpha x h + w x (w x h),
+    moment = I alpha + w x (I w) + h x acl, into force[i], moment[i]."""
+    mass, first, inertia = body
+    t1, t2, iw = work[0], work[1], work[2]
+    h = first[i]
+    _cross(alpha[i], h, t1)
+    _cross(omega[i], h, t2)
+    _cross(omega[i], t2, iw)
+    for r in range(3):
+        force[i, r] = mass[i] * acl[i, r] + t1[r] + iw[r]
+    for r in range(3):
+        t1[r] = _rot(inertia[i], omega[i], r)
+    _cross(omega[i], t1, t2)
+    _cross(h, acl[i], iw)
+    for r in range(3):
+        moment[i, r] = _rot(inertia[i], alpha[i], r) + t2[r] + iw[r]
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _flange_wrench(ends, rot, h, force, moment, work) -> None:
+    """Add the wrench ``h`` (6,) the flange exerts (base-frame coordinates) to the last link's
+    force and moment: rotated into F_n, its moment carried to F_n's origin."""
+    base_rot, flange_pos = ends[0], ends[1]
+    n = rot.shape[0]
+    world, tmp = work[3:6], work[6:9]
+    t1, t2, iw = work[0], work[1], work[2]
+    world[:, :] = base_rot
+    for i in range(n):
+        for r in range(3):
+            for c in range(3):
+                tmp[r, c] = _rot(world, rot[i, :, c], r)
+        world[:, :] = tmp
+    for r in range(3):
+        t1[r] = _rot_t(world, h[0:3], r)
+        t2[r] = _rot_t(world, h[3:6], r)
+    _cross(flange_pos, t1, iw)
+    for r in range(3):
+        force[n - 1, r] += t1[r]
+        moment[n - 1, r] += t2[r] + iw[r]
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _backward_pass(geo, rot, pos, force, moment, tau, work) -> None:
+    """Joint torques ``tau`` (n,) from the link wrenches, each carried into its parent."""
     axis, axis_v = geo[6], geo[7]
-    n = q.shape[1]
-    rot = np.empty((n, 3, 3))
-    pos = np.empty((n, 3))
-    omega = np.empty((n, 3))
-    vel = np.empty((n, 3))
-    alpha = np.empty((n, 3))
-    acl = np.empty((n, 3))
-    force = np.empty((n, 3))
-    moment = np.empty((n, 3))
-    t1 = np.zeros(3)
-    t2 = np.zeros(3)
-    iw = np.zeros(3)
-    world = np.zeros((3, 3))
-    tmp = np.zeros((3, 3))
-    work = np.zeros((9, 3))
-    for k in range(lo, hi):
-        _motion_pass(geo, g0, q[k], qd[k], qdd[k], rot, pos, omega, vel, alpha, acl, work)
-        for i in range(n):
-            h = first[i]
-            # force = m acl + alpha x h + w x (w x h)
-            _cross(alpha[i], h, t1)
-            _cross(omega[i], h, t2)
-            _cross(omega[i], t2, iw)
+    t1, t2, iw = work[0], work[1], work[2]
+    for i in range(rot.shape[0] - 1, -1, -1):
+        acc = 0.0
+        for r in range(3):
+            acc += moment[i, r] * axis[i, r]
+        for r in range(3):
+            acc += force[i, r] * axis_v[i, r]
+        tau[i] = acc
+        if i > 0:
             for r in range(3):
-                force[i, r] = mass[i] * acl[i, r] + t1[r] + iw[r]
-            # moment = I alpha + w x (I w) + h x acl
+                t1[r] = _rot(rot[i], force[i], r)
+                t2[r] = _rot(rot[i], moment[i], r)
+            _cross(pos[i], t1, iw)
             for r in range(3):
-                t1[r] = (
-                    inertia[i, r, 0] * omega[i, 0]
-                    + inertia[i, r, 1] * omega[i, 1]
-                    + inertia[i, r, 2] * omega[i, 2]
-                )
-            _cross(omega[i], t1, t2)
-            _cross(h, acl[i], iw)
-            for r in range(3):
-                moment[i, r] = (
-                    inertia[i, r, 0] * alpha[i, 0]
-                    + inertia[i, r, 1] * alpha[i, 1]
-                    + inertia[i, r, 2] * alpha[i, 2]
-                    + t2[r]
-                    + iw[r]
-                )
-        if use_wrench:
-            world[:, :] = base_rot
-            for i in range(n):
-                for r in range(3):
-                    for c in range(3):
-                        tmp[r, c] = (
-                            world[r, 0] * rot[i, 0, c]
-                            + world[r, 1] * rot[i, 1, c]
-                            + world[r, 2] * rot[i, 2, c]
-                        )
-                world[:, :] = tmp
-            for r in range(3):
-                t1[r] = (
-                    world[0, r] * wrench[k, 0]
-                    + world[1, r] * wrench[k, 1]
-                    + world[2, r] * wrench[k, 2]
-                )
-                t2[r] = (
-                    world[0, r] * wrench[k, 3]
-                    + world[1, r] * wrench[k, 4]
-                    + world[2, r] * wrench[k, 5]
-                )
-            _cross(flange_pos, t1, iw)
-            for r in range(3):
-                force[n - 1, r] += t1[r]
-                moment[n - 1, r] += t2[r] + iw[r]
-        for i in range(n - 1, -1, -1):
-            tau[k, i] = (
-                moment[i, 0] * axis[i, 0]
-                + moment[i, 1] * axis[i, 1]
-                + moment[i, 2] * axis[i, 2]
-                + force[i, 0] * axis_v[i, 0]
-                + force[i, 1] * axis_v[i, 1]
-                + force[i, 2] * axis_v[i, 2]
-            )
-            if i > 0:
-                for r in range(3):
-                    t1[r] = (
-                        rot[i, r, 0] * force[i, 0]
-                        + rot[i, r, 1] * force[i, 1]
-                        + rot[i, r, 2] * force[i, 2]
-                    )
-                    t2[r] = (
-                        rot[i, r, 0] * moment[i, 0]
-                        + rot[i, r, 1] * moment[i, 1]
-                        + rot[i, r, 2] * moment[i, 2]
-                    )
-                _cross(pos[i], t1, iw)
-                for r in range(3):
-                    force[i - 1, r] += t1[r]
-                    moment[i - 1, r] += t2[r] + iw[r]
+                force[i - 1, r] += t1[r]
+                moment[i - 1, r] += t2[r] + iw[r]
 
 
 @njit(cache=True, fastmath=False)
-def _regressor_chunk(
-    lo: int,
-    hi: int,
-    geo: tuple[Array, Array, Array, Array, Array, Array, Array, Array],
-    g0: Array,
-    q: Array,
-    qd: Array,
-    qdd: Array,
-    y: Array,
-) -> None:
-    """Fill ``y`` (N, n, 10 n), zeros on entry, with the regressor in the parameter order ``[m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]``.
+def rnea_rows(lo, hi, geo, ends, body, state, wrench, tau) -> None:
+    """Fill rows lo:hi of ``tau`` (N, n) with the joint torques of ``state``; ``wrench`` is
+    (N, 6), or (0, 6) for none."""
+    q, qd, qdd = state
+    n = q.shape[1]
+    frames = np.empty((6, n, 3))  # pos, omega, vel, alpha, acl, force
+    rot = np.empty((n, 3, 3))
+    moment = np.empty((n, 3))
+    work = np.zeros((9, 3))
+    pos, omega, vel, alpha, acl = frames[0], frames[1], frames[2], frames[3], frames[4]
+    force = frames[5]
+    for k in range(lo, hi):
+        _motion_pass(geo, ends[2], q[k], qd[k], qdd[k], rot, pos, omega, vel, alpha, acl, work)
+        for i in range(n):
+            _link_wrench(body, i, omega, alpha, acl, force, moment, work)
+        if wrench.shape[0] > 0:
+            _flange_wrench(ends, rot, wrench[k], force, moment, work)
+        _backward_pass(geo, rot, pos, force, moment, tau[k], work)
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _carry_axes(j, rot, pos, sax, work) -> None:
+    """Carry the axes ``sax`` (n, 6) of joints 0..j-1 from F_{j-1} into F_j:
+    ``w' = R^T w``, ``v' = R^T (v + w x p)``."""
+    t1, t2 = work[0], work[1]
+    for i in range(j):
+        for r in range(3):
+            t1[r] = sax[i, r]
+        _cross(t1, pos[j], t2)
+        for r in range(3):
+            t2[r] += sax[i, 3 + r]
+        for r in range(3):
+            sax[i, r] = _rot_t(rot[j], t1, r)
+            sax[i, 3 + r] = _rot_t(rot[j], t2, r)
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _wrench_matrix(w: Array, al: Array, ac: Array, kmat: Array) -> None:
+    """``K`` (6, 10) with link wrench (moment; force) ``= K pi`` (module docstring of
+    :func:`regressor_rows`); only the non-zero entries are written."""
+    wx, wy, wz = w[0], w[1], w[2]
+    ax, ay, az = al[0], al[1], al[2]
+    # mass: force = acl
+    kmat[3, 0], kmat[4, 0], kmat[5, 0] = ac[0], ac[1], ac[2]
+    # first moment h: moment = h x acl = -[acl]x h; force = ([alpha]x + [w]x[w]x) h
+    kmat[0, 2], kmat[0, 3] = ac[2], -ac[1]
+    kmat[1, 1], kmat[1, 3] = -ac[2], ac[0]
+    kmat[2, 1], kmat[2, 2] = ac[1], -ac[0]
+    kmat[3, 1], kmat[3, 2], kmat[3, 3] = -(wy * wy + wz * wz), wx * wy - az, wx * wz + ay
+    kmat[4, 1], kmat[4, 2], kmat[4, 3] = wx * wy + az, -(wx * wx + wz * wz), wy * wz - ax
+    kmat[5, 1], kmat[5, 2], kmat[5, 3] = wx * wz - ay, wy * wz + ax, -(wx * wx + wy * wy)
+    # inertia about the origin: moment = L(alpha) + [w]x L(w), I w = L(w) [Ixx Ixy Iyy Ixz Iyz Izz]
+    kmat[0, 4], kmat[1, 4], kmat[2, 4] = ax, wx * wz, -wx * wy
+    kmat[0, 5], kmat[1, 5], kmat[2, 5] = ay - wx * wz, ax + wy * wz, wx * wx - wy * wy
+    kmat[0, 6], kmat[1, 6], kmat[2, 6] = -wy * wz, ay, wx * wy
+    kmat[0, 7], kmat[1, 7], kmat[2, 7] = az + wx * wy, wz * wz - wx * wx, ax - wy * wz
+    kmat[0, 8], kmat[1, 8], kmat[2, 8] = wy * wy - wz * wz, az - wx * wy, ay + wx * wz
+    kmat[0, 9], kmat[1, 9], kmat[2, 9] = wy * wz, -wx * wz, az
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _regressor_block(j, sax, kmat, y, clear) -> None:
+    """Columns ``10 j .. 10 j + 9`` of one sample's regressor ``y`` (n, 10 n): joint i's row is
+    ``(X_{j<-i} S_i) . K_j`` for i <= j (K_j's structural zeros skipped), zero below (written
+    only if ``clear``: 20 % of the time)."""
+    c0 = 10 * j
+    for i in range(j + 1):
+        y[i, c0] = sax[i, 3] * kmat[3, 0] + sax[i, 4] * kmat[4, 0] + sax[i, 5] * kmat[5, 0]
+        for c in range(1, 4):
+            acc = 0.0
+            for r in range(6):
+                acc += sax[i, r] * kmat[r, c]
+            y[i, c0 + c] = acc
+        for c in range(4, 10):
+            y[i, c0 + c] = sax[i, 0] * kmat[0, c] + sax[i, 1] * kmat[1, c] + sax[i, 2] * kmat[2, c]
+    for i in range(j + 1, y.shape[0] if clear else 0):
+        for c in range(10):
+            y[i, c0 + c] = 0.0
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _regressor_scratch(n):
+    """Scratch space of :func:`_regressor_sample` for n joints."""
+    frames = np.empty((6, n, 3))  # pos, omega, vel, alpha, acl
+    rot = np.empty((n, 3, 3))
+    work = np.zeros((9, 3))
+    sax = np.empty((n, 6))  # joint axes (angular; linear) in the current link frame
+    kmat = np.zeros((6, 10))  # only its non-zero entries are ever written
+    return frames, rot, work, sax, kmat
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _regressor_sample(geo, g0, q, qd, qdd, y, clear, scratch) -> None:
+    """One sample's regressor ``y`` (n, 10 n) (:func:`regressor_rows`)."""
+    frames, rot, work, sax, kmat = scratch
+    axis, axis_v = geo[6], geo[7]
+    pos, omega, vel, alpha, acl = frames[0], frames[1], frames[2], frames[3], frames[4]
+    _motion_pass(geo, g0, q, qd, qdd, rot, pos, omega, vel, alpha, acl, work)
+    for j in range(q.shape[0]):
+        _carry_axes(j, rot, pos, sax, work)
+        for r in range(3):
+            sax[j, r] = axis[j, r]
+            sax[j, 3 + r] = axis_v[j, r]
+        _wrench_matrix(omega[j], alpha[j], acl[j], kmat)
+        _regressor_block(j, sax, kmat, y, clear)
+
+
+@njit(cache=True, fastmath=False)
+def regressor_rows(lo, hi, geo, g0, state, y, clear) -> None:
+    """Fill rows lo:hi of ``y`` (N, n, 10 n) with the regressor in the parameter order
+    ``[m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]``; the structurally zero entries are written
+    if ``clear`` (any contents on entry), else left as they are (zeros on entry).
 
     Link j's wrench (moment; force) at the origin of F_j is linear in its parameters,
     ``wrench_j = K_j pi_j`` with::
@@ -257,132 +309,83 @@ def _regressor_chunk(
     j >= i: each joint axis is carried out to the links it moves instead of carrying every link's
     ten wrench columns back to each joint.
     """
-    axis, axis_v = geo[6], geo[7]
-    n = q.shape[1]
-    rot = np.empty((n, 3, 3))
-    pos = np.empty((n, 3))
-    omega = np.empty((n, 3))
-    vel = np.empty((n, 3))
-    alpha = np.empty((n, 3))
-    acl = np.empty((n, 3))
-    work = np.zeros((9, 3))
-    sax = np.empty((n, 6))  # joint axes (angular; linear) in the current link frame
-    kmat = np.empty((6, 10))
-    t1 = np.zeros(3)
-    t2 = np.zeros(3)
+    q, qd, qdd = state
+    scratch = _regressor_scratch(q.shape[1])
     for k in range(lo, hi):
-        _motion_pass(geo, g0, q[k], qd[k], qdd[k], rot, pos, omega, vel, alpha, acl, work)
+        _regressor_sample(geo, g0, q[k], qd[k], qdd[k], y[k], clear, scratch)
+
+
+@njit(cache=True, fastmath=False, inline="always")
+def _weighted(geo, g0, x, weights, y, scratch) -> float:
+    """``sum(weights * Y(x))`` for one sample, ``x = (q, qd, qdd)`` (n,) each."""
+    _regressor_sample(geo, g0, x[0], x[1], x[2], y, True, scratch)
+    acc = 0.0
+    for i in range(y.shape[0]):
+        for c in range(y.shape[1]):
+            acc += weights[i, c] * y[i, c]
+    return acc
+
+
+@njit(cache=True, fastmath=False)
+def regressor_gradient_rows(lo, hi, geo, g0, state, weights, step_q, sens) -> None:
+    """Rows lo:hi of ``sens`` (3, N, n): the derivatives of ``f = sum(weights[k] * Y_k)`` in
+    every sample's ``q``, ``qd`` and ``qdd``.
+
+    ``Y`` is linear in ``qdd`` and a quadratic in ``qd``, so a unit forward step in ``qdd`` and
+    a central unit step in ``qd`` give their derivatives up to rounding; ``q`` takes a central
+    step of ``step_q`` rad (error ``O(step_q^2)``).
+    """
+    q, qd, qdd = state
+    n = q.shape[1]
+    scratch = _regressor_scratch(n)
+    y = np.empty((n, 10 * n))
+    x = np.empty((3, n))
+    steps = (step_q, 1.0)
+    for k in range(lo, hi):
+        x[0, :] = q[k]
+        x[1, :] = qd[k]
+        x[2, :] = qdd[k]
+        w = weights[k]
+        f0 = _weighted(geo, g0, x, w, y, scratch)
         for j in range(n):
-            # carry the axes of joints 0..j-1 from F_{j-1} into F_j: w' = R^T w, v' = R^T (v + w x p)
-            for i in range(j):
-                t1[0] = sax[i, 0]
-                t1[1] = sax[i, 1]
-                t1[2] = sax[i, 2]
-                _cross(t1, pos[j], t2)
-                for r in range(3):
-                    t2[r] += sax[i, 3 + r]
-                for r in range(3):
-                    sax[i, r] = rot[j, 0, r] * t1[0] + rot[j, 1, r] * t1[1] + rot[j, 2, r] * t1[2]
-                    sax[i, 3 + r] = (
-                        rot[j, 0, r] * t2[0] + rot[j, 1, r] * t2[1] + rot[j, 2, r] * t2[2]
-                    )
-            for r in range(3):
-                sax[j, r] = axis[j, r]
-                sax[j, 3 + r] = axis_v[j, r]
-            w = omega[j]
-            al = alpha[j]
-            ac = acl[j]
-            wx, wy, wz = w[0], w[1], w[2]
-            ax, ay, az = al[0], al[1], al[2]
-            # K_j, rows 0-2 moment, 3-5 force; columns m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz
-            for r in range(6):
-                for c in range(10):
-                    kmat[r, c] = 0.0
-            # mass: force = acl
-            kmat[3, 0], kmat[4, 0], kmat[5, 0] = ac[0], ac[1], ac[2]
-            # first moment h: moment = h x acl = -[acl]x h; force = ([alpha]x + [w]x[w]x) h
-            kmat[0, 2], kmat[0, 3] = ac[2], -ac[1]
-            kmat[1, 1], kmat[1, 3] = -ac[2], ac[0]
-            kmat[2, 1], kmat[2, 2] = ac[1], -ac[0]
-            kmat[3, 1], kmat[3, 2], kmat[3, 3] = -(wy * wy + wz * wz), wx * wy - az, wx * wz + ay
-            kmat[4, 1], kmat[4, 2], kmat[4, 3] = wx * wy + az, -(wx * wx + wz * wz), wy * wz - ax
-            kmat[5, 1], kmat[5, 2], kmat[5, 3] = wx * wz - ay, wy * wz + ax, -(wx * wx + wy * wy)
-            # inertia about the origin: moment = L(alpha) + [w]x L(w), I w = L(w) [Ixx Ixy Iyy Ixz Iyz Izz]
-            kmat[0, 4], kmat[1, 4], kmat[2, 4] = ax, wx * wz, -wx * wy
-            kmat[0, 5], kmat[1, 5], kmat[2, 5] = ay - wx * wz, ax + wy * wz, wx * wx - wy * wy
-            kmat[0, 6], kmat[1, 6], kmat[2, 6] = -wy * wz, ay, wx * wy
-            kmat[0, 7], kmat[1, 7], kmat[2, 7] = az + wx * wy, wz * wz - wx * wx, ax - wy * wz
-            kmat[0, 8], kmat[1, 8], kmat[2, 8] = wy * wy - wz * wz, az - wx * wy, ay + wx * wz
-            kmat[0, 9], kmat[1, 9], kmat[2, 9] = wy * wz, -wx * wz, az
-            c0 = 10 * j
-            for i in range(j + 1):  # skip K_j's structural zeros
-                y[k, i, c0] = (
-                    sax[i, 3] * kmat[3, 0] + sax[i, 4] * kmat[4, 0] + sax[i, 5] * kmat[5, 0]
-                )
-                for c in range(1, 4):
-                    acc = 0.0
-                    for r in range(6):
-                        acc += sax[i, r] * kmat[r, c]
-                    y[k, i, c0 + c] = acc
-                for c in range(4, 10):
-                    y[k, i, c0 + c] = (
-                        sax[i, 0] * kmat[0, c] + sax[i, 1] * kmat[1, c] + sax[i, 2] * kmat[2, c]
-                    )
+            for kind in range(2):  # central steps in q, qd
+                h = steps[kind]
+                x[kind, j] += h
+                up = _weighted(geo, g0, x, w, y, scratch)
+                x[kind, j] -= 2.0 * h
+                down = _weighted(geo, g0, x, w, y, scratch)
+                x[kind, j] = state[kind][k, j]
+                sens[kind, k, j] = (up - down) / (2.0 * h)
+            x[2, j] += 1.0
+            sens[2, k, j] = _weighted(geo, g0, x, w, y, scratch) - f0
+            x[2, j] = qdd[k, j]
 
 
 _CHUNK = 256  # samples per parallel work item
+#: samples per parallel work item of the gradient (a sample costs 5 n + 1 regressors)
+GRADIENT_CHUNK = 16
 
 
 @njit(cache=True, parallel=True)
-def rnea_kernel(
-    geo: tuple[Array, Array, Array, Array, Array, Array, Array, Array],
-    base_rot: Array,
-    flange_pos: Array,
-    g0: Array,
-    mass: Array,
-    first: Array,
-    inertia: Array,
-    q: Array,
-    qd: Array,
-    qdd: Array,
-    wrench: Array,
-    use_wrench: bool,
-    tau: Array,
-) -> None:
-    """Fill ``tau`` (N, n) with rigid-body joint torques; samples split over threads."""
-    big_n = q.shape[0]
-    chunks = (big_n + _CHUNK - 1) // _CHUNK
-    for c in prange(chunks):
-        _rnea_chunk(
-            c * _CHUNK,
-            min(big_n, (c + 1) * _CHUNK),
-            geo,
-            base_rot,
-            flange_pos,
-            g0,
-            mass,
-            first,
-            inertia,
-            q,
-            qd,
-            qdd,
-            wrench,
-            use_wrench,
-            tau,
-        )
+def rnea_kernel(geo, ends, body, state, wrench, tau) -> None:
+    """:func:`rnea_rows` over all samples, split over threads."""
+    big_n = tau.shape[0]
+    for c in prange((big_n + _CHUNK - 1) // _CHUNK):
+        rnea_rows(c * _CHUNK, min(big_n, (c + 1) * _CHUNK), geo, ends, body, state, wrench, tau)
 
 
 @njit(cache=True, parallel=True)
-def regressor_kernel(
-    geo: tuple[Array, Array, Array, Array, Array, Array, Array, Array],
-    g0: Array,
-    q: Array,
-    qd: Array,
-    qdd: Array,
-    y: Array,
-) -> None:
-    """Fill ``y`` (N, n, 10 n), zeros on entry, with the regressor; samples split over threads."""
-    big_n = q.shape[0]
-    chunks = (big_n + _CHUNK - 1) // _CHUNK
-    for c in prange(chunks):
-        _regressor_chunk(c * _CHUNK, min(big_n, (c + 1) * _CHUNK), geo, g0, q, qd, qdd, y)
+def regressor_kernel(geo, g0, state, y, clear) -> None:
+    """:func:`regressor_rows` over all samples, split over threads."""
+    big_n = y.shape[0]
+    for c in prange((big_n + _CHUNK - 1) // _CHUNK):
+        regressor_rows(c * _CHUNK, min(big_n, (c + 1) * _CHUNK), geo, g0, state, y, clear)
+
+
+@njit(cache=True, parallel=True)
+def regressor_gradient_kernel(geo, g0, state, weights, step_q, sens) -> None:
+    """:func:`regressor_gradient_rows` over all samples, split over threads."""
+    big_n = weights.shape[0]
+    for c in prange((big_n + GRADIENT_CHUNK - 1) // GRADIENT_CHUNK):
+        lo, hi = c * GRADIENT_CHUNK, min(big_n, (c + 1) * GRADIENT_CHUNK)
+        regressor_gradient_rows(lo, hi, geo, g0, state, weights, step_q, sens)

@@ -13,7 +13,10 @@ of ``F_{i-1} · P_i``. Frame 0 sits at ``robot.base`` in the base frame.
 
 from __future__ import annotations
 
+import math
+import weakref
 from dataclasses import dataclass
+from typing import TypeGuard
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -23,11 +26,16 @@ from kinergy.model.robot import Robot, inertia_matrix
 
 __all__ = [
     "Chain",
+    "KernelData",
     "LinkInertials",
     "check_state",
+    "contiguous_state",
+    "gravity_in_frame0",
+    "kernel_data",
     "kernel_geometry",
     "link_inertials",
     "make_chain",
+    "output_array",
 ]
 
 Array = NDArray[np.float64]
@@ -181,6 +189,28 @@ def link_inertials(robot: Robot, *, include_payload: bool = True) -> LinkInertia
     return LinkInertials(mass, com, inertia)
 
 
+def _is_float_array(value: object) -> TypeGuard[Array]:
+    return type(value) is np.ndarray and value.dtype == np.float64
+
+
+def _all_finite(arr: Array) -> bool:
+    """Whether every entry is finite. A sample's few entries: one dot product (nan or inf in,
+    nan or inf out; checked entry by entry only when it is not, as large finite values can
+    overflow it), 4x faster than ``isfinite().all()``; a batch: ``isfinite`` (a long dot
+    product may wait for BLAS threads on a busy machine)."""
+    if arr.size > 64:
+        return bool(np.isfinite(arr).all())
+    flat = arr.ravel()
+    return math.isfinite(float(flat.dot(flat))) or bool(np.isfinite(arr).all())
+
+
+def _as_float_array(name: str, value: ArrayLike) -> Array:
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise KinergyError(f"{name}: must be numbers, shape (n,) or (N, n)") from None
+
+
 def check_state(robot: Robot, **arrays: ArrayLike | None) -> tuple[bool, dict[str, Array]]:
     """Validate joint-state arrays at the public boundary.
 
@@ -199,10 +229,7 @@ def check_state(robot: Robot, **arrays: ArrayLike | None) -> tuple[bool, dict[st
     for name, value in arrays.items():
         if value is None:
             continue
-        try:
-            arr = np.asarray(value, dtype=float)
-        except (TypeError, ValueError):
-            raise KinergyError(f"{name}: must be numbers, shape (n,) or (N, n)") from None
+        arr = value if _is_float_array(value) else _as_float_array(name, value)
         if arr.ndim not in (1, 2) or arr.shape[-1] != n:
             raise KinergyError(
                 f"{name}: expected shape ({n},) or (N, {n}) for {robot.name}, got {arr.shape}"
@@ -210,9 +237,8 @@ def check_state(robot: Robot, **arrays: ArrayLike | None) -> tuple[bool, dict[st
         if shape is not None and arr.shape != shape:
             raise KinergyError(f"{name}: shape {arr.shape} differs from the other inputs' {shape}")
         shape = arr.shape
-        bad = ~np.isfinite(arr)
-        if bad.any():
-            idx = np.argwhere(bad)[0]
+        if not _all_finite(arr):
+            idx = np.argwhere(~np.isfinite(arr))[0]
             where = (
                 f"sample {idx[0]}, joint {idx[-1] + 1}" if arr.ndim == 2 else f"joint {idx[0] + 1}"
             )
@@ -228,3 +254,112 @@ def check_state(robot: Robot, **arrays: ArrayLike | None) -> tuple[bool, dict[st
         elif single:
             out[name] = out[name][None, :]
     return single, out
+
+
+@dataclass(frozen=True)
+class KernelData:
+    """What the compiled kernels (:mod:`kinergy.dynamics._kernels`) need of a robot, built once
+    per robot (:func:`kernel_data`).
+
+    Attributes
+    ----------
+    chain : Chain
+    inertials : LinkInertials
+        The payload merged into the last link.
+    geo : tuple of 8 ndarray
+        :func:`kernel_geometry` of the chain.
+    ends : tuple of 3 ndarray
+        ``(base_rot, flange_pos, g0)``: (3, 3) frame 0 in the base frame, (3,) flange origin in
+        frame n (m), (3,) gravity in frame 0 (m/s^2).
+    body : tuple of 3 ndarray
+        ``(mass, first, inertia)``: (n,) kg, (n, 3) ``m c`` kg m, (n, 3, 3) about the link
+        origins kg m^2; the payload merged into the last link.
+    """
+
+    chain: Chain
+    inertials: LinkInertials
+    geo: tuple[Array, Array, Array, Array, Array, Array, Array, Array]
+    ends: tuple[Array, Array, Array]
+    body: tuple[Array, Array, Array]
+
+
+#: one KernelData per robot; a robot is immutable, and dropping it drops its entry
+_KERNEL_DATA: weakref.WeakKeyDictionary[Robot, KernelData] = weakref.WeakKeyDictionary()
+
+
+def kernel_data(robot: Robot) -> KernelData:
+    """The robot's :class:`KernelData`, built on first use and cached (the geometry costs a few
+    hundred microseconds; a kernel call on one sample a few)."""
+    data = _KERNEL_DATA.get(robot)
+    if data is None:
+        chain = make_chain(robot)
+        body = link_inertials(robot)
+        data = KernelData(
+            chain,
+            body,
+            kernel_geometry(chain),
+            tuple(  # type: ignore[arg-type]
+                np.ascontiguousarray(x, dtype=float)
+                for x in (chain.base[:3, :3], chain.flange[:3, 3], chain.gravity0)
+            ),
+            tuple(  # type: ignore[arg-type]
+                np.ascontiguousarray(x, dtype=float)
+                for x in (body.mass, body.first_moment, body.inertia_origin)
+            ),
+        )
+        _KERNEL_DATA[robot] = data
+    return data
+
+
+def contiguous_state(s: dict[str, Array]) -> tuple[Array, Array, Array]:
+    """``(q, qd, qdd)`` of :func:`check_state`'s output, C-contiguous, for the kernels."""
+    return (
+        np.ascontiguousarray(s["q"]),
+        np.ascontiguousarray(s["qd"]),
+        np.ascontiguousarray(s["qdd"]),
+    )
+
+
+def output_array(out: Array | None, shape: tuple[int, ...], single: bool) -> Array:
+    """A fresh array of ``shape`` (batch first), or ``out`` checked and viewed so.
+
+    ``out`` must be a writeable C-contiguous float64 array of ``shape``, or of ``shape[1:]``
+    when the inputs were one sample (``single``).
+
+    Raises
+    ------
+    KinergyError
+        ``out`` of another shape, type or layout.
+    """
+    if out is None:
+        return np.empty(shape)
+    expected = shape[1:] if single else shape
+    if (
+        not isinstance(out, np.ndarray)
+        or out.shape != expected
+        or out.dtype != np.float64
+        or not out.flags.c_contiguous
+        or not out.flags.writeable
+    ):
+        got = out.shape if isinstance(out, np.ndarray) else type(out).__name__
+        raise KinergyError(
+            f"out: expected a writeable C-contiguous float64 array of shape {expected}, got {got}"
+        )
+    return out.reshape(shape)
+
+
+def gravity_in_frame0(robot: Robot, gravity: ArrayLike | None) -> Array | None:
+    """Gravity in frame 0 for a ``gravity`` override (base frame, m/s^2), shape (3,); None for
+    none (the kernels then use the robot's).
+
+    Raises
+    ------
+    KinergyError
+        Not 3 finite numbers.
+    """
+    if gravity is None:
+        return None
+    g = np.asarray(gravity, dtype=float)
+    if g.shape != (3,) or not np.all(np.isfinite(g)):
+        raise KinergyError(f"gravity: expected 3 finite numbers, got {g.tolist()}")
+    return np.ascontiguousarray(robot.base[:3, :3].T @ g)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from kinergy.dynamics.chain import Chain, check_state, make_chain
+from kinergy.dynamics.chain import Chain, check_state, kernel_data
 from kinergy.model.robot import Robot
 
 __all__ = ["flange_pose", "jacobian", "joint_axes", "link_poses", "rot_z_batch"]
@@ -62,14 +62,14 @@ def link_poses(robot: Robot, q: ArrayLike) -> Array:
     ndarray, shape (n, 4, 4) or (N, n, 4, 4)
     """
     single, s = check_state(robot, q=q)
-    _, link = _poses(make_chain(robot), s["q"])
+    _, link = _poses(kernel_data(robot).chain, s["q"])
     return link[0] if single else link
 
 
 def flange_pose(robot: Robot, q: ArrayLike) -> Array:
     """Pose of the flange in the base frame, shape (4, 4) or (N, 4, 4)."""
     single, s = check_state(robot, q=q)
-    chain = make_chain(robot)
+    chain = kernel_data(robot).chain
     _, link = _poses(chain, s["q"])
     out = link[:, -1] @ chain.flange
     return out[0] if single else out
@@ -98,7 +98,7 @@ def jacobian(robot: Robot, q: ArrayLike) -> Array:
     ndarray, shape (6, n) or (N, 6, n)
     """
     single, s = check_state(robot, q=q)
-    chain = make_chain(robot)
+    chain = kernel_data(robot).chain
     z, o, link = joint_axes(chain, s["q"])
     tip = (link[:, -1] @ chain.flange)[:, :3, 3]
     jv = np.cross(z, tip[:, None, :] - o)

@@ -17,9 +17,15 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from kinergy.dynamics._kernels import rnea_kernel
-from kinergy.dynamics.chain import check_state, kernel_geometry, link_inertials, make_chain
+from kinergy.dynamics.chain import (
+    check_state,
+    contiguous_state,
+    gravity_in_frame0,
+    kernel_data,
+    output_array,
+)
 from kinergy.dynamics.kinematics import joint_axes
+from kinergy.dynamics.launch import rnea_into
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 
@@ -50,6 +56,8 @@ def rnea(
     *,
     wrench: ArrayLike | None = None,
     gravity: ArrayLike | None = None,
+    out: Array | None = None,
+    threads: int | None = None,
 ) -> Array:
     """Rigid-body joint torques by the recursive Newton-Euler algorithm (UR5e eqs 1, 3-6).
 
@@ -64,11 +72,15 @@ def rnea(
         the flange origin, base-frame coordinates); adds ``J^T h`` (framework eq 1).
     gravity : array_like, shape (3,), optional
         Overrides ``robot.gravity`` (base frame, m/s^2); ``[0, 0, 0]`` for no gravity.
+    out : ndarray, shape like ``q``, optional
+        C-contiguous float64 array the torques are written to (no allocation).
+    threads : int, optional
+        numba threads for this call (:func:`kinergy.dynamics.threads.kernel_threads`).
 
     Returns
     -------
     ndarray, shape like ``q``
-        Joint torques ``f_link`` of UR5e eq 2, N m.
+        Joint torques ``f_link`` of UR5e eq 2, N m (``out`` when given).
 
     Examples
     --------
@@ -79,35 +91,17 @@ def rnea(
     -59.76
     """
     single, s = check_state(robot, q=q, qd=qd, qdd=qdd)
-    chain = make_chain(robot)
+    data = kernel_data(robot)
     rows = s["q"].shape[0]
-    g0 = chain.gravity0 if gravity is None else _gravity0(robot, gravity)
+    g0 = gravity_in_frame0(robot, gravity)
     w = _check_wrench(wrench, rows, single)
-    body = link_inertials(robot)
-    tau = np.empty((rows, robot.n))
-    rnea_kernel(
-        kernel_geometry(chain),
-        np.ascontiguousarray(chain.base[:3, :3]),
-        np.ascontiguousarray(chain.flange[:3, 3]),
-        g0,
-        body.mass,
-        np.ascontiguousarray(body.first_moment),
-        np.ascontiguousarray(body.inertia_origin),
-        np.ascontiguousarray(s["q"]),
-        np.ascontiguousarray(s["qd"]),
-        np.ascontiguousarray(s["qdd"]),
-        np.empty((0, 6)) if w is None else np.ascontiguousarray(w),
-        w is not None,
-        tau,
-    )
+    tau = output_array(out, (rows, robot.n), single)
+    state = contiguous_state(s)
+    wrench_rows = np.empty((0, 6)) if w is None else np.ascontiguousarray(w)
+    rnea_into(data, state, wrench_rows, tau, g0, threads)
+    if out is not None:
+        return out
     return tau[0] if single else tau
-
-
-def _gravity0(robot: Robot, gravity: ArrayLike) -> Array:
-    g = np.asarray(gravity, dtype=float)
-    if g.shape != (3,) or not np.all(np.isfinite(g)):
-        raise KinergyError(f"gravity: expected 3 finite numbers, got {g.tolist()}")
-    return robot.base[:3, :3].T @ g
 
 
 def gravity_torque(robot: Robot, q: ArrayLike) -> Array:
@@ -130,8 +124,7 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> Array:
     ndarray, shape (n, n) or (N, n, n)
     """
     single, s = check_state(robot, q=q)
-    chain = make_chain(robot)
-    body = link_inertials(robot)
+    chain, body = kernel_data(robot).chain, kernel_data(robot).inertials
     z, o, link = joint_axes(chain, s["q"])  # (N, n, 3), (N, n, 3), (N, n, 4, 4)
     n = robot.n
     rot = link[..., :3, :3]

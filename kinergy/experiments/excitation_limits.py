@@ -23,7 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from kinergy.dynamics.chain import make_chain
+from kinergy.dynamics.chain import kernel_data
 from kinergy.dynamics.kinematics import joint_axes
 from kinergy.errors import KinergyError
 from kinergy.experiments.excitation_series import SeriesGrid
@@ -286,7 +286,7 @@ def frame_heights(
     The frames are the flange (``"flange"``) or every link frame from the second on and the
     flange (``"links"``); a height's derivative is the z component of ``axis x lever``.
     """
-    chain = make_chain(robot)
+    chain = kernel_data(robot).chain  # built once per robot
     axes, points, link = joint_axes(chain, q)
     flange = (link[:, -1] @ chain.flange)[:, :3, 3]
     n = robot.n

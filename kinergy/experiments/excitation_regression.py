@@ -24,8 +24,10 @@ criterion is
   confidence ellipsoid, up to a constant).
 
 Its gradient is exact in the criterion (eigen-decomposition of ``W_s^T W_s``, the column scaling
-included) and uses one forward difference of the regressor per joint and signal (``3 n`` extra
-regressor evaluations in one batch, instead of one per unknown).
+included) and goes to the states through
+:func:`kinergy.dynamics.regressor.regressor_gradient` (the derivative of ``sum(G * Y)`` in each
+sample's states in one compiled pass: exact in ``qd`` and ``qdd``, a central step in ``q``;
+nothing of size samples x n x 10 n x 3 n is built).
 """
 
 from __future__ import annotations
@@ -37,7 +39,12 @@ import scipy.linalg
 from numpy.typing import NDArray
 
 from kinergy.drives.transmission import motor_speed, transmission_matrix
-from kinergy.dynamics.regressor import BaseParameters, base_parameters, regressor
+from kinergy.dynamics.regressor import (
+    BaseParameters,
+    base_parameters,
+    regressor,
+    regressor_gradient,
+)
 from kinergy.friction.registry import friction_columns
 from kinergy.linalg import column_scale, pivoted_rank
 from kinergy.model.robot import Robot
@@ -61,8 +68,23 @@ COULOMB_SMOOTHING = 0.05
 _FRICTION = "viscous_coulomb"
 #: a drive column whose part independent of the link base columns is below this is dependent
 _DEPENDENT_TOL = 1e-8
-#: forward-difference step of the regressor derivatives (rad, rad/s, rad/s^2)
+#: central-difference step of the friction columns' derivative in qd, rad/s
 _FD_STEP = 1e-6
+
+
+def _motor_columns(smoothing: Array, wm: Array, dwm: Array) -> Array:
+    """Rotor-inertia, viscous and Coulomb columns of every motor, motor side, (N, 3, n):
+    ``dwm``, then the registry's viscous and Coulomb columns of ``wm`` at ``smoothing[m]``."""
+    friction = [
+        friction_columns(_FRICTION, {"viscous": 0.0, "coulomb": 0.0, "smoothing": s}, wm[:, m])
+        for m, s in enumerate(smoothing)
+    ]  # each (N, 2): viscous, Coulomb
+    return np.concatenate([dwm[:, None, :], np.stack(friction, axis=2)], axis=1)
+
+
+def _reach(robot: Robot) -> Array:
+    """``[j, k n + m] = N[m, j]``, (n, 3 n): how motor m's column k reaches joint j."""
+    return np.tile(transmission_matrix(robot).T, 3)
 
 
 def _drive_columns(robot: Robot, smoothing: Array, qd: Array, qdd: Array) -> Array:
@@ -73,13 +95,8 @@ def _drive_columns(robot: Robot, smoothing: Array, qd: Array, qdd: Array) -> Arr
     ``smoothing[m]`` (rad/s, motor side).
     """
     wm, dwm = motor_speed(robot, qd), motor_speed(robot, qdd)  # rad/s, rad/s^2
-    friction = [
-        friction_columns(_FRICTION, {"viscous": 0.0, "coulomb": 0.0, "smoothing": s}, wm[:, m])
-        for m, s in enumerate(smoothing)
-    ]  # each (N, 2): viscous, Coulomb
-    motor = np.concatenate([dwm[:, None, :], np.stack(friction, axis=2)], axis=1)  # (N, 3, n)
-    reach = np.tile(transmission_matrix(robot).T, 3)  # [j, k n + m] = N[m, j]
-    return reach[None, :, :] * motor.reshape(len(wm), 1, -1)
+    motor = _motor_columns(smoothing, wm, dwm)
+    return _reach(robot)[None, :, :] * motor.reshape(len(wm), 1, -1)
 
 
 def _independent_drive_columns(
@@ -145,23 +162,46 @@ class ExcitationRegression:
         """The criterion of ``W`` on the states (N, n), its gradient with respect to them
         (3, N, n: ``q``, ``qd``, ``qdd``) and the condition number.
 
-        The regressor's derivatives are forward differences: every sample's ``q``, ``qd`` or
-        ``qdd`` of one joint pushed by one step at once (``1 + 3 n`` regressor batches in one).
+        With ``G = dF/dW`` (:func:`criterion`), ``dF/dx[s, j] = sum(G[s] * dW[s]/dx[s, j])``:
+        the link columns' part is :func:`kinergy.dynamics.regressor.regressor_gradient` (one
+        thread: 200 samples of an optimisation loop lose more to a parallel launch on a busy
+        machine than they gain) with
+        ``G`` scattered onto the base columns (no regressor derivative is stored), the drive
+        columns' part :meth:`drive_gradient`.
         """
         big_n, n = q.shape
-        stack = np.empty((1 + 3 * n, 3, big_n, n))
-        stack[:] = np.stack([q, qd, qdd])[None]
-        for kind_x in range(3):
-            for j in range(n):
-                stack[1 + kind_x * n + j, kind_x, :, j] += _FD_STEP
-        flat = stack.transpose(1, 0, 2, 3).reshape(3, -1, n)
-        w_all = self.matrix(flat[0], flat[1], flat[2]).reshape(1 + 3 * n, big_n, n, -1)
-        w0 = w_all[0]
+        w0 = self.matrix(q, qd, qdd)
         value, grad_w, cond = criterion(w0.reshape(big_n * n, -1), kind)
         grad_w = grad_w.reshape(w0.shape)
-        # dF/dx[s, j] for x in (q, qd, qdd): sum over rows of sample s and columns
-        sens = np.einsum("sik,xsik->xs", grad_w, w_all[1:] - w0[None]) / _FD_STEP
-        return value, sens.reshape(3, n, big_n).transpose(0, 2, 1), cond
+        b = self.base.size
+        weights = np.zeros((big_n, n, 10 * n))
+        weights[..., self.base.independent] = grad_w[..., :b]
+        sens = regressor_gradient(self.robot, q, qd, qdd, weights, threads=1)
+        if self.drive_columns.size:
+            sens[1:] += self.drive_gradient(qd, qdd, grad_w[..., b:])
+        return value, sens, cond
+
+    def drive_gradient(self, qd: Array, qdd: Array, weights: Array) -> Array:
+        """Derivatives of ``sum(weights * D)`` in every sample's ``qd`` and ``qdd``, (2, N, n),
+        ``D`` (N, n, k) the drive columns in ``W``.
+
+        Motor m's columns depend on its own speed ``wm_m`` and acceleration only, so one central
+        step of :data:`_FD_STEP` of every motor speed at once gives each ``d/dwm_m`` (the
+        rotor-inertia column is linear: its weight is the derivative); ``wm = N qd`` carries
+        them to the joints (``N^T``).
+        """
+        robot, n = self.robot, qd.shape[1]
+        n_mat = transmission_matrix(robot)
+        per_motor = np.zeros((*qd.shape[:1], 3 * n))  # sum_j weights * reach, per motor column
+        per_motor[:, self.drive_columns] = np.einsum(
+            "sik,ik->sk", weights, _reach(robot)[:, self.drive_columns]
+        )
+        per_motor = per_motor.reshape(-1, 3, n)
+        wm, dwm = qd @ n_mat.T, qdd @ n_mat.T
+        up = _motor_columns(self.smoothing, wm + _FD_STEP, dwm)
+        down = _motor_columns(self.smoothing, wm - _FD_STEP, dwm)
+        d_speed = np.einsum("scm,scm->sm", per_motor[:, 1:], (up - down)[:, 1:]) / (2 * _FD_STEP)
+        return np.stack([d_speed @ n_mat, per_motor[:, 0] @ n_mat])
 
 
 def excitation_regression(robot: Robot, *, include_drives: bool = True) -> ExcitationRegression:

@@ -2,8 +2,9 @@
 
 :func:`movej_program` writes a movej program: one ``movej(q, a=..., v=..., r=...)`` per move,
 joint angles in rad, URScript's ``a`` (rad/s^2) and ``v`` (rad/s) of the leading joint, as
-kinergy's :func:`kinergy.trajectory.movej.movej` plans them. :func:`write_script` puts any script
-on disk atomically.
+kinergy's :func:`kinergy.trajectory.movej.movej` plans them. :func:`program_script` writes a
+:class:`~kinergy.trajectory.robot_program.RobotProgram` read from a file back with changed moves:
+every other line kept as it was. :func:`write_script` puts any script on disk atomically.
 
 Blending: URScript's ``r`` is a blend radius in metres around the target's tool position, while
 kinergy plans blends as a joint-space radius (rad, on the leading joint). The two do not convert
@@ -24,8 +25,16 @@ from numpy.typing import ArrayLike, NDArray
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
 from kinergy.trajectory.movej import check_waypoints, per_move
+from kinergy.trajectory.robot_program import Move, RobotProgram
 
-__all__ = ["SERVO_PERIOD", "movej_program", "servoj_program", "write_script"]
+__all__ = [
+    "SERVO_PERIOD",
+    "move_statement",
+    "movej_program",
+    "program_script",
+    "servoj_program",
+    "write_script",
+]
 
 Array = NDArray[np.float64]
 
@@ -156,6 +165,50 @@ def movej_program(
         )
     header = _movej_header(blends is not None, cycle_time, energy, comments)
     return _program(name, header, body)
+
+
+def move_statement(move: Move) -> str:
+    """One move as URScript: ``movej([...], a=..., v=..., r=...)``, a pose ``p[...]`` (m, rad),
+    ``get_inverse_kin(p[...], qnear=[...])`` for a movej's pose target with ``qnear``."""
+    target = _vector(move.target)
+    if move.pose:
+        target = "p" + target
+        if move.qnear is not None and not move.tool_space:
+            target = f"get_inverse_kin({target}, qnear={_vector(move.qnear)})"
+    args = [target, f"a={_decimal(move.a)}", f"v={_decimal(move.v)}"]
+    if move.t > 0.0 and move.kind != "movep":
+        args.append(f"t={_decimal(move.t)}")
+    if move.r > 0.0:
+        args.append(f"r={_decimal(move.r)}")
+    return f"{move.kind}({', '.join(args)})"
+
+
+def program_script(program: RobotProgram, header: Sequence[str] = ()) -> str:
+    """A program read from a file written back with its (changed) moves.
+
+    Every move's line is replaced by :func:`move_statement` (its indentation and comment kept);
+    every other line (events, I/O, variables, comments) stays as it was. ``header`` lines go in
+    as comments after the ``def`` line (or at the top). A program built in code (no ``lines``) is
+    written as ``def name():`` with one move per line and its events' statements.
+
+    Returns
+    -------
+    str
+        Newline-terminated.
+    """
+    if not program.lines:
+        body = [move_statement(s) if isinstance(s, Move) else s.text for s in program.steps]
+        return _program(program.name, header, body)
+    lines = list(program.lines)
+    for move in program.moves:
+        old = lines[move.line - 1]
+        indent = old[: len(old) - len(old.lstrip())]
+        comment = old[old.index("#") :] if "#" in old and "#" not in move.text else ""
+        lines[move.line - 1] = indent + move_statement(move) + (f"  {comment}" if comment else "")
+    at = next((i + 1 for i, line in enumerate(lines) if line.lstrip().startswith("def ")), 0)
+    indent = "  " if at else ""
+    lines[at:at] = [f"{indent}# {line}" for text in header for line in str(text).splitlines()]
+    return "\n".join(lines) + "\n"
 
 
 def write_script(path: str | os.PathLike[str], text: str) -> Path:

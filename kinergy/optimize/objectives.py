@@ -16,6 +16,13 @@ on the DC bus: ``int sum_j W_elec,j dt`` with ``W_elec = tau_m^2 / k_m^2 + (k_b/
 (:func:`kinergy.predict.drive_state`), braking energy returned to the bus (signed, as the seed)
 or, without recovery, the summed bus power clipped at 0 (the supply takes nothing back), as
 :func:`kinergy.accounting.energy.energy` counts the total.
+
+:class:`SupplyEnergy` (what :func:`kinergy.optimize.programs.optimize_program` minimises) is the
+energy the arm draws from its supply: the joints' electrical powers summed on the DC bus, a
+braking surplus lost in the shunt (the bus power clipped at 0), plus the controller's standby
+power times the cycle time: the drives' DC-bus model (:func:`kinergy.drives.bus.supply_power`,
+what ``kinergy energy`` reports as drawn from the supply). :data:`PROGRAM_OBJECTIVE` names the
+objective the program optimiser uses: switching is that one line.
 """
 
 from __future__ import annotations
@@ -26,9 +33,10 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.drives.bus import supply_power
 from kinergy.optimize.program import ProgramSamples
 
-__all__ = ["ElectricalEnergy", "Objective", "bus_power"]
+__all__ = ["PROGRAM_OBJECTIVE", "ElectricalEnergy", "Objective", "SupplyEnergy", "bus_power"]
 
 Array = NDArray[np.float64]
 
@@ -61,3 +69,26 @@ class ElectricalEnergy:
 
     def __call__(self, samples: ProgramSamples) -> tuple[Array, Array]:
         return samples.integrate(bus_power(samples, recovery=self.recovery))
+
+
+@dataclass(frozen=True)
+class SupplyEnergy:
+    """The energy the arm draws from its supply per program, J: ``int (max(sum_j W_elec,j, 0)
+    + P_standby) dt`` (UR5e eq 23 summed on the DC bus, braking surplus lost, standby power).
+
+    Parameters
+    ----------
+    standby : float
+        Power the controller and the arm draw whatever the motion, W (>= 0): adds
+        ``standby * cycle time``.
+    """
+
+    standby: float = 0.0
+
+    def __call__(self, samples: ProgramSamples) -> tuple[Array, Array]:
+        bus = supply_power(samples.drive.power, self.standby)
+        return samples.integrate(bus.motors + bus.standby)
+
+
+#: the objective of :func:`kinergy.optimize.programs.optimize_program`, given the standby power
+PROGRAM_OBJECTIVE = SupplyEnergy

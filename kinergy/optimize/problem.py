@@ -30,6 +30,7 @@ __all__ = [
     "CycleTime",
     "Evaluator",
     "TimingProblem",
+    "fastest_acceleration",
     "joint_caps",
     "program_settings",
     "timing_problem",
@@ -168,7 +169,7 @@ def joint_caps(
     return np.array(v_cap), np.array(a_cap), v_why, a_why
 
 
-def _fastest_acceleration(evaluate: Evaluator, travel: Array, v_cap: Array, a_cap: Array) -> Array:
+def fastest_acceleration(evaluate: Evaluator, travel: Array, v_cap: Array, a_cap: Array) -> Array:
     """Per move the largest acceleration (at most ``a_cap``) at ``v_cap`` whose torques stay
     within the limits (0.1 % margin): a geometric scan of every move at once, then a finer linear
     scan inside the bracket each move found."""
@@ -281,7 +282,7 @@ def timing_problem(
         blends=r,
         v_cap=v_cap,
         a_cap=a_cap,
-        a_fast=_fastest_acceleration(evaluate, travel, v_cap, a_cap),
+        a_fast=fastest_acceleration(evaluate, travel, v_cap, a_cap),
         evaluate=evaluate,
         cycle=cycle,
         objective=objective,

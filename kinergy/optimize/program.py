@@ -33,9 +33,11 @@ from kinergy.trajectory.movej import MovejPlan, blend_starts, sample_moves, trap
 __all__ = [
     "ProgramSamples",
     "durations",
+    "grid_weights",
     "motion_samples",
     "quadrature_nodes",
     "sample_programs",
+    "samples_at",
     "serial",
     "settings",
 ]
@@ -85,7 +87,9 @@ def durations(travel: Array, v: Array, a: Array) -> tuple[Array, Array]:
     return t, f
 
 
-def quadrature_nodes(breaks: Array) -> tuple[Array, Array, Mask]:
+def quadrature_nodes(
+    breaks: Array, *, sub: int = _SUB, order: int = _ORDER
+) -> tuple[Array, Array, Mask]:
     """Gauss-Legendre nodes and weights over the pieces between sorted breakpoints, plus the ends
     of every piece nudged inside it (weight 0, for the limit checks at the switching times).
 
@@ -93,6 +97,8 @@ def quadrature_nodes(breaks: Array) -> tuple[Array, Array, Mask]:
     ----------
     breaks : ndarray, shape (B, P)
         Sorted switching times of each program, s.
+    sub, order : int
+        Sub-intervals per piece and Gauss-Legendre nodes per sub-interval.
 
     Returns
     -------
@@ -103,13 +109,15 @@ def quadrature_nodes(breaks: Array) -> tuple[Array, Array, Mask]:
         switching time, where rounding can put it in two phases at once (the braking of one move
         and the start of the next).
     """
+    gauss_x, gauss_w = (
+        (_GAUSS_X, _GAUSS_W) if order == _ORDER else np.polynomial.legendre.leggauss(order)
+    )
     lo, hi = breaks[:, :-1], breaks[:, 1:]  # (B, P - 1)
-    width = (hi - lo) / _SUB
-    sub = np.arange(_SUB)
-    centre = lo[..., None] + (sub + 0.5) * width[..., None]  # (B, P-1, SUB)
+    width = (hi - lo) / sub
+    centre = lo[..., None] + (np.arange(sub) + 0.5) * width[..., None]  # (B, P-1, SUB)
     half = 0.5 * width[..., None, None]
-    t = centre[..., None] + half * _GAUSS_X  # (B, P-1, SUB, ORDER)
-    w = np.broadcast_to(half * _GAUSS_W, t.shape)
+    t = centre[..., None] + half * gauss_x  # (B, P-1, SUB, ORDER)
+    w = np.broadcast_to(half * gauss_w, t.shape)
     eps = 1e-9 * np.maximum(hi - lo, 0.0)
     ends = np.stack([lo + eps, hi - eps], axis=-1)  # (B, P-1, 2)
     big_b = breaks.shape[0]
@@ -180,6 +188,33 @@ def _move_of(t: Array, start: Array) -> NDArray[np.intp]:
     return np.maximum(np.sum(started, axis=2) - 1, 0)
 
 
+def samples_at(
+    times: Array,
+    weights: Array,
+    start: Array,
+    end: Array,
+    drive: DriveState,
+    valid: Mask | None = None,
+) -> ProgramSamples:
+    """:class:`ProgramSamples` of B programs at given times.
+
+    Parameters
+    ----------
+    times, weights : ndarray, shape (B, M)
+        Sample times (s) and integration weights (s).
+    start, end : ndarray, shape (B, K)
+        When each move starts and ends, s.
+    drive : DriveState
+        The drive model at the samples, arrays of shape (B * M, n).
+    valid : ndarray of bool, shape (B, M), optional
+        Samples that count for the moves' spans (default all).
+    """
+    inside = (times[:, :, None] >= start[:, None, :]) & (times[:, :, None] <= end[:, None, :])
+    if valid is not None:
+        inside &= valid[:, :, None]
+    return ProgramSamples(times, weights, _move_of(times, start), inside, drive)
+
+
 def sample_programs(
     robot: Robot, waypoints: Array, blends: Array, t: Array, f: Array
 ) -> ProgramSamples:
@@ -209,12 +244,16 @@ def sample_programs(
     q, qd, qdd = sample_moves(waypoints, times, start, t, ramp, v, a)
     n = waypoints.shape[1]
     state = drive_state(robot, q.reshape(-1, n), qd.reshape(-1, n), qdd.reshape(-1, n))
-    inside = (
-        valid[:, :, None]
-        & (times[:, :, None] >= start[:, None, :])
-        & (times[:, :, None] <= end[:, None, :])
-    )
-    return ProgramSamples(times, weights, _move_of(times, start), inside, state)
+    return samples_at(times, weights, start, end, state, valid)
+
+
+def grid_weights(t: Array) -> Array:
+    """Trapezoid-rule weights of samples at times ``t`` (N,), s: ``sum(w x) = int x dt``."""
+    weights = np.zeros_like(t)
+    steps = np.diff(t)
+    weights[:-1] += 0.5 * steps
+    weights[1:] += 0.5 * steps
+    return weights
 
 
 def motion_samples(t: Array, plan: MovejPlan, drive: DriveState) -> ProgramSamples:
@@ -229,11 +268,5 @@ def motion_samples(t: Array, plan: MovejPlan, drive: DriveState) -> ProgramSampl
     drive : DriveState
         The drive model at the samples, arrays of shape (N, n).
     """
-    weights = np.zeros_like(t)
-    steps = np.diff(t)
-    weights[:-1] += 0.5 * steps
-    weights[1:] += 0.5 * steps
-    start, end = plan.start[None, :], (plan.start + plan.duration)[None, :]
-    times = t[None, :]
-    inside = (times[:, :, None] >= start[:, None, :]) & (times[:, :, None] <= end[:, None, :])
-    return ProgramSamples(times, weights[None, :], _move_of(times, start), inside, drive)
+    start = plan.start[None, :]
+    return samples_at(t[None, :], grid_weights(t)[None, :], start, start + plan.duration, drive)

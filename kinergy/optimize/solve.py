@@ -17,6 +17,7 @@ problem's callables only, whatever its objective.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -211,6 +212,7 @@ def solve_timing(
     share_budget: bool = True,
     torque_margin: float = 0.0,
     maxiter: int = 150,
+    deadline: float | None = None,
 ) -> Solution:
     """Minimise the objective of ``problem`` at ``cycle_time`` with SLSQP, from ``(v0, a0)``.
 
@@ -228,6 +230,8 @@ def solve_timing(
         Keep each move's largest joint torque below ``1 - torque_margin`` times its limit.
     maxiter : int
         SLSQP iterations.
+    deadline : float, optional
+        ``time.process_time()`` after which SLSQP stops at its current iterate.
 
     Returns
     -------
@@ -238,6 +242,11 @@ def solve_timing(
     a0 = np.asarray(a0, dtype=float)
     variables, x0 = _variables(problem, cycle_time, v0, a0, share_budget)
     model = _Model(problem, variables, x0)
+
+    def stop(_: Array) -> None:
+        if deadline is not None and time.process_time() > deadline:
+            raise StopIteration
+
     res = minimize(
         lambda x: model.value(x)[0],
         x0,
@@ -246,6 +255,7 @@ def solve_timing(
         bounds=list(zip(variables.lower, variables.upper, strict=True)),
         constraints=_constraints(model, cycle_time, torque_margin),
         options={"maxiter": maxiter, "ftol": 1e-8},
+        callback=stop,
     )
     t, f = variables.timing(np.clip(res.x, variables.lower, variables.upper))
     e, _ = problem.evaluate(t, f)

@@ -60,7 +60,7 @@ import dataclasses
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -79,7 +79,15 @@ from kinergy.optimize.program import durations, serial
 from kinergy.optimize.solve import Solution, solve_timing
 from kinergy.optimize.verify import ProgramResult, simulate_program
 
-__all__ = ["ParetoPoint", "TimingResult", "optimize_timing", "pareto_front"]
+__all__ = [
+    "Checks",
+    "ParetoPoint",
+    "TimingResult",
+    "best_verified",
+    "optimize_timing",
+    "pareto_front",
+    "uniform_wins",
+]
 
 Array = NDArray[np.float64]
 
@@ -153,9 +161,22 @@ class TimingResult:
         }
 
 
+class Checks(Protocol):
+    """How every program of one comparison is re-simulated, checked and scored: the problem,
+    and ``run(v, a, label, predicted)`` -> the re-simulated :class:`ProgramResult` (with its
+    ``score``)."""
+
+    @property
+    def problem(self) -> TimingProblem: ...
+
+    def run(
+        self, v: Array, a: Array, label: str, predicted: float | None = None
+    ) -> ProgramResult: ...
+
+
 @dataclass(frozen=True)
 class _Checks:
-    """How every program of one comparison is re-simulated, checked and scored."""
+    """How every program of one comparison is re-simulated, checked and scored (movej)."""
 
     robot: Robot
     problem: TimingProblem
@@ -204,7 +225,7 @@ def _scaled_to(
     return uniform_scaling(v, a, problem.cycle_time(v, a) / cycle_time)
 
 
-def _uniform_wins(uniform: ProgramResult, optimized: ProgramResult) -> bool:
+def uniform_wins(uniform: ProgramResult, optimized: ProgramResult) -> bool:
     """Whether uniform scaling keeps the limits and the optimum does not, or scores better."""
     assert uniform.score is not None and optimized.score is not None
     return uniform.ok and (not optimized.ok or uniform.score < optimized.score)
@@ -224,7 +245,14 @@ def _tightened(problem: TimingProblem, over: dict[str, float]) -> TimingProblem:
 
 
 def _optimum(
-    checks: _Checks, cycle_time: float, v0: Array, a0: Array, *, share_budget: bool
+    checks: Checks,
+    cycle_time: float,
+    v0: Array,
+    a0: Array,
+    *,
+    share_budget: bool,
+    maxiter: int = 150,
+    deadline: float | None = None,
 ) -> tuple[ProgramResult, Solution | None, int]:
     """Solve, re-simulate at 500 Hz, and tighten the bounds by any excess found there (up to
     four attempts). Returns the verified program, the last solution (None at the fastest cycle
@@ -240,7 +268,14 @@ def _optimum(
     iterations = 0
     for _ in range(4):
         sol = solve_timing(
-            current, cycle_time, v0=v0, a0=a0, share_budget=share_budget, torque_margin=margin
+            current,
+            cycle_time,
+            v0=v0,
+            a0=a0,
+            share_budget=share_budget,
+            torque_margin=margin,
+            maxiter=maxiter,
+            deadline=deadline,
         )
         iterations += sol.iterations
         result = checks.run(sol.v, sol.a, "optimized", sol.value)
@@ -249,7 +284,11 @@ def _optimum(
             for kind, (ratio, _, _) in result.check.worst().items()
             if ratio > 1.0 + LIMIT_TOL
         }
-        if not over or "position" in over:
+        if (
+            not over
+            or "position" in over
+            or (deadline is not None and time.process_time() > deadline)
+        ):
             break  # (a movej cannot leave the box its waypoints span: nothing to tighten)
         current = _tightened(current, over)
         if "torque" in over:
@@ -282,20 +321,28 @@ def _active(problem: TimingProblem, result: ProgramResult) -> list[str]:
     return out
 
 
-def _best(
-    checks: _Checks,
+def best_verified(
+    checks: Checks,
     cycle_time: float,
     v0: Array,
     a0: Array,
     uniform: ProgramResult,
     share_budget: bool,
+    maxiter: int = 150,
+    deadline: float | None = None,
 ) -> tuple[ProgramResult, str, int]:
-    """The verified optimum (:func:`_optimum`), or uniform scaling should the solver end above
-    it; the solver's message (and the fallback taken) and its iterations."""
-    optimized, sol, iterations = _optimum(checks, cycle_time, v0, a0, share_budget=share_budget)
+    """The verified optimum at ``cycle_time`` from ``(v0, a0)``: solved, re-simulated at 500 Hz
+    and re-solved with the caps tightened by any excess found there (up to four attempts), or
+    ``uniform`` should the solver end above it; the solver's message (and the fallback taken)
+    and its iterations (``maxiter``: SLSQP's limit per attempt; ``deadline``: a
+    ``time.process_time()`` after which the solver stops where it is and no further attempt is
+    made)."""
+    optimized, sol, iterations = _optimum(
+        checks, cycle_time, v0, a0, share_budget=share_budget, maxiter=maxiter, deadline=deadline
+    )
     message = "fastest cycle time: every move at its limits" if sol is None else sol.message
     # uniform scaling to the budget is the program itself at the program's own cycle time
-    if _uniform_wins(uniform, optimized):
+    if uniform_wins(uniform, optimized):
         message += (
             f"; the solver ended above uniform scaling ({optimized.e_elec:.6g} J vs "
             f"{uniform.e_elec:.6g} J): kept uniform scaling"
@@ -383,7 +430,7 @@ def optimize_timing(
     budget = _budget(cycle_time, program, problem.fastest_cycle_time)
     uniform = checks.run(*uniform_scaling(v_prog, a_prog, program.cycle_time / budget), "uniform")
     v0, a0 = _scaled_to(problem, v_prog, a_prog, budget)
-    optimized, message, iterations = _best(checks, budget, v0, a0, uniform, share_budget)
+    optimized, message, iterations = best_verified(checks, budget, v0, a0, uniform, share_budget)
     return TimingResult(
         cycle_time=budget,
         program=program,
@@ -477,7 +524,7 @@ def pareto_front(
         uniform = checks.run(*uniform_scaling(v_prog, a_prog, own / budget), "uniform")
         v0, a0 = _scaled_to(problem, v0, a0, float(budget))
         best, _, _ = _optimum(checks, float(budget), v0, a0, share_budget=share_budget)
-        if _uniform_wins(uniform, best):
+        if uniform_wins(uniform, best):
             best = uniform
         out.append(
             ParetoPoint(

@@ -170,35 +170,53 @@ def trapezoid_timing(
 
 
 def blend_starts(
-    travel: Array, blend: Array, duration: Array, acceleration: Array, ramp: Array
+    travel: Array,
+    blend: Array,
+    duration: Array,
+    acceleration: Array,
+    ramp: Array,
+    *,
+    linked: NDArray[np.bool_] | None = None,
+    gaps: Array | None = None,
 ) -> Array:
     """Start time of every move (s) under kinergy's blending rule (see the module docstring).
 
     Parameters
     ----------
     travel, blend : ndarray, shape (K,)
-        Leading-joint travel and blend radius of each move, rad.
+        Leading-joint travel and blend radius of each move, rad (or any unit, the same for both:
+        a tool move's path length in m).
     duration, acceleration, ramp : ndarray, shape (..., K)
         Each move's profile (:func:`trapezoid_timing`), s, rad/s^2, s; leading axes are
         independent programs.
+    linked : ndarray of bool, shape (K,), optional
+        Whether move k may blend into move k + 1 at all (default: every pair); a program's
+        moves of different kinds, or with an event between them, do not.
+    gaps : ndarray, shape (K,), optional
+        Fixed time at rest before each move (events: sleeps, I/O), s; default 0.
 
     Returns
     -------
     ndarray, shape (..., K)
         The next move starts when the current one's leading joint is within ``r`` of its target,
-        at most the shorter of the two ramps before the current move's end.
+        at most the shorter of the two ramps before the current move's end (after the gap, when
+        there is one: then no blend).
     """
     start = np.zeros_like(duration)
+    links = np.ones(travel.size, dtype=bool) if linked is None else linked
+    gap = np.zeros(travel.size) if gaps is None else gaps
+    if travel.size:
+        start[..., 0] = gap[0]
     for k in range(1, duration.shape[-1]):
         overlap = np.zeros(duration.shape[:-1])
-        if blend[k - 1] > 0.0 and travel[k - 1] > 0.0 and travel[k] > 0.0:
+        if links[k - 1] and blend[k - 1] > 0.0 and travel[k - 1] > 0.0 and travel[k] > 0.0:
             overlap = np.minimum(
                 np.minimum(
                     np.sqrt(2.0 * blend[k - 1] / acceleration[..., k - 1]), ramp[..., k - 1]
                 ),
                 ramp[..., k],
             )
-        start[..., k] = start[..., k - 1] + duration[..., k - 1] - overlap
+        start[..., k] = start[..., k - 1] + duration[..., k - 1] - overlap + gap[k]
     return start
 
 

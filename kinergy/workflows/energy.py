@@ -10,6 +10,7 @@ from kinergy.accounting.supply import measured_supply
 from kinergy.io.motion import motion_from_log
 from kinergy.io.rtde import read_log
 from kinergy.model.robot import Robot
+from kinergy.workflows.logs import read_motion
 
 __all__ = ["energy_of_log"]
 
@@ -25,7 +26,10 @@ def energy_of_log(
     """The energy of the motion in a log or motion file (:func:`kinergy.accounting.energy.energy`),
     with friction at the log's ``joint_temperatures`` where it has them, and the supply energy
     the log measured (``actual_robot_voltage`` x ``actual_robot_current``) beside the predicted
-    one where it has both."""
+    one where it has both. A URScript program (``*.script``) is run as the controller would
+    (:func:`kinergy.workflows.logs.read_motion`)."""
+    if os.fspath(path).endswith(".script"):
+        return energy(robot, read_motion(path, n_joints=robot.n, robot=robot), recovery=recovery)
     log = read_log(path, columns=columns)
     motion = motion_from_log(log, n_joints=robot.n, source=source)
     temperature = None

@@ -25,7 +25,7 @@ def twin_truth(robot: Robot, mismatch: str, seed: int) -> Robot:
 def _target(robot: Robot, trajectory: str, columns: str | None) -> Motion:
     if trajectory in TEST_TRAJECTORIES:
         return paper_trajectory(robot, trajectory)
-    return read_motion(trajectory, n_joints=robot.n, columns=columns, source="target")
+    return read_motion(trajectory, n_joints=robot.n, columns=columns, source="target", robot=robot)
 
 
 def simulate_to_file(

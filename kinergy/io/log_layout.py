@@ -1,0 +1,114 @@
+"""The layout of a delimited log file: its column names, delimiter and header lines, found from
+its first two lines before any data is read.
+
+A record.py log starts with a header line naming its columns; a headerless one is described by a
+column spec (:func:`kinergy.io.columns.parse_columns`). A UTF-8 byte-order mark is skipped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from kinergy.errors import KinergyError
+from kinergy.io.columns import MAX_COLUMNS, parse_columns
+
+__all__ = ["LogLayout", "first_lines", "log_layout"]
+
+#: the longest first line read to find a layout: MAX_COLUMNS columns of 64 characters each
+_MAX_LINE = MAX_COLUMNS * 64
+
+
+@dataclass(frozen=True)
+class LogLayout:
+    """How a delimited log is laid out.
+
+    Attributes
+    ----------
+    path : Path
+    names : list of str
+        The columns, in file order.
+    sep : str
+        ``","`` or ``" "`` (any run of white space when not :attr:`plain`).
+    skip : int
+        Header lines before the data (0 or 1).
+    source : str
+        What named the columns, for messages: ``"header"`` or ``"--columns spec"``.
+    plain : bool
+        The first data line has exactly one delimiter between fields (no runs of spaces, no tabs)
+        and as many fields as :attr:`names`, or one more that is empty: a fast reader can read it.
+    trailing : bool
+        Lines end with a delimiter (one more, empty field).
+    """
+
+    path: Path
+    names: list[str]
+    sep: str
+    skip: int
+    source: str
+    plain: bool
+    trailing: bool
+
+
+def first_lines(path: Path, count: int) -> list[str]:
+    """The first ``count`` lines of ``path`` (each at most ``_MAX_LINE`` characters), decoded
+    as UTF-8 with a byte-order mark removed.
+
+    Raises
+    ------
+    KinergyError
+        The file cannot be opened or read, or a first line is longer than the limit.
+    """
+    lines: list[str] = []
+    try:
+        with path.open("r", encoding="utf-8-sig", errors="replace", newline="") as fh:
+            for _ in range(count):
+                line = fh.readline(_MAX_LINE + 1)
+                if len(line) > _MAX_LINE:
+                    raise KinergyError(
+                        f"{path}: line {len(lines) + 1} is longer than {_MAX_LINE} characters "
+                        f"(at most {MAX_COLUMNS} columns)"
+                    )
+                lines.append(line)
+    except OSError as exc:
+        raise KinergyError(f"{path}: cannot read log ({exc.strerror})") from None
+    return lines
+
+
+def log_layout(path: Path, columns: str | None) -> LogLayout:
+    """The layout of the log at ``path``; ``columns`` is the spec of a headerless file.
+
+    Raises
+    ------
+    KinergyError
+        Empty file; no header line and no spec; more than :data:`MAX_COLUMNS` columns; no
+        ``timestamp`` column.
+    """
+    head, data = first_lines(path, 2)
+    if not head.strip():
+        raise KinergyError(f"{path}: empty log")
+    sep = "," if "," in head else " "
+    if columns is None:
+        fields = head.strip().replace(",", " ").split()
+        if len(fields) > MAX_COLUMNS:
+            raise KinergyError(
+                f"{path}: the header names {len(fields)} columns; at most {MAX_COLUMNS}"
+            )
+        first = fields[0] if fields else ""
+        if not first or first[:1].isdigit() or first[:1] in "+-.":
+            raise KinergyError(
+                f"{path}: no header line (record.py layout); give the layout with --columns"
+            )
+        names, skip, source = fields, 1, "header"
+    else:
+        names, skip, source, data = parse_columns(columns), 0, "--columns spec", head
+    if "timestamp" not in names:
+        raise KinergyError(f"{path}: no 'timestamp' column")
+    if len(set(names)) != len(names):
+        raise KinergyError(f"{path}: the {source} repeats a column name")
+    cells = data.rstrip("\r\n").split(sep)
+    trailing = len(cells) == len(names) + 1 and cells[-1] == ""
+    same_width = len(cells) == len(names) + trailing
+    single = sep == "," or cells == data.split()
+    plain = same_width and single and "\t" not in data and '"' not in data
+    return LogLayout(path, names, sep, skip, source, plain, trailing)

@@ -1,0 +1,158 @@
+"""A robot program (URScript's moves and events) as a batched function of its moves' timing.
+
+The timing solver (:mod:`kinergy.optimize.solve`) sees a program through the durations ``t_k``
+and ramp fractions ``f_k`` of its moves (:func:`kinergy.optimize.program.settings`). For a
+resolved :class:`~kinergy.trajectory.program_path.ProgramPath` (movej, movel, movep, blends,
+events of fixed time), :func:`sample_path_programs` plans B such programs
+(:func:`kinergy.trajectory.program_motion.schedule_profiles`), samples them at Gauss-Legendre
+nodes between all their switching times (each move's start, end of ramp, start of braking, end;
+each event's start and end: :func:`kinergy.optimize.program.quadrature_nodes`) and runs the
+drive model over every sample with the load the program has set there
+(:func:`drive_by_payload`). :func:`grid_path_samples` gives a 500 Hz re-simulation the same
+form, so one objective (:mod:`kinergy.optimize.objectives`) scores both.
+"""
+
+from __future__ import annotations
+
+from dataclasses import fields
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kinergy.model.robot import Payload, Robot
+from kinergy.optimize.program import (
+    ProgramSamples,
+    grid_weights,
+    quadrature_nodes,
+    samples_at,
+    settings,
+)
+from kinergy.predict import DriveState, drive_state
+from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.program_motion import (
+    Schedule,
+    payload_index,
+    sample_path,
+    schedule_profiles,
+)
+from kinergy.trajectory.program_path import ProgramPath
+
+__all__ = ["drive_by_payload", "grid_path_samples", "path_schedule", "sample_path_programs"]
+
+Array = NDArray[np.float64]
+
+#: Gauss-Legendre sub-intervals per piece (the 500 Hz re-simulation makes the final figures)
+_SUB = 2
+
+
+def drive_by_payload(
+    robot: Robot,
+    payloads: tuple[Payload | None, ...],
+    load: NDArray[np.intp],
+    q: Array,
+    qd: Array,
+    qdd: Array,
+) -> DriveState:
+    """The drive model (:func:`kinergy.predict.drive_state`) at samples that carry different
+    loads.
+
+    Parameters
+    ----------
+    robot : Robot
+    payloads : tuple of Payload or None
+        The loads (``None``: none at the flange).
+    load : ndarray of int, shape (N,)
+        Index into ``payloads`` of each sample's load.
+    q, qd, qdd : ndarray, shape (N, n)
+
+    Returns
+    -------
+    DriveState
+        Arrays of shape (N, n), each sample computed with its load.
+    """
+    used = np.unique(load)
+    if used.size == 1:
+        return drive_state(robot.with_payload(payloads[int(used[0])]), q, qd, qdd)
+    parts = {
+        int(i): drive_state(robot.with_payload(payloads[int(i)]), q[m], qd[m], qdd[m])
+        for i in used
+        if np.any(m := load == i)
+    }
+    out = {}
+    for f in fields(DriveState):
+        arr = np.zeros(q.shape)
+        for i, state in parts.items():
+            arr[load == i] = getattr(state, f.name)
+        out[f.name] = arr
+    return DriveState(**out)
+
+
+def path_schedule(path: ProgramPath, t: Array, f: Array) -> Schedule:
+    """B programs on ``path`` given their moves' durations ``t`` (s) and ramp fractions ``f``,
+    shape (B, K) (:func:`kinergy.optimize.program.settings`)."""
+    v, a, ramp = settings(path.travel, t, f)
+    return schedule_profiles(path, t, ramp, v, a)
+
+
+def _breaks(path: ProgramPath, sched: Schedule) -> Array:
+    """Every switching time of B programs, sorted, shape (B, P)."""
+    end = sched.start + sched.duration
+    event_end = sched.event_start + path.event_time
+    parts = [
+        np.zeros((sched.start.shape[0], 1)),
+        sched.start,
+        sched.start + sched.ramp,
+        end - sched.ramp,
+        end,
+        sched.event_start,
+        event_end,
+        sched.total[:, None],
+    ]
+    return np.sort(np.concatenate(parts, axis=1), axis=1)
+
+
+def _samples(
+    robot: Robot,
+    path: ProgramPath,
+    sched: Schedule,
+    times: Array,
+    weights: Array,
+    valid: NDArray[np.bool_] | None,
+) -> ProgramSamples:
+    q, qd, qdd = sample_path(robot, path, sched, times)
+    n = path.q0.size
+    load = payload_index(path, sched, times).reshape(-1)
+    drive = drive_by_payload(
+        robot, path.payloads, load, q.reshape(-1, n), qd.reshape(-1, n), qdd.reshape(-1, n)
+    )
+    end = sched.start + sched.duration
+    return samples_at(times, weights, sched.start, end, drive, valid)
+
+
+def sample_path_programs(robot: Robot, path: ProgramPath, t: Array, f: Array) -> ProgramSamples:
+    """B programs on ``path`` at the quadrature nodes, with the drive model.
+
+    Parameters
+    ----------
+    robot : Robot
+    path : ProgramPath
+    t, f : ndarray, shape (B, K)
+        Each program's move durations (s) and ramp fractions.
+
+    Returns
+    -------
+    ProgramSamples
+        Gauss-Legendre nodes between every program's switching times; events count to the move
+        before them.
+    """
+    sched = path_schedule(path, t, f)
+    times, weights, valid = quadrature_nodes(_breaks(path, sched), sub=_SUB)
+    return _samples(robot, path, sched, times, weights, valid)
+
+
+def grid_path_samples(
+    robot: Robot, path: ProgramPath, sched: Schedule, motion: Motion
+) -> ProgramSamples:
+    """One program's samples on its time grid (a 500 Hz re-simulation, trapezoid weights)."""
+    times = motion.t[None, :]
+    return _samples(robot, path, sched, times, grid_weights(motion.t)[None, :], None)

@@ -1,0 +1,102 @@
+"""The program optimiser: the path search, and ``kinergy optimize`` on a URScript program."""
+
+from __future__ import annotations
+
+import itertools
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from kinergy.cli.optimize import optimize
+from kinergy.io.rtde import read_log
+from kinergy.model.library import load_robot
+from kinergy.optimize.program_search import cheapest_cycle
+from kinergy.workflows.logs import read_motion
+
+SMALL = (Path(__file__).parent / "programs" / "small.script").read_text()
+
+
+def test_cheapest_cycle_is_the_brute_force_optimum() -> None:
+    rng = np.random.default_rng(5)
+    sizes = [3, 2, 4, 3]
+    costs = [rng.uniform(1, 10, (sizes[k - 1], sizes[k])) for k in range(len(sizes))]
+    costs[2][1, 2] = np.inf
+    best = min(
+        (
+            sum(costs[k][states[k - 1], states[k]] for k in range(len(sizes))),
+            states,
+        )
+        for states in itertools.product(*(range(s) for s in sizes))
+    )
+    states, total = cheapest_cycle(costs)
+    assert total == pytest.approx(best[0])
+    assert tuple(states) == best[1]
+
+
+@pytest.fixture(scope="module")
+def optimized(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict]:
+    folder = tmp_path_factory.mktemp("program")
+    source = folder / "small.script"
+    source.write_text(SMALL)
+    out = folder / "small_opt.script"
+    result = CliRunner().invoke(
+        optimize,
+        [
+            "ur5e", str(source), "--tool-symmetry", "z", "--json",
+            "--urscript", str(out), "--motions", str(folder / "motions"),
+        ],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    return folder, json.loads(result.stdout)
+
+
+def test_optimize_program_saves_and_keeps_the_job(optimized: tuple[Path, dict]) -> None:
+    _, data = optimized
+    for key in ("program", "optimized"):
+        assert {"cycle_time", "e_elec", "within_limits"} <= set(data[key])
+    assert data["optimized"]["cycle_time"] == pytest.approx(data["program"]["cycle_time"], rel=1e-3)
+    assert data["optimized"]["within_limits"]
+    assert data["targets_met"]
+    assert data["saving"] > 0.02
+    names = [lv["name"] for lv in data["levers"]]
+    assert names[:2] == ["program", "2pi"] and "tool symmetry" in names and "timing" in names
+    readback = data["readback_e_supply"] / data["optimized"]["e_supply"] - 1.0
+    assert abs(readback) < 0.01
+
+
+def test_written_program_reproduces_optimized_csv(optimized: tuple[Path, dict]) -> None:
+    folder, _ = optimized
+    text = (folder / "small_opt.script").read_text()
+    assert "set_standard_digital_out(0, True)" in text and "sleep(0.25)" in text
+    log = read_log(folder / "motions" / "optimized.csv")
+    assert {"target_q", "target_qd", "target_qdd"} <= set(log.signals)
+    assert (folder / "motions" / "optimized.csv").read_text().startswith("timestamp target_q_0")
+    again = read_motion(folder / "small_opt.script", n_joints=6, robot=load_robot("ur5e"))
+    q = log["target_q"]
+    n = min(q.shape[0], again.q.shape[0])
+    assert abs(q.shape[0] - again.q.shape[0]) <= 1
+    np.testing.assert_allclose(again.q[:n], q[:n], atol=1e-5)
+
+
+def test_never_writes_over_the_program(tmp_path: Path) -> None:
+    source = tmp_path / "small.script"
+    source.write_text(SMALL)
+    result = CliRunner().invoke(
+        optimize, ["ur5e", str(source), "--urscript", str(source), "--no-blends"]
+    )
+    assert result.exit_code != 0
+    assert "is also an input" in str(result.exception)
+    assert source.read_text() == SMALL
+
+
+def test_cycle_time_too_short_names_a_line(tmp_path: Path) -> None:
+    source = tmp_path / "small.script"
+    source.write_text(SMALL)
+    result = CliRunner().invoke(optimize, ["ur5e", str(source), "--cycle-time", "0.5"])
+    assert result.exit_code != 0
+    message = str(result.exception)
+    assert "\n" not in message
+    assert "small.script" in message and "shorter than the fastest possible" in message
