@@ -15,10 +15,11 @@ Coriolis/centrifugal terms and the rotor inertia), and ``W_elec`` is the copper 
     E_elec = E_inertial + E_gravity + E_friction + E_copper
 
 where each motion part includes its share of the non-copper motor losses (the ``k_b / k_t`` factor).
-Integrals are signed by default, as in the seed: braking energy returns to the DC bus and is
-counted negative. ``recovery=False`` clips negative power: per joint for the joint figures, and on
-the summed bus power for the total (joints braking can still feed joints driving; the supply takes
-nothing back).
+Integrals run over each stretch of unbroken sampling (:mod:`kinergy.io.segments`), never
+across a gap in the time stamps. They are signed by default, as in the seed: braking energy
+returns to the DC bus and is counted negative. ``recovery=False`` clips negative power: per
+joint for the joint figures, and on the summed bus power for the total (joints braking can still
+feed joints driving; the supply takes nothing back).
 
 What the arm draws from its supply -- the answer to "how much did it cost" -- is the report's
 ``supply`` (:mod:`kinergy.accounting.supply`): the joints' powers shared on the DC bus, the
@@ -37,6 +38,7 @@ from scipy.integrate import trapezoid
 
 from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy, supply_energy
 from kinergy.drives.transmission import transmission_matrix
+from kinergy.io.segments import segment_bounds
 from kinergy.jsonable import to_jsonable
 from kinergy.model.robot import Robot
 from kinergy.predict import DriveState, drive_state
@@ -199,8 +201,12 @@ def energy(
     kt_over_kb = np.array([j.drive.kt_over_kb for j in robot.joints])
     copper = p_elec - state.wm * state.tau_m / kt_over_kb
 
+    pieces = segment_bounds(t)  # never integrate across a gap in the time stamps
+
     def integral(power: Array) -> Array:
-        return np.asarray(trapezoid(power, t, axis=0), dtype=float)
+        return np.asarray(
+            sum(trapezoid(power[a:b], t[a:b], axis=0) for a, b in pieces), dtype=float
+        )
 
     part_power = {
         "inertial": state.wm * tau_inertial_m / kt_over_kb,
@@ -217,7 +223,7 @@ def energy(
         total_elec = float(integral(np.maximum(p_elec.sum(axis=1), 0.0)[:, None])[0])
         p_mech = np.maximum(p_mech, 0.0)
         p_elec = np.maximum(p_elec, 0.0)
-    duration = float(t[-1] - t[0])
+    recorded = float(sum(t[b - 1] - t[a] for a, b in pieces))  # gaps excluded
     return EnergyReport(
         robot=robot.name,
         joints=robot.joint_names,
@@ -228,7 +234,7 @@ def energy(
         e_elec=integral(p_elec),
         breakdown=breakdown,
         part_power=part_power,
-        standby=robot.standby_power * duration,
+        standby=robot.standby_power * recorded,
         total_e_mech=total_mech,
         total_e_elec=total_elec,
         recovery=recovery,

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import trapezoid
 
 from kinergy.drives.bus import SupplyPower, supply_power
+from kinergy.io.segments import segment_bounds
 
 __all__ = [
     "MEASURED_INCLUDES",
@@ -71,7 +72,13 @@ class SupplyEnergy:
 
 
 def _integral(t: Array, power: Array) -> float:
-    return float(trapezoid(power, t))
+    """``int power dt`` over each stretch of unbroken sampling, never across a gap."""
+    return float(sum(trapezoid(power[a:b], t[a:b]) for a, b in segment_bounds(t)))
+
+
+def _duration(t: Array) -> float:
+    """Seconds sampled: the gaps between segments left out."""
+    return float(sum(t[b - 1] - t[a] for a, b in segment_bounds(t)))
 
 
 def supply_energy(t: ArrayLike, power: ArrayLike, standby_power: float = 0.0) -> SupplyEnergy:
@@ -79,7 +86,7 @@ def supply_energy(t: ArrayLike, power: ArrayLike, standby_power: float = 0.0) ->
     times ``t`` (s, (N,)) and a constant ``standby_power`` (W)."""
     t = np.asarray(t, dtype=float)
     bus: SupplyPower = supply_power(power, standby_power)
-    duration = float(t[-1] - t[0])
+    duration = _duration(t)
     motors = _integral(t, bus.motors)
     standby = bus.standby * duration
     drawn = motors + standby
@@ -109,7 +116,7 @@ def measured_supply(t: ArrayLike, voltage: ArrayLike, current: ArrayLike) -> Mea
     t = np.asarray(t, dtype=float)
     power = np.asarray(voltage, dtype=float) * np.asarray(current, dtype=float)
     drawn = _integral(t, power)
-    duration = float(t[-1] - t[0])
+    duration = _duration(t)
     return MeasuredSupply(
         drawn=drawn,
         mean_power=drawn / duration if duration else float("nan"),

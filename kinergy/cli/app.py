@@ -41,6 +41,9 @@ COMMANDS = {
     "nursing": "kinergy.cli.nursing:nursing",
     "report": "kinergy.cli.report:report",
     "demo": "kinergy.cli.demo:demo",
+    "record": "kinergy.cli.record:record",
+    "monitor": "kinergy.cli.monitor:monitor",
+    "fleet": "kinergy.cli.fleet:fleet",
 }
 
 

@@ -2,7 +2,7 @@
 
 A motion file is a log in record.py layout holding at least ``timestamp`` and ``target_q`` (the
 twin and ``kinergy excite`` write ``target_qd`` and ``target_qdd`` too). Missing derivatives are
-computed from a cubic spline through the samples.
+computed from a cubic spline through the samples of each segment (:mod:`kinergy.io.segments`).
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from scipy.interpolate import CubicSpline
 
 from kinergy.errors import KinergyError
 from kinergy.io.log import Log
+from kinergy.io.segments import segment_bounds
 from kinergy.trajectory.motion import Motion
 
 __all__ = ["motion_from_log"]
@@ -20,8 +21,14 @@ __all__ = ["motion_from_log"]
 Array = NDArray[np.float64]
 
 
-def _derivatives(t: Array, x: Array, order: int) -> Array:
-    return np.asarray(CubicSpline(t, x, axis=0)(t, order), dtype=float)
+def _derivatives(t: Array, x: Array, order: int, bounds: list[tuple[int, int]]) -> Array:
+    """The ``order``-th derivative of a spline through each segment of samples (never across
+    a gap); a segment of one sample has none (0)."""
+    out = np.zeros_like(x, dtype=float)
+    for a, b in bounds:
+        if b - a > 1:
+            out[a:b] = CubicSpline(t[a:b], x[a:b], axis=0)(t[a:b], order)
+    return out
 
 
 def motion_from_log(log: Log, *, n_joints: int | None = None, source: str = "auto") -> Motion:
@@ -58,13 +65,14 @@ def motion_from_log(log: Log, *, n_joints: int | None = None, source: str = "aut
             f"but the robot has {n_joints}"
         )
     t = log.t
-    qd = log[qd_name] if qd_name in log else _derivatives(t, q, 1)
+    bounds = segment_bounds(t, log.signals.get("segment"))
+    qd = log[qd_name] if qd_name in log else _derivatives(t, q, 1, bounds)
     if qdd_name in log:
         qdd = log[qdd_name]
     elif qd_name in log:
-        qdd = _derivatives(t, qd, 1)
+        qdd = _derivatives(t, qd, 1, bounds)
     else:
-        qdd = _derivatives(t, q, 2)
+        qdd = _derivatives(t, q, 2, bounds)
     for name, arr in ((qd_name, qd), (qdd_name, qdd)):
         if arr.shape != q.shape:
             raise KinergyError(

@@ -1,0 +1,80 @@
+"""``kinergy fleet energy``: every log's energy per cycle on Dask, by robot and day, with drift."""
+
+from __future__ import annotations
+
+import click
+
+from kinergy.cli.common import note, progress, table
+from kinergy.fleet.analysis import LogResult
+from kinergy.jsonable import dumps
+from kinergy.workflows.fleet import fleet_energy
+
+__all__ = ["fleet"]
+
+
+@click.group()
+def fleet() -> None:
+    """Many robots' logs at once (needs the fleet extra: pip install 'kinergy[fleet]')."""
+
+
+@fleet.command("energy")
+@click.argument("logs", nargs=-1, metavar="LOGS...", type=click.Path(dir_okay=False))
+@click.option("--manifest", required=True, type=click.Path(dir_okay=False), help="FLEET.toml.")
+@click.option("--out", required=True, type=click.Path(dir_okay=False), help="FLEET.parquet.")
+@click.option("--report", type=click.Path(file_okay=False), help="Write the HTML report here.")
+@click.option("--scheduler", metavar="ADDRESS", help="A Dask scheduler (default: a local cluster).")
+@click.option("--workers", type=int, help="Local cluster worker processes [one per core].")
+@click.option(
+    "--min-rise", type=float, default=0.05, show_default=True, help="Smallest rise called drift."
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the robots as JSON.")
+def energy(
+    logs: tuple[str, ...],
+    manifest: str,
+    out: str,
+    report: str | None,
+    scheduler: str | None,
+    workers: int | None,
+    min_rise: float,
+    as_json: bool,
+) -> None:
+    """Energy per cycle of every log (LOGS and the manifest's globs), by robot and by day.
+
+    Writes one row per cycle to --out (Parquet) and flags each robot whose energy or friction
+    per cycle, for the same program, rises beyond its own spread; a step (a new payload) is
+    reported as a change, not as drift.
+    """
+    say = progress()
+
+    def tick(done: int, total: int, result: LogResult) -> None:
+        if result.error is not None:
+            note(result.error)
+        if done == total or done % max(1, total // 10) == 0:
+            say(f"{done}/{total} logs")
+
+    result = fleet_energy(
+        logs, manifest, out, report=report, scheduler=scheduler, workers=workers,
+        min_rise=min_rise, progress=tick,
+    )  # fmt: skip
+    if as_json:
+        click.echo(dumps(result))
+        return
+    rows = [
+        [r.name, str(r.logs), str(r.cycles), f"{r.energy_J / 1e3:.2f}",
+         "-" if not r.measured_J else f"{r.predicted_J / r.measured_J:.4f}",
+         "DRIFT" if r.drift else "-", str(len(r.changes))]
+        for r in result.robots
+    ]  # fmt: skip
+    click.echo(
+        table(
+            ["robot", "logs", "cycles", "energy [kJ]", "model/measured", "drift", "changes"], rows
+        )
+    )
+    for r in result.robots:
+        for c in r.changes:
+            click.echo(
+                f"{r.name}: {c.metric} per cycle of {c.program} changed on {c.date} "
+                f"({100 * c.relative:+.1f} %): a change, not drift"
+            )
+    where = f"; report {report}/report.html" if report else ""
+    say(f"{result.logs} logs on {result.workers} worker(s) in {result.seconds:.1f} s: {out}{where}")

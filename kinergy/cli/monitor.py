@@ -1,0 +1,67 @@
+"""``kinergy monitor``: live energy per program cycle, measured against the model."""
+
+from __future__ import annotations
+
+import click
+
+from kinergy.cli.common import fmt, load, progress
+from kinergy.jsonable import dumps
+from kinergy.live.monitor import CycleEnergy
+from kinergy.workflows.monitor import monitor_cycles
+
+__all__ = ["monitor"]
+
+_HEAD = f"{'cycle':>5}  {'start [s]':>11}  {'T [s]':>7}  {'measured [J]':>12}  {'model [J]':>10}  {'model err':>9}"
+
+
+def _line(c: CycleEnergy) -> str:
+    measured = "-" if c.measured is None else f"{c.measured:.1f}"
+    error = "-" if c.error is None else f"{100 * c.error:+.2f} %"
+    return (
+        f"{c.index:>5}  {c.start:>11.3f}  {c.duration:>7.3f}  {measured:>12}  "
+        f"{c.predicted:>10.1f}  {error:>9}"
+    )
+
+
+@click.command()
+@click.argument("address", metavar="HOST[:PORT]")
+@click.option(
+    "--model", "model", required=True, metavar="ROBOT", help="Robot model (name or file)."
+)
+@click.option("--frequency", type=float, default=500.0, show_default=True, help="Hz.")
+@click.option("--duration", type=float, help="Stop after this many seconds of controller time.")
+@click.option("--json", "as_json", is_flag=True, help="At the end, print the cycles as JSON.")
+def monitor(
+    address: str, model: str, frequency: float, duration: float | None, as_json: bool
+) -> None:
+    """Energy of every program cycle, live: the supply's (voltage x current) against the model's.
+
+    Cycles are found from the repeating commanded joint angles; Ctrl-C stops.
+    """
+    robot = load(model, None)
+    say = progress()
+    shown: list[CycleEnergy] = []
+
+    def show(cycle: CycleEnergy) -> None:
+        if not shown and not as_json:
+            click.echo(_HEAD)
+        shown.append(cycle)
+        if not as_json:
+            click.echo(_line(cycle))
+
+    tracker = monitor_cycles(
+        address, robot, frequency=frequency, duration=duration, on_cycle=show, status=say
+    )
+    period = "not found" if tracker.period is None else f"{fmt(tracker.period)} s"
+    if as_json:
+        click.echo(
+            dumps(
+                {
+                    "robot": robot.name,
+                    "period": tracker.period,
+                    "supply_logged": tracker.supply,
+                    "cycles": [{**vars(c), "error": c.error} for c in shown],
+                }
+            )
+        )
+    say(f"{len(shown)} cycle(s), period {period}")

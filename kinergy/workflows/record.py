@@ -1,0 +1,68 @@
+"""``kinergy record``: a controller's RTDE stream to log files until a duration, Ctrl-C or SIGTERM."""
+
+from __future__ import annotations
+
+import os
+import threading
+from collections.abc import Callable
+
+from kinergy.errors import KinergyError
+from kinergy.files import check_output
+from kinergy.live.recorder import FIELDS, OPTIONAL_FIELDS, Recording, record
+from kinergy.live.rtde import parse_address
+from kinergy.live.stream import Stream, stop_on_signals
+
+__all__ = ["record_to_file"]
+
+
+def record_to_file(
+    address: str,
+    out: str | os.PathLike[str],
+    *,
+    frequency: float = 500.0,
+    duration: float | None = None,
+    rotate_minutes: float | None = None,
+    rotate_megabytes: float | None = None,
+    status: Callable[[str], None] | None = None,
+) -> Recording:
+    """Record every field kinergy uses from the controller at ``address`` (``HOST[:PORT]``).
+
+    SIGINT and SIGTERM end the recording with complete files (``Recording.stopped`` names the
+    signal); see :func:`kinergy.live.recorder.record`.
+
+    Raises
+    ------
+    KinergyError
+        A bad address, host or output path, a refused connection, a controller that refuses the
+        protocol or the recipe, a non-positive duration or rotation.
+    """
+    host, port = parse_address(address)
+    for flag, value in (
+        ("--duration", duration),
+        ("--rotate", rotate_minutes),
+        ("--rotate-size", rotate_megabytes),
+    ):
+        if value is not None and not value > 0:
+            raise KinergyError(f"{flag} must be > 0, got {value:g}")
+    check_output(out)
+    stop = threading.Event()
+    with stop_on_signals(stop) as seen:
+        stream = Stream(host, port, FIELDS, frequency, optional=OPTIONAL_FIELDS, status=status)
+        if status is not None:
+            major, minor, bugfix, build = stream.version
+            status(
+                f"connected to {host}:{port} (controller {major}.{minor}.{bugfix}.{build}), "
+                f"{len(stream.recipe.names)} fields at {frequency:g} Hz"
+            )
+        result = record(
+            stream,
+            out,
+            stop=stop,
+            duration=duration,
+            rotate_seconds=None if rotate_minutes is None else 60.0 * rotate_minutes,
+            rotate_bytes=None if rotate_megabytes is None else int(rotate_megabytes * 1e6),
+            status=status,
+        )
+    if "signal" in seen:
+        result.stopped = seen["signal"]
+    return result
