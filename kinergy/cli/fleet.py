@@ -44,7 +44,6 @@ def energy(
     per cycle, for the same program, rises beyond its own spread; a step (a new payload) is
     reported as a change, not as drift.
     """
-    say = progress()
 
     def tick(done: int, total: int, result: LogResult) -> None:
         if result.error is not None:
@@ -52,10 +51,11 @@ def energy(
         if done == total or done % max(1, total // 10) == 0:
             say(f"{done}/{total} logs")
 
-    result = fleet_energy(
-        logs, manifest, out, report=report, scheduler=scheduler, workers=workers,
-        min_rise=min_rise, progress=tick,
-    )  # fmt: skip
+    with progress() as say:
+        result = fleet_energy(
+            logs, manifest, out, report=report, scheduler=scheduler, workers=workers,
+            min_rise=min_rise, progress=tick,
+        )  # fmt: skip
     if as_json:
         click.echo(dumps(result))
         return
@@ -77,4 +77,7 @@ def energy(
                 f"({100 * c.relative:+.1f} %): a change, not drift"
             )
     where = f"; report {report}/report.html" if report else ""
-    say(f"{result.logs} logs on {result.workers} worker(s) in {result.seconds:.1f} s: {out}{where}")
+    click.echo(
+        f"{result.logs} logs on {result.workers} worker(s) in {result.seconds:.1f} s: {out}{where}",
+        err=True,
+    )

@@ -39,7 +39,6 @@ def monitor(
     Cycles are found from the repeating commanded joint angles; Ctrl-C stops.
     """
     robot = load(model, None)
-    say = progress()
     shown: list[CycleEnergy] = []
 
     def show(cycle: CycleEnergy) -> None:
@@ -49,9 +48,10 @@ def monitor(
         if not as_json:
             click.echo(_line(cycle))
 
-    tracker = monitor_cycles(
-        address, robot, frequency=frequency, duration=duration, on_cycle=show, status=say
-    )
+    with progress() as say:
+        tracker = monitor_cycles(
+            address, robot, frequency=frequency, duration=duration, on_cycle=show, status=say
+        )
     period = "not found" if tracker.period is None else f"{fmt(tracker.period)} s"
     if as_json:
         click.echo(
@@ -64,4 +64,4 @@ def monitor(
                 }
             )
         )
-    say(f"{len(shown)} cycle(s), period {period}")
+    click.echo(f"{len(shown)} cycle(s), period {period}", err=True)

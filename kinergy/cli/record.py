@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import progress
+from kinergy.cli.common import progress, writes
 from kinergy.workflows.record import record_to_file
 
 __all__ = ["record"]
@@ -23,6 +23,7 @@ __all__ = ["record"]
 @click.option(
     "--rotate-size", "rotate_megabytes", type=float, metavar="MB", help="New file every MB."
 )
+@writes(files=("out",))
 def record(
     address: str,
     out: str,
@@ -36,19 +37,20 @@ def record(
     Every package is kept, with the controller's own time stamps, in UR's record.py layout plus a
     `segment` column that counts reconnections. Ctrl-C or SIGTERM stops with complete files.
     """
-    say = progress()
-    result = record_to_file(
-        address,
-        out,
-        frequency=frequency,
-        duration=duration,
-        rotate_minutes=rotate_minutes,
-        rotate_megabytes=rotate_megabytes,
-        status=say,
-    )
+    with progress() as say:
+        result = record_to_file(
+            address,
+            out,
+            frequency=frequency,
+            duration=duration,
+            rotate_minutes=rotate_minutes,
+            rotate_megabytes=rotate_megabytes,
+            status=say,
+        )
     span = 0.0 if result.first is None else (result.last or 0.0) - result.first
     files = ", ".join(result.files)
-    say(
+    click.echo(
         f"stopped ({result.stopped}): {result.rows} rows, {span:.3f} s of controller time, "
-        f"{result.segments} segment(s) in {files}"
+        f"{result.segments} segment(s) in {files}",
+        err=True,
     )
