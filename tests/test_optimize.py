@@ -536,3 +536,20 @@ def test_command_bad_task_file(tmp_path: Path) -> None:
     assert "bad.toml" in message and "move[1].q" in message and "\n" not in message
     assert not script.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
+
+
+def test_a_task_over_the_move_cap_is_refused_in_one_line_at_once(tmp_path: Path) -> None:
+    from kinergy.workflows.optimize import MAX_MOVES
+
+    rng = np.random.default_rng(7)
+    moves = "".join(
+        f"[[move]]\nq = {[round(float(x), 3) for x in rng.uniform(-1, 1, 6)]}\n"
+        for _ in range(MAX_MOVES + 1)
+    )
+    task = tmp_path / "big.toml"
+    task.write_text("speed = 1.0\nacceleration = 2.0\n" + moves)
+    result = CliRunner().invoke(optimize, ["ur5e", str(task)])
+    assert result.exit_code != 0
+    assert f"{MAX_MOVES + 1} moves; the timing optimiser takes at most {MAX_MOVES}" in str(
+        result.output + str(result.exception)
+    )

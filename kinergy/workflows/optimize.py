@@ -30,7 +30,7 @@ from kinergy.optimize import (
 )
 from kinergy.report.plots import save, timing_pareto
 
-__all__ = ["OptimizeRun", "optimize_task", "run_optimize", "timing_script"]
+__all__ = ["MAX_MOVES", "OptimizeRun", "optimize_task", "run_optimize", "timing_script"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,6 +64,11 @@ class OptimizeRun:
         return out
 
 
+MAX_MOVES = 100
+"""Most moves :func:`optimize_task` takes: a 30-move task costs about 40 s per timing on two
+cores, so a 100-move task with the default Pareto front already runs for tens of minutes."""
+
+
 def optimize_task(
     robot: Robot,
     task: Task,
@@ -80,8 +85,13 @@ def optimize_task(
     Raises
     ------
     KinergyError
-        Prefixed with the task's name.
+        Prefixed with the task's name; a task of more than :data:`MAX_MOVES` moves.
     """
+    if task.moves > MAX_MOVES:
+        raise KinergyError(
+            f"{task.name}: {task.moves} moves; the timing optimiser takes at most {MAX_MOVES} "
+            "(each timing costs about 1.4 s per move on two cores; split the program)"
+        )
     try:
         problem = timing_problem(
             robot, task.waypoints, blends=task.blends, v_max=v_max, a_max=a_max
