@@ -41,6 +41,26 @@ def _measured_power(log: Log) -> Array | None:
     return None
 
 
+#: the signals besides the motion that the energy of a log uses
+_EXTRAS = ("joint_temperatures", "actual_robot_voltage", "actual_robot_current", "segment")
+
+
+def _signals_used(
+    path: str | os.PathLike[str], columns: str | None, source: str
+) -> list[str] | None:
+    """The signals of the log at ``path`` its energy uses (the others are never converted):
+    the motion of ``source`` (``auto`` as :func:`kinergy.io.motion.motion_from_log`) and
+    :data:`_EXTRAS`, those the log has; None (all) when it has no joint positions, so the
+    error lists what it has."""
+    names = next(iter_log(path, columns=columns, rows=2)).signals
+    if source == "auto":
+        source = "target" if "target_q" in names else "actual"
+    if f"{source}_q" not in names:
+        return None
+    wanted = [f"{source}_{x}" for x in ("q", "qd", "qdd")] + list(_EXTRAS)
+    return [name for name in wanted if name in names]
+
+
 def energy_of_log(
     robot: Robot,
     path: str | os.PathLike[str],
@@ -84,7 +104,8 @@ def energy_figures_of_log(
         return energy_of_log(robot, path, recovery=recovery).figures()
     acc = EnergyAccumulator(robot, recovery=recovery)
     measured = False
-    chunks = iter_log(path, columns=columns, rows=rows)
+    select = _signals_used(path, columns, source)
+    chunks = iter_log(path, columns=columns, rows=rows, select=select)
     for part in iter_motion(chunks, n_joints=robot.n, source=source):
         m = part.motion
         state = drive_state(robot, m.q, m.qd, m.qdd, temperature=_temperature(part.log, m))
