@@ -52,7 +52,10 @@ def _signals_used(
     the motion of ``source`` (``auto`` as :func:`kinergy.io.motion.motion_from_log`) and
     :data:`_EXTRAS`, those the log has; None (all) when it has no joint positions, so the
     error lists what it has."""
-    names = next(iter_log(path, columns=columns, rows=2)).signals
+    first = next(iter_log(path, columns=columns, rows=2), None)
+    if first is None:
+        return None
+    names = first.signals
     if source == "auto":
         source = "target" if "target_q" in names else "actual"
     if f"{source}_q" not in names:
