@@ -24,7 +24,6 @@ import argparse
 import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -66,23 +65,16 @@ def _leaves(d: object, where: str = "") -> dict[str, float]:
 def run_path(path: Path, which: str) -> dict[str, object]:
     """One path in a fresh interpreter: seconds of the call, peak RSS (MB), the report; and
     the process's wall time."""
-    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+    from bench_read import run_python  # the benchmarks' fresh-interpreter runner
+
     start = time.perf_counter()
-    out = subprocess.run(
-        [sys.executable, "-c", _CHILD, str(path), which],
-        check=True,
-        capture_output=True,
-        text=True,
-        env=env,
-    ).stdout
-    result: dict[str, object] = json.loads(out)
+    result: dict[str, object] = json.loads(run_python(_CHILD, str(path), which))
     result["process"] = time.perf_counter() - start
     return result
 
 
 def long_log(args: argparse.Namespace) -> None:
     """The ``--long`` mode: one pass against in memory on a long log."""
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
     from bench_read import write_log  # the benchmark log's generator
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -108,6 +100,7 @@ def long_log(args: argparse.Namespace) -> None:
 
 
 def main() -> None:
+    sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_read beside this file
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=15)
     parser.add_argument("--long", action="store_true", help="a long log, one pass vs in memory")

@@ -76,16 +76,21 @@ def write_log(path: Path, minutes: float, rate: float, seed: int = 0) -> int:
     return rows
 
 
-def run_reader(body: str, path: Path) -> tuple[int, float, float]:
-    """Run one reader in a fresh interpreter: rows, seconds, peak RSS in MB."""
+def run_python(code: str, *args: str) -> str:
+    """Run ``code`` in a fresh interpreter with this tree first on the path; its stdout."""
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
-    out = subprocess.run(
-        [sys.executable, "-c", _CHILD.format(body=body), str(path)],
+    return subprocess.run(
+        [sys.executable, "-c", code, *args],
         check=True,
         capture_output=True,
         text=True,
         env=env,
-    ).stdout.split()
+    ).stdout
+
+
+def run_reader(body: str, path: Path) -> tuple[int, float, float]:
+    """Run one reader in a fresh interpreter: rows, seconds, peak RSS in MB."""
+    out = run_python(_CHILD.format(body=body), str(path)).split()
     return int(out[0]), float(out[1]), float(out[2])
 
 
