@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import statistics
 import sys
 import tempfile
@@ -75,18 +74,10 @@ def run_path(path: Path, which: str) -> dict[str, object]:
 
 def long_log(args: argparse.Namespace) -> None:
     """The ``--long`` mode: one pass against in memory on a long log."""
-    from bench_read import write_log  # the benchmark log's generator
+    from bench_read import prepared_log  # the benchmark log's generator
 
     with tempfile.TemporaryDirectory() as tmp:
-        path = args.keep or Path(tmp) / "long.csv"
-        if not path.exists():
-            t0 = time.perf_counter()
-            rows = write_log(path, args.minutes, args.rate)
-            print(
-                f"wrote {rows} rows, {path.stat().st_size / 1e6:.0f} MB in "
-                f"{time.perf_counter() - t0:.0f} s"
-            )
-        print(f"cpu: {os.cpu_count()} logical CPUs, 1-min load {os.getloadavg()[0]:.1f}")
+        path = prepared_log(args, Path(tmp))
         print("| path | call s | process s | peak RSS MB |")
         print("|---|---:|---:|---:|")
         reports = {}
