@@ -76,16 +76,36 @@ def write_log(path: Path, minutes: float, rate: float, seed: int = 0) -> int:
     return rows
 
 
-def run_reader(body: str, path: Path) -> tuple[int, float, float]:
-    """Run one reader in a fresh interpreter: rows, seconds, peak RSS in MB."""
+def prepared_log(args: argparse.Namespace, tmp: Path) -> Path:
+    """The benchmark log: ``--keep`` (written if missing) or one written in ``tmp``; prints
+    what was written and the machine's CPUs and load."""
+    path: Path = args.keep or tmp / "long.csv"
+    if not path.exists():
+        t0 = time.perf_counter()
+        rows = write_log(path, args.minutes, args.rate)
+        print(
+            f"wrote {rows} rows, {path.stat().st_size / 1e6:.0f} MB in "
+            f"{time.perf_counter() - t0:.0f} s"
+        )
+    print(f"cpu: {os.cpu_count()} logical CPUs, 1-min load {os.getloadavg()[0]:.1f}")
+    return path
+
+
+def run_python(code: str, *args: str) -> str:
+    """Run ``code`` in a fresh interpreter with this tree first on the path; its stdout."""
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
-    out = subprocess.run(
-        [sys.executable, "-c", _CHILD.format(body=body), str(path)],
+    return subprocess.run(
+        [sys.executable, "-c", code, *args],
         check=True,
         capture_output=True,
         text=True,
         env=env,
-    ).stdout.split()
+    ).stdout
+
+
+def run_reader(body: str, path: Path) -> tuple[int, float, float]:
+    """Run one reader in a fresh interpreter: rows, seconds, peak RSS in MB."""
+    out = run_python(_CHILD.format(body=body), str(path)).split()
     return int(out[0]), float(out[1]), float(out[2])
 
 
@@ -97,15 +117,7 @@ def main() -> None:
     parser.add_argument("--keep", type=Path, help="write the log here and keep it")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        path = args.keep or Path(tmp) / "long.csv"
-        if not path.exists():
-            t0 = time.perf_counter()
-            rows = write_log(path, args.minutes, args.rate)
-            print(
-                f"wrote {rows} rows, {path.stat().st_size / 1e6:.0f} MB in "
-                f"{time.perf_counter() - t0:.0f} s"
-            )
-        print(f"cpu: {os.cpu_count()} logical CPUs, 1-min load {os.getloadavg()[0]:.1f}")
+        path = prepared_log(args, Path(tmp))
         print("| reader | s (median) | s (all) | peak RSS MB |")
         print("|---|---:|---:|---:|")
         for name, body in READERS.items():

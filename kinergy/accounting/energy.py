@@ -36,15 +36,15 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import trapezoid
 
+from kinergy.accounting.figures import EnergyFigures
 from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy, supply_energy
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.io.segments import segment_bounds
-from kinergy.jsonable import to_jsonable
 from kinergy.model.robot import Robot
 from kinergy.predict import DriveState, drive_state
 from kinergy.trajectory.motion import Motion
 
-__all__ = ["EnergyReport", "energy"]
+__all__ = ["EnergyReport", "energy", "part_powers"]
 
 Array = NDArray[np.float64]
 
@@ -101,67 +101,66 @@ class EnergyReport:
 
     @property
     def duration(self) -> float:
-        return float(self.t[-1] - self.t[0])
+        """Seconds sampled: the sum of the segments' durations (gaps left out)."""
+        return float(sum(self.t[b - 1] - self.t[a] for a, b in segment_bounds(self.t)))
 
     @property
     def efficiency(self) -> Array:
         """Per joint ``E_mech / E_elec`` (UR5e eq 24); NaN where ``E_elec`` is 0."""
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(self.e_elec != 0.0, self.e_mech / self.e_elec, np.nan)
+        return self.figures().efficiency
 
     @property
     def total_efficiency(self) -> float:
         """``sum E_mech / sum E_elec`` over the joints (standby excluded), the seed's eta."""
-        return float(self.total_e_mech / self.total_e_elec) if self.total_e_elec else float("nan")
+        return self.figures().total_efficiency
+
+    def figures(self) -> EnergyFigures:
+        """The report's figures without its time series (what ``energy`` prints)."""
+        return EnergyFigures(
+            robot=self.robot,
+            joints=self.joints,
+            duration=self.duration,
+            span=float(self.t[-1] - self.t[0]),
+            samples=int(self.t.size),
+            segments=len(segment_bounds(self.t)),
+            recovery=self.recovery,
+            e_mech=self.e_mech,
+            e_elec=self.e_elec,
+            breakdown=self.breakdown,
+            peak_power=np.max(self.p_elec, axis=0),
+            bus_peak=float(np.max(self.p_elec.sum(axis=1))),
+            rms_current=np.sqrt(np.mean(self.drive.current**2, axis=0)),
+            peak_current=np.max(np.abs(self.drive.current), axis=0),
+            standby=self.standby,
+            total_e_mech=self.total_e_mech,
+            total_e_elec=self.total_e_elec,
+            supply=self.supply,
+            measured=self.measured,
+        )
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``energy --json`` shape of DESIGN.md (extra keys included)."""
-        joints = []
-        for i, name in enumerate(self.joints):
-            eff = self.efficiency[i]
-            joints.append(
-                {
-                    "name": name,
-                    "e_mech": float(self.e_mech[i]),
-                    "e_elec": float(self.e_elec[i]),
-                    "efficiency": None if np.isnan(eff) else float(eff),
-                    "mean_power": float(self.e_elec[i] / self.duration) if self.duration else None,
-                    "peak_power": float(np.max(self.p_elec[:, i])),
-                    "breakdown": {k: float(v[i]) for k, v in self.breakdown.items()},
-                    "rms_current": float(np.sqrt(np.mean(self.drive.current[:, i] ** 2))),
-                    "peak_current": float(np.max(np.abs(self.drive.current[:, i]))),
-                }
-            )
-        bus = self.p_elec.sum(axis=1)
-        total_elec = self.total_e_elec + self.standby
-        return {
-            "robot": self.robot,
-            "duration": self.duration,
-            "samples": int(self.t.size),
-            "recovery": self.recovery,
-            "joints": joints,
-            "total": {
-                "e_mech": self.total_e_mech,
-                "e_elec": self.total_e_elec,
-                "efficiency": self.total_efficiency,
-                "standby": self.standby,
-                "e_elec_with_standby": total_elec,
-                "mean_power": total_elec / self.duration if self.duration else None,
-                "peak_power": float(np.max(bus)),
-                "breakdown": {k: float(v.sum()) for k, v in self.breakdown.items()},
-            },
-            "supply": to_jsonable(self.supply),
-            **({"measured": self.measured_dict()} if self.measured is not None else {}),
-        }
+        """The ``energy --json`` shape of DESIGN.md (:meth:`EnergyFigures.to_dict`)."""
+        return self.figures().to_dict()
 
     def measured_dict(self) -> dict[str, Any]:
-        """The ``measured`` object of the JSON: the log's supply energy and the predicted one's
-        error against it (%)."""
-        assert self.measured is not None
-        out = to_jsonable(self.measured)
-        if self.measured.drawn:
-            out["error"] = 100.0 * (self.supply.drawn / self.measured.drawn - 1.0)
-        return dict(out)
+        """The ``measured`` object of the JSON (:meth:`EnergyFigures.measured_dict`)."""
+        return self.figures().measured_dict()
+
+
+def part_powers(robot: Robot, state: DriveState) -> dict[str, Array]:
+    """The electrical power of each part of the motor torque (framework Fig. 4), W, each
+    (N, n): ``inertial``, ``gravity``, ``friction`` (motor side, each with its ``k_b / k_t``
+    share) and ``copper`` (``W_elec`` minus those three); they add up to ``state.power``."""
+    n_mat = transmission_matrix(robot)
+    tau_gravity_m = np.linalg.solve(n_mat.T, state.tau_gravity.T).T
+    tau_inertial_m = state.tau_load - tau_gravity_m
+    kt_over_kb = np.array([j.drive.kt_over_kb for j in robot.joints])
+    return {
+        "inertial": state.wm * tau_inertial_m / kt_over_kb,
+        "gravity": state.wm * tau_gravity_m / kt_over_kb,
+        "friction": state.wm * state.tau_friction / kt_over_kb,
+        "copper": state.power - state.wm * state.tau_m / kt_over_kb,
+    }
 
 
 def energy(
@@ -194,13 +193,6 @@ def energy(
     t = motion.t
     p_mech = state.p_mech
     p_elec = state.power
-    # split the motor torque into its sources (motor side)
-    n_mat = transmission_matrix(robot)
-    tau_gravity_m = np.linalg.solve(n_mat.T, state.tau_gravity.T).T
-    tau_inertial_m = state.tau_load - tau_gravity_m
-    kt_over_kb = np.array([j.drive.kt_over_kb for j in robot.joints])
-    copper = p_elec - state.wm * state.tau_m / kt_over_kb
-
     pieces = segment_bounds(t)  # never integrate across a gap in the time stamps
 
     def integral(power: Array) -> Array:
@@ -208,12 +200,7 @@ def energy(
             sum(trapezoid(power[a:b], t[a:b], axis=0) for a, b in pieces), dtype=float
         )
 
-    part_power = {
-        "inertial": state.wm * tau_inertial_m / kt_over_kb,
-        "gravity": state.wm * tau_gravity_m / kt_over_kb,
-        "friction": state.wm * state.tau_friction / kt_over_kb,
-        "copper": copper,
-    }
+    part_power = part_powers(robot, state)
     breakdown = {name: integral(power) for name, power in part_power.items()}
     if recovery:
         total_mech = float(integral(p_mech.sum(axis=1)[:, None])[0])

@@ -10,7 +10,7 @@ import click
 from kinergy.accounting.supply import MEASURED_INCLUDES, PREDICTED_INCLUDES
 from kinergy.cli.common import columns_option, load, payload_option, table
 from kinergy.jsonable import dumps
-from kinergy.workflows.energy import energy_of_log
+from kinergy.workflows.energy import energy_figures_of_log
 
 __all__ = ["energy", "energy_text"]
 
@@ -65,6 +65,8 @@ def energy_text(report: dict[str, Any]) -> str:
     )
     headers = ["joint", "E_mech [J]", "E_elec [J]", "eta [%]", "mean P [W]", "peak P [W]"]
     headers += [f"{k} [J]" for k in _PARTS]
+    if "segments" in report:
+        head += f"\n{report['segments']} segments; gaps of {report['gaps']:.3f} s not integrated."
     lines = [
         head,
         *_supply_lines(report),
@@ -109,7 +111,7 @@ def energy(
     with --columns) or a motion file.
     """
     r = load(model, payload)
-    report = energy_of_log(
+    report = energy_figures_of_log(
         r, motion_path, columns=columns, source=source, recovery=not no_recovery
     ).to_dict()
     click.echo(dumps(report) if as_json else energy_text(report))

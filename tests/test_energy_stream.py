@@ -1,0 +1,91 @@
+"""Energy in one pass (issue 16) and never across a gap (issue 15): a log read in small chunks
+gives the in-memory figures, and a log with a one-hour gap gives the sum of its two parts."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import kinergy
+from kinergy.cli import main
+from kinergy.io.rtde import write_log
+from kinergy.simulate import simulate
+from kinergy.trajectory.programs import paper_trajectory
+from kinergy.workflows.energy import energy_figures_of_log, energy_of_log
+
+RTOL = 1e-9
+
+
+def _leaves(d: Any, where: str = "") -> dict[str, Any]:
+    if isinstance(d, dict):
+        return {k: v for key, x in d.items() for k, v in _leaves(x, f"{where}.{key}").items()}
+    if isinstance(d, list):
+        return {k: v for i, x in enumerate(d) for k, v in _leaves(x, f"{where}[{i}]").items()}
+    return {where: d}
+
+
+def _assert_same(got: dict[str, Any], want: dict[str, Any], rtol: float = RTOL) -> None:
+    g, w = _leaves(got), _leaves(want)
+    assert set(g) == set(w)
+    for key, value in w.items():
+        if isinstance(value, float):
+            assert g[key] == pytest.approx(value, rel=rtol, abs=1e-12), key
+        else:
+            assert g[key] == value, key
+
+
+@pytest.fixture(scope="module")
+def long_log(tmp_path_factory: pytest.TempPathFactory, ur5e: kinergy.Robot) -> Path:
+    """A 20 s, 500 Hz twin log (noisy actual signals, target ones, supply, temperatures)."""
+    path = tmp_path_factory.mktemp("stream") / "long.csv"
+    twin = simulate(ur5e, paper_trajectory(ur5e, "test-a", dt=0.002, rest=3.43))
+    assert twin.t[-1] - twin.t[0] == pytest.approx(20.0, abs=0.01)
+    write_log(path, twin.t, twin.signals)
+    return path
+
+
+@pytest.mark.parametrize("source", ["target", "actual"])
+@pytest.mark.parametrize("recovery", [True, False])
+def test_one_pass_equals_in_memory(
+    ur5e: kinergy.Robot, long_log: Path, source: str, recovery: bool
+) -> None:
+    # actual: accelerations from a spline of the noisy speed, carried across chunk boundaries
+    want = energy_of_log(ur5e, long_log, source=source, recovery=recovery).to_dict()
+    got = energy_figures_of_log(ur5e, long_log, source=source, recovery=recovery, rows=1000)
+    assert got.samples == want["samples"] >= 10_000 and got.segments == 1
+    assert "measured" in want
+    _assert_same(got.to_dict(), want)
+
+
+def test_a_gap_is_never_integrated_across(
+    ur5e: kinergy.Robot, long_log: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    a = simulate(ur5e, paper_trajectory(ur5e, "test-a", dt=0.002))
+    b = simulate(ur5e, paper_trajectory(ur5e, "test-b", dt=0.002), name="b")
+    parts = {"a": tmp_path / "a.csv", "b": tmp_path / "b.csv", "ab": tmp_path / "ab.csv"}
+    write_log(parts["a"], a.t, a.signals)
+    t_b = b.t - b.t[0] + a.t[-1] + 3600.0  # an hour later
+    write_log(parts["b"], t_b, b.signals)
+    joined = {k: np.concatenate([a[k], b[k]]) for k in a.signals}
+    write_log(parts["ab"], np.concatenate([a.t, t_b]), joined)
+    one = {k: energy_figures_of_log(ur5e, p, source="actual", rows=1000) for k, p in parts.items()}
+    ab, sa, sb = one["ab"], one["a"], one["b"]
+    assert ab.segments == 2 and sa.segments == sb.segments == 1
+    assert ab.duration == pytest.approx(sa.duration + sb.duration, rel=1e-12)
+    assert ab.span - ab.duration == pytest.approx(3600.0, rel=1e-9)
+    np.testing.assert_allclose(ab.e_elec, sa.e_elec + sb.e_elec, rtol=RTOL)
+    np.testing.assert_allclose(ab.e_mech, sa.e_mech + sb.e_mech, rtol=RTOL)
+    assert ab.total_e_elec == pytest.approx(sa.total_e_elec + sb.total_e_elec, rel=RTOL)
+    assert ab.supply.drawn == pytest.approx(sa.supply.drawn + sb.supply.drawn, rel=RTOL)
+    assert ab.measured is not None and sa.measured is not None and sb.measured is not None
+    assert ab.measured.drawn == pytest.approx(sa.measured.drawn + sb.measured.drawn, rel=RTOL)
+    # the in-memory path splits the same way
+    _assert_same(ab.to_dict(), energy_of_log(ur5e, parts["ab"], source="actual").to_dict())
+    assert main(["energy", "ur5e", str(parts["ab"])]) == 0
+    text = capsys.readouterr().out
+    assert "2 segments; gaps of 3600.000 s not integrated." in text
+    assert main(["energy", "ur5e", str(parts["a"])]) == 0
+    assert "segments" not in capsys.readouterr().out
