@@ -36,7 +36,7 @@ from kinergy.identify.result import (
     IDENTIFIED,
     KEPT,
 )
-from kinergy.linalg import scaled_lstsq
+from kinergy.linalg import Reduced, scaled_solution
 from kinergy.model.robot import Friction, Joint, Robot
 
 __all__ = [
@@ -44,9 +44,13 @@ __all__ = [
     "CurrentStats",
     "FrictionChoice",
     "candidates",
+    "current_problem",
     "current_step",
     "motor_signals",
+    "solve_current",
     "rotor_inertias",
+    "rotor_problem",
+    "rotor_solution",
     "rotor_step",
     "stack",
     "with_rotor_inertias",
@@ -86,34 +90,50 @@ def stack(datas: Sequence[IdentData], name: str) -> Array:
     return np.vstack([getattr(d, name) for d in datas])
 
 
-def rotor_inertias(
-    robot: Robot, datas: Sequence[IdentData], active: Sequence[int] | None = None
-) -> tuple[Array, Array, float]:
-    """Step 2: ``J_m + J_r`` per motor from ``target_moment`` (UR5e eqs 7-9).
+def rotor_problem(robot: Robot, datas: Sequence[IdentData], into: Reduced | None = None) -> Reduced:
+    """Step 2's least squares (UR5e eqs 7-9) folded into a triangle (:class:`Reduced`), every
+    motor's column: ``tau_ref - f_link = N^T diag(J) N qdd`` with ``N`` the transmission matrix,
+    linear in J; rows (sample, joint) of ``datas`` stacked onto ``into`` (default none yet)."""
+    n_mat = transmission_matrix(robot)
+    problem = Reduced.empty(robot.n) if into is None else into
+    for data in datas:
+        assert data.tau_ref is not None
+        f_link = rnea(robot, data.q_cmd, data.qd_cmd, data.qdd_cmd)
+        # rows (sample, joint), column m: contribution of J_m, n_mat[m, j] * (N qdd)_m
+        a = rotor_columns(n_mat, data.qdd_cmd @ n_mat.T).reshape(-1, robot.n)
+        problem = problem.stack(a, (data.tau_ref - f_link).reshape(-1))
+    return problem
 
-    ``tau_ref - f_link = N^T diag(J) N qdd`` with ``N`` the transmission matrix, linear in J.
+
+def rotor_solution(
+    robot: Robot, problem: Reduced, active: Sequence[int] | None = None
+) -> tuple[Array, Array, float]:
+    """Step 2 from its triangle (:func:`rotor_problem`): ``J_m + J_r`` per motor.
 
     Returns
     -------
     inertia, std : ndarray, shape (n,)
         kg m^2 (motor side) and its standard deviation; motors not in ``active`` (default all)
-        keep the model's value and a NaN deviation.
+        keep the model's value (moved into the target) and a NaN deviation.
     condition : float
     """
     active = list(range(robot.n)) if active is None else list(active)
-    q, qd, qdd = stack(datas, "q_cmd"), stack(datas, "qd_cmd"), stack(datas, "qdd_cmd")
-    tau_ref = stack(datas, "tau_ref")
-    f_link = rnea(robot, q, qd, qdd)
-    n_mat = transmission_matrix(robot)
-    # rows (sample, joint), column m: contribution of J_m, n_mat[m, j] * (N qdd)_m
-    a = rotor_columns(n_mat, qdd @ n_mat.T).reshape(-1, robot.n)
-    fixed = [m for m in range(robot.n) if m not in active]
     known = np.array([j.drive.rotor_inertia for j in robot.joints])
-    y = (tau_ref - f_link).reshape(-1) - a[:, fixed] @ known[fixed]
-    sol, sol_std, cond = scaled_lstsq(a[:, active], y)
+    pick = np.zeros((robot.n + 1, len(active) + 1))
+    pick[active, np.arange(len(active))] = 1.0
+    pick[:, -1] = np.append([0.0 if m in active else -known[m] for m in range(robot.n)], 1.0)
+    sol, sol_std, cond = scaled_solution(problem.combine(pick))
     inertia, std = known.copy(), np.full(robot.n, np.nan)
     inertia[active], std[active] = sol, sol_std
     return inertia, std, cond
+
+
+def rotor_inertias(
+    robot: Robot, datas: Sequence[IdentData], active: Sequence[int] | None = None
+) -> tuple[Array, Array, float]:
+    """Step 2: ``J_m + J_r`` per motor from ``target_moment`` (UR5e eqs 7-9): :func:`rotor_solution`
+    of :func:`rotor_problem` (kg m^2 motor side, standard deviations, condition number)."""
+    return rotor_solution(robot, rotor_problem(robot, datas), active)
 
 
 @dataclass(frozen=True, eq=False)
@@ -154,20 +174,38 @@ def _columns(model: str, params: dict[str, float], signals: _Signals) -> Array:
     return np.column_stack([s.tau_load, cols])
 
 
+def current_problem(model: str, params: dict[str, float], signals: _Signals) -> Reduced:
+    """Eq 18's least squares for one motor, ``[tau_load, friction columns | current]``, folded
+    into its triangle (:class:`Reduced`; stack more chunks onto it in time order)."""
+    a = _columns(model, params, signals)
+    return Reduced.empty(a.shape[1]).stack(a, signals.current)
+
+
+def solve_current(
+    model: str, params: dict[str, float], problem: Reduced, kt_prior: float
+) -> _CurrentFit:
+    """Eq 18 for one motor from its triangle (:func:`current_problem`), the model's shape
+    parameters held (:func:`_current_fit`)."""
+    x, std, cond = scaled_solution(problem)
+    fixed = not (x[0] > 0 and std[0] < MAX_KT_SPREAD * x[0])
+    if fixed:
+        # the friction columns against current - tau_load / kt_prior
+        p = x.size
+        rest_of = np.zeros((p + 1, p))
+        rest_of[1:p, : p - 1] = np.eye(p - 1)
+        rest_of[0, -1], rest_of[p, -1] = -1.0 / kt_prior, 1.0
+        rest, rest_std, cond = scaled_solution(problem.combine(rest_of))
+        x = np.concatenate([[1.0 / kt_prior], rest])
+        std = np.concatenate([[0.0], rest_std])
+    sse = problem.norm2(np.append(-x, 1.0))
+    return _CurrentFit(model, params, x, std, cond, sse, fixed)
+
+
 def _solve_current(
     model: str, params: dict[str, float], signals: _Signals, kt_prior: float
 ) -> _CurrentFit:
     """Eq 18 for one motor with the model's shape parameters held (:func:`_current_fit`)."""
-    a = _columns(model, params, signals)
-    current = signals.current
-    x, std, cond = scaled_lstsq(a, current)
-    fixed = not (x[0] > 0 and std[0] < MAX_KT_SPREAD * x[0])
-    if fixed:
-        rest, rest_std, cond = scaled_lstsq(a[:, 1:], current - signals.tau_load / kt_prior)
-        x = np.concatenate([[1.0 / kt_prior], rest])
-        std = np.concatenate([[0.0], rest_std])
-    sse = float(np.sum((current - a @ x) ** 2))
-    return _CurrentFit(model, params, x, std, cond, sse, fixed)
+    return solve_current(model, params, current_problem(model, params, signals), kt_prior)
 
 
 def _current_fit(
