@@ -36,11 +36,12 @@ from kinergy.identify.result import (
     IDENTIFIED,
     KEPT,
 )
-from kinergy.linalg import Reduced, scaled_solution
+from kinergy.linalg import Reduced, scaled_lstsq, scaled_solution
 from kinergy.model.robot import Friction, Joint, Robot
 
 __all__ = [
     "AUTO_CANDIDATES",
+    "CurrentProblem",
     "CurrentStats",
     "FrictionChoice",
     "candidates",
@@ -181,23 +182,43 @@ def current_problem(model: str, params: dict[str, float], signals: _Signals) -> 
     return Reduced.empty(a.shape[1]).stack(a, signals.current)
 
 
-def solve_current(
-    model: str, params: dict[str, float], problem: Reduced, kt_prior: float
-) -> _CurrentFit:
-    """Eq 18 for one motor from its triangle (:func:`current_problem`), the model's shape
-    parameters held (:func:`_current_fit`)."""
-    x, std, cond = scaled_solution(problem)
-    fixed = not (x[0] > 0 and std[0] < MAX_KT_SPREAD * x[0])
-    if fixed:
-        # the friction columns against current - tau_load / kt_prior
-        p = x.size
+#: eq 18's least squares: the regressor ``[tau_load, friction columns]`` (N, 1 + k) and the
+#: current (N,), or both folded into a triangle (:func:`current_problem`, chunk by chunk)
+CurrentProblem = Reduced | tuple[Array, Array]
+
+
+def _eq18(problem: CurrentProblem, kt_prior: float | None = None) -> tuple[Array, Array, float]:
+    """:func:`~kinergy.linalg.scaled_lstsq` of eq 18 (x, standard errors, condition); with
+    ``kt_prior``, of the friction columns alone against ``current - tau_load / kt_prior``."""
+    if isinstance(problem, Reduced):
+        if kt_prior is None:
+            return scaled_solution(problem)
+        p = problem.r.shape[1] - 1
         rest_of = np.zeros((p + 1, p))
         rest_of[1:p, : p - 1] = np.eye(p - 1)
         rest_of[0, -1], rest_of[p, -1] = -1.0 / kt_prior, 1.0
-        rest, rest_std, cond = scaled_solution(problem.combine(rest_of))
+        return scaled_solution(problem.combine(rest_of))
+    a, current = problem
+    if kt_prior is None:
+        return scaled_lstsq(a, current)
+    return scaled_lstsq(a[:, 1:], current - a[:, 0] / kt_prior)
+
+
+def solve_current(
+    model: str, params: dict[str, float], problem: CurrentProblem, kt_prior: float
+) -> _CurrentFit:
+    """Eq 18 for one motor (:func:`_current_fit`), the model's shape parameters held, from its
+    rows or its triangle (:data:`CurrentProblem`: the same fit to round-off)."""
+    x, std, cond = _eq18(problem)
+    fixed = not (x[0] > 0 and std[0] < MAX_KT_SPREAD * x[0])
+    if fixed:
+        rest, rest_std, cond = _eq18(problem, kt_prior)
         x = np.concatenate([[1.0 / kt_prior], rest])
         std = np.concatenate([[0.0], rest_std])
-    sse = problem.norm2(np.append(-x, 1.0))
+    if isinstance(problem, Reduced):
+        sse = problem.norm2(np.append(-x, 1.0))
+    else:
+        sse = float(np.sum((problem[1] - problem[0] @ x) ** 2))
     return _CurrentFit(model, params, x, std, cond, sse, fixed)
 
 
@@ -205,7 +226,8 @@ def _solve_current(
     model: str, params: dict[str, float], signals: _Signals, kt_prior: float
 ) -> _CurrentFit:
     """Eq 18 for one motor with the model's shape parameters held (:func:`_current_fit`)."""
-    return solve_current(model, params, current_problem(model, params, signals), kt_prior)
+    problem = (_columns(model, params, signals), signals.current)
+    return solve_current(model, params, problem, kt_prior)
 
 
 def _current_fit(
