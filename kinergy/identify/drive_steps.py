@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -44,16 +44,22 @@ __all__ = [
     "CurrentProblem",
     "CurrentStats",
     "FrictionChoice",
+    "JointFitter",
+    "best_hold",
     "candidates",
+    "current_fitter",
     "current_problem",
     "current_step",
+    "fit_joints",
+    "holdings_of",
     "motor_signals",
-    "solve_current",
     "rotor_inertias",
     "rotor_problem",
     "rotor_solution",
     "rotor_step",
+    "solve_current",
     "stack",
+    "start_params",
     "with_rotor_inertias",
 ]
 
@@ -252,16 +258,17 @@ def _current_fit(
 
 
 def rotor_step(
-    robot: Robot, ref_logs: Sequence[IdentData], active: list[int], warnings: list[str]
+    robot: Robot, problem: Reduced | None, active: list[int], warnings: list[str]
 ) -> tuple[Array, Array, float | None]:
-    """Rotor inertias (kg m^2, motor side), their standard errors (NaN where not identified) and
+    """Rotor inertias (kg m^2, motor side) from step 2's triangle (:func:`rotor_problem`; None
+    when no log has ``target_moment``), their standard errors (NaN where not identified) and
     the regression's condition number (None without ``target_moment``). A rotor inertia that
     comes out negative is not written: the model's is kept (NaN standard error) with a warning."""
     rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
     rotor_std = np.full(robot.n, np.nan)
     cond = None
-    if ref_logs:
-        rotor, rotor_std, cond = rotor_inertias(robot, ref_logs, active)
+    if problem is not None:
+        rotor, rotor_std, cond = rotor_solution(robot, problem, active)
         if cond > MAX_CONDITION:
             raise KinergyError(
                 f"rotor inertia regression is singular (condition {cond:.3g}): too little acceleration"
@@ -325,7 +332,7 @@ def motor_signals(robot: Robot, rotor: Array, logs: Sequence[IdentData]) -> list
     ]
 
 
-def _start(joint: Joint, model: str, standstill: float, holding: float) -> dict[str, float]:
+def start_params(joint: Joint, model: str, standstill: float, holding: float) -> dict[str, float]:
     """Parameters to fit ``model`` from, holding ``holding`` of the friction through standstill."""
     params = start_parameters(model, joint.drive.friction.model, joint.drive.friction.params)
     params.pop("standstill", None)
@@ -344,14 +351,24 @@ def _best_hold(
     holdings: Sequence[float],
 ) -> _CurrentFit:
     """Eq 18 with each fraction of ``holdings`` of the friction held through standstill (below
-    ``standstill`` rad/s, motor side); the first whose squared current error no later one cuts by
+    ``standstill`` rad/s, motor side): :func:`best_hold`."""
+
+    def fit(holding: float) -> _CurrentFit:
+        params = start_params(joint, model, standstill, holding)
+        return _current_fit(model, params, signals, joint.drive.torque_constant)
+
+    return best_hold(holdings, fit)
+
+
+def best_hold(holdings: Sequence[float], fit: Callable[[float], _CurrentFit]) -> _CurrentFit:
+    """Of the fits of eq 18 holding each fraction of ``holdings`` of the friction through
+    standstill (``fit(holding)``), the first whose squared current error no later one cuts by
     :data:`MIN_GAIN`."""
     best: _CurrentFit | None = None
     for holding in holdings:
-        params = _start(joint, model, standstill, holding)
-        fit = _current_fit(model, params, signals, joint.drive.torque_constant)
-        if best is None or fit.sse < best.sse * (1.0 - MIN_GAIN):
-            best = fit
+        this = fit(holding)
+        if best is None or this.sse < best.sse * (1.0 - MIN_GAIN):
+            best = this
     assert best is not None
     return best
 
@@ -401,7 +418,7 @@ def _auto_fit(
     kt = joint.drive.torque_constant
     fits, scores = {}, {}
     for model in candidates(signals):
-        fit = _current_fit(model, _start(joint, model, standstill, holding), signals, kt)
+        fit = _current_fit(model, start_params(joint, model, standstill, holding), signals, kt)
         if fit.cond <= MAX_CONDITION:
             fits[model], scores[model] = fit, _cv_rms(fit, signals, kt)
     ranked = sorted(scores, key=scores.__getitem__)
@@ -499,27 +516,60 @@ def current_step(
     ``options`` = (friction model, ``"auto"`` or None; hold). Returns the robot, each joint's
     statistics, the friction fraction held through standstill and, with ``"auto"``, how each
     joint's model was chosen (None where not fitted)."""
+    fitter = current_fitter(staged, rotor, logs, options)
+    return fit_joints(staged, problems, fitter, warnings)
+
+
+def current_fitter(
+    staged: Robot,
+    rotor: Array,
+    logs: Sequence[IdentData],
+    options: tuple[str | None, str | bool],
+) -> JointFitter:
+    """Step 3's fit of one joint on ``logs`` held whole (:data:`JointFitter`); ``options`` as
+    :func:`current_step`."""
     friction, hold = options
     signals = motor_signals(staged, rotor, logs)
-    holdings = HOLDINGS if hold == "auto" else ((1.0,) if hold else (0.0,))
+    holdings = holdings_of(hold)
+
+    def fit_joint(
+        m: int, joint: Joint, standstill: float
+    ) -> tuple[_CurrentFit, FrictionChoice | None]:
+        if friction == "auto":
+            return _auto_fit(joint, standstill, signals[m], holdings)
+        model = friction or joint.drive.friction.model
+        return _best_hold(joint, model, standstill, signals[m], holdings), None
+
+    return fit_joint
+
+
+def holdings_of(hold: str | bool) -> tuple[float, ...]:
+    """The friction fractions held through standstill that ``hold`` tries (:data:`HOLDINGS`)."""
+    return HOLDINGS if hold == "auto" else ((1.0,) if hold else (0.0,))
+
+
+#: one joint's eq 18 fit: (motor index, joint, standstill speed in rad/s motor side) -> the fit
+#: and, with ``friction="auto"``, how its model was chosen
+JointFitter = Callable[[int, Joint, float], tuple[_CurrentFit, "FrictionChoice | None"]]
+
+
+def fit_joints(
+    staged: Robot, problems: dict[int, str], fit_joint: JointFitter, warnings: list[str]
+) -> tuple[Robot, list[CurrentStats], tuple[float | None, ...], tuple[FrictionChoice | None, ...]]:
+    """Step 3 over the joints: each identifiable joint fitted by ``fit_joint`` and written
+    (:func:`_apply_current_fit`); returns as :func:`current_step`."""
     joints: list[Joint] = []
     stats: list[CurrentStats] = []
     held: list[float | None] = []
     chosen: list[FrictionChoice | None] = []
     for m, joint in enumerate(staged.joints):
-        choice = None
         if m in problems:
             joints.append(joint)
             stats.append(CurrentStats())
             held.append(None)
             chosen.append(None)
             continue
-        standstill = STILL_SPEED * abs(joint.drive.gear_ratio)
-        if friction == "auto":
-            fit, choice = _auto_fit(joint, standstill, signals[m], holdings)
-        else:
-            model = friction or joint.drive.friction.model
-            fit = _best_hold(joint, model, standstill, signals[m], holdings)
+        fit, choice = fit_joint(m, joint, STILL_SPEED * abs(joint.drive.gear_ratio))
         held.append(float(fit.params.get("holding", 0.0)))
         chosen.append(choice)
         new, stat = _apply_current_fit(m, joint, fit, warnings)

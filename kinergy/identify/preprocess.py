@@ -28,9 +28,9 @@ from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 
 __all__ = [
+    "MAX_LAG",
     "MEASURED_TORQUE",
     "IdentData",
-    "MAX_LAG",
     "check_joints",
     "commanded_motion",
     "default_cutoff",
@@ -248,9 +248,7 @@ def lag_samples(t: Array, *, max_lag: float = MAX_LAG) -> NDArray[np.intp]:
     return inner[:: max(1, inner.size // 4000)]
 
 
-def estimate_lag(
-    t: Array, commanded: Array, measured: Array, *, max_lag: float = MAX_LAG
-) -> float:
+def estimate_lag(t: Array, commanded: Array, measured: Array, *, max_lag: float = MAX_LAG) -> float:
     """Delay of ``measured`` behind ``commanded`` (both (N, n) speeds), s, by least squares over
     sub-sample shifts up to ``max_lag`` (a coarse grid then a golden-section refinement) at the
     samples :func:`lag_samples` picks."""
