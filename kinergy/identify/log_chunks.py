@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import os
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import BinaryIO
 
@@ -51,6 +51,7 @@ from kinergy.identify.preprocess import (
     MAX_LAG,
     MEASURED_TORQUE,
     IdentData,
+    check_cutoff,
     check_joints,
     commanded_motion,
     default_cutoff,
@@ -73,6 +74,7 @@ __all__ = [
     "LogSpill",
     "PreparedSegment",
     "prepare_segment",
+    "segment_paths",
     "spill_log",
     "streamable",
 ]
@@ -251,7 +253,7 @@ class PreparedSegment:
         if self.grid is None:
             log = self.spill.read(a + start, a + stop)
         else:
-            grid = self.t0 + self.grid[0] * np.arange(start, stop)
+            grid = np.asarray(self.t0 + self.grid[0] * np.arange(start, stop), dtype=float)
             raw = self.spill.state.t[self.rows]
             lo = max(int(np.searchsorted(raw, grid[0], side="right")) - 1, 0)
             hi = min(int(np.searchsorted(raw, grid[-1], side="left")) + 1, raw.size)
@@ -285,7 +287,7 @@ def _lag(segment: PreparedSegment) -> float:
     if segment.grid is None:
         t = segment.spill.state.t[segment.rows]
     else:
-        t = t0 + dt * np.arange(size)
+        t = np.asarray(t0 + dt * np.arange(size), dtype=float)
     inner = lag_samples(t)
     if inner.size == 0:
         return 0.0
@@ -323,10 +325,8 @@ def prepare_segment(
     check_joints(spill.read(rows.start, rows.start + 1), n_joints)
     names = {name for name, _, _ in spill.layout}
     if {"actual_q", "actual_qd"} <= names:
-        from kinergy.identify.preprocess import _check_cutoff
-
         fs = 1.0 / float(head.t[1] - head.t[0])
-        _check_cutoff(fs, default_cutoff(head.t) if cutoff is None else cutoff)
+        check_cutoff(fs, default_cutoff(head.t) if cutoff is None else cutoff)
     return PreparedSegment(path, spill, rows, grid, _lag(segment), "delayed target")
 
 
@@ -337,7 +337,3 @@ def segment_paths(spill: LogSpill) -> list[tuple[tuple[int, int], str]]:
     if len(bounds) == 1:
         return [(bounds[0], spill.path)]
     return [(ab, f"{spill.path}#{k}") for k, ab in enumerate(bounds)]
-
-
-def _unused(_: Sequence[object]) -> None:  # pragma: no cover
-    return None

@@ -31,6 +31,7 @@ __all__ = [
     "MAX_LAG",
     "MEASURED_TORQUE",
     "IdentData",
+    "check_cutoff",
     "check_joints",
     "commanded_motion",
     "default_cutoff",
@@ -215,7 +216,7 @@ def uniform(log: Log, *, tolerance: float = 0.01) -> Log:
     return resample(log, log.t[0] + dt * np.arange(size))
 
 
-def _check_cutoff(fs: float, cutoff: float) -> None:
+def check_cutoff(fs: float, cutoff: float) -> None:
     """Raise unless ``0 < cutoff < fs / 2`` (Hz)."""
     if not 0.0 < cutoff < fs / 2.0:
         raise KinergyError(
@@ -227,7 +228,7 @@ def lowpass(x: Array, fs: float, cutoff: float, order: int = 4) -> Array:
     """Zero-phase Butterworth low-pass of ``x`` (N, ...) along time; ``cutoff`` Hz, ``fs`` Hz."""
     from scipy.signal import butter, sosfiltfilt  # slow to import; only filtering needs it
 
-    _check_cutoff(fs, cutoff)
+    check_cutoff(fs, cutoff)
     sos = butter(order, cutoff / (fs / 2.0), output="sos")
     # pad by several periods of the cutoff so the ends have settled
     padlen = min(int(np.ceil(6.0 * fs / cutoff)), x.shape[0] - 1)
@@ -352,7 +353,7 @@ def _motions(log: Log, cutoff: float) -> tuple[_Motion3, _Motion3, float, str]:
     if not (has_target or has_actual):
         log.require("actual_q", "actual_qd", purpose="identification")
     if has_actual:
-        _check_cutoff(fs, cutoff)
+        check_cutoff(fs, cutoff)
     if has_target:
         commanded = commanded_motion(log)
         lag = estimate_lag(t, commanded[1], log["actual_qd"]) if has_actual else 0.0
