@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import os
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import BinaryIO
 
@@ -139,15 +139,17 @@ class LogSpill:
             col += width
         self.file.write(rows.tobytes())
 
-    def read(self, start: int, stop: int) -> Log:
-        """Samples ``start:stop`` as a :class:`Log` (time stamps from :attr:`state`)."""
+    def read(self, start: int, stop: int, names: Sequence[str] | None = None) -> Log:
+        """Samples ``start:stop`` as a :class:`Log` (time stamps from :attr:`state`), of the
+        signals ``names`` (default all)."""
         size = (stop - start) * self.width * 8
         raw = os.pread(self.file.fileno(), size, start * self.width * 8)
         rows = np.frombuffer(raw, dtype=float).reshape(stop - start, self.width)
         signals, col = {}, 0
         for name, width, vector in self.layout:
-            block = rows[:, col : col + width]
-            signals[name] = block.copy() if vector else block[:, 0].copy()
+            if names is None or name in names:
+                block = rows[:, col : col + width]
+                signals[name] = block.copy() if vector else block[:, 0].copy()
             col += width
         return Log(self.path, self.state.t[start:stop], signals)
 
@@ -247,17 +249,18 @@ class PreparedSegment:
             return self.t0, float(self.spill.state.t[self.rows.stop - 1])
         return self.t0, self.t0 + self.grid[0] * (self.grid[1] - 1)
 
-    def uniform(self, start: int, stop: int) -> Log:
-        """Uniform samples ``start:stop`` of the segment (resampled where the log is not)."""
+    def uniform(self, start: int, stop: int, names: Sequence[str] | None = None) -> Log:
+        """Uniform samples ``start:stop`` of the segment (resampled where the log is not), of
+        the signals ``names`` (default all)."""
         a = self.rows.start
         if self.grid is None:
-            log = self.spill.read(a + start, a + stop)
+            log = self.spill.read(a + start, a + stop, names)
         else:
             grid = np.asarray(self.t0 + self.grid[0] * np.arange(start, stop), dtype=float)
             raw = self.spill.state.t[self.rows]
             lo = max(int(np.searchsorted(raw, grid[0], side="right")) - 1, 0)
             hi = min(int(np.searchsorted(raw, grid[-1], side="left")) + 1, raw.size)
-            log = resample(self.spill.read(a + lo, a + hi), grid)
+            log = resample(self.spill.read(a + lo, a + hi, names), grid)
         return Log(self.path, log.t, log.signals)
 
     def halo(self) -> int:
@@ -296,7 +299,8 @@ def _lag(segment: PreparedSegment) -> float:
     np.add.at(near, np.clip(inner + HALO + 1, 0, size), -1)
     covered = np.cumsum(near[:-1]) > 0
     edges = np.flatnonzero(np.diff(np.concatenate([[0], covered.astype(int), [0]])))
-    parts = [segment.uniform(a, b) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+    speeds = ("target_qd", "actual_qd")
+    parts = [segment.uniform(a, b, speeds) for a, b in zip(edges[::2], edges[1::2], strict=True)]
     window = Log.concatenate(parts)
     spline = CubicSpline(window.t, window["target_qd"], axis=0)
     measured = np.vstack([p["actual_qd"] for p in parts])[np.searchsorted(window.t, t[inner])]

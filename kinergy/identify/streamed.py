@@ -29,8 +29,10 @@ Which fits stream: the sequential method with a fixed friction model whose shape
 from __future__ import annotations
 
 import dataclasses
+import os
+import tempfile
 from collections.abc import Iterator, Sequence
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -170,6 +172,45 @@ def _state(robot: Robot, held: _Held, chunk: IdentData, temperature: bool) -> Ar
     return np.stack([state.current[k:], state.power[k:]])
 
 
+class _Store:
+    """Prepared chunks written once to an unnamed temporary file (removed when closed) and read
+    back in order: later passes do not prepare them again (splines, resampling)."""
+
+    def __init__(self) -> None:
+        self.file = tempfile.TemporaryFile()
+        self.index: list[tuple[int, int, list[tuple[str, tuple[int, ...]]], IdentData]] = []
+        self.end = 0
+
+    def put(self, segment: int, chunk: IdentData) -> None:
+        """Append ``chunk`` of segment number ``segment``."""
+        arrays = [(name, getattr(chunk, name)) for name in _FIELDS]
+        present = [
+            (name, np.ascontiguousarray(a, dtype=float)) for name, a in arrays if a is not None
+        ]
+        data = b"".join(a.tobytes() for _, a in present)
+        self.file.write(data)
+        shell = chunk.sliced(0, 0)
+        self.index.append((segment, self.end, [(n, a.shape) for n, a in present], shell))
+        self.end += len(data)
+
+    def chunks(self) -> Iterator[tuple[int, IdentData]]:
+        """(segment number, chunk) in the order they were put."""
+        self.file.flush()
+        for k, (segment, offset, shapes, shell) in enumerate(self.index):
+            stop = self.index[k + 1][1] if k + 1 < len(self.index) else self.end
+            raw = np.frombuffer(os.pread(self.file.fileno(), stop - offset, offset), dtype=float)
+            fields: dict[str, Any] = {}
+            at = 0
+            for name, shape in shapes:
+                size = int(np.prod(shape))
+                fields[name] = raw[at : at + size].reshape(shape)
+                at += size
+            yield segment, dataclasses.replace(shell, **fields)
+
+    def close(self) -> None:
+        self.file.close()
+
+
 class LogsInChunks:
     """Prepared logs read in chunks of ``rows`` samples (:class:`~kinergy.identify.sequential.SequentialLogs`
     for :func:`~kinergy.identify.sequential.sequential_from`); step 2's rows for ``robot``.
@@ -189,12 +230,15 @@ class LogsInChunks:
         self.has: list[dict[str, bool]] = []
         self.seconds = 0.0
         self._summary: MotionSummary | None = None
+        self._electrics: tuple[Robot, list[ElectricsSums]] | None = None
         problem, span = Reduced.empty(robot.n), 0.0
-        for segment in self.segments:
+        self.store = _Store()
+        for k, segment in enumerate(self.segments):
             low = high = None
             first = True
             for chunk in segment.chunks(rows):
                 check_signals([chunk])
+                self.store.put(k, chunk)
                 if first:
                     self.has.append({f: getattr(chunk, f) is not None for f in _FIELDS})
                     t0, first = float(chunk.t[0]), False
@@ -224,10 +268,13 @@ class LogsInChunks:
 
     def _chunks(self, field: str | None = None) -> Iterator[tuple[int, IdentData]]:
         """(segment index, chunk) of every segment (that has ``field``), in order."""
-        for k, segment in enumerate(self.segments):
+        for k, chunk in self.store.chunks():
             if field is None or self.has[k][field]:
-                for chunk in segment.chunks(self.rows):
-                    yield k, chunk
+                yield k, chunk
+
+    def close(self) -> None:
+        """Remove the prepared chunks' file."""
+        self.store.close()
 
     def summary(self) -> MotionSummary:
         assert self._summary is not None
@@ -290,9 +337,15 @@ class LogsInChunks:
 
     def validation(self, robot: Robot) -> Validation:
         """The fit statistics of ``robot`` on the logs, pooled (friction held per log, as
-        :func:`~kinergy.identify.result.validation_metrics`)."""
+        :func:`~kinergy.identify.result.validation_metrics`). When the model holds no friction
+        through standstill and the logs' temperatures are all there or all missing, its
+        predicted currents are the instrument of :meth:`electrics` too: the same pass
+        accumulates that fit."""
         sums: dict[str, MetricSums | None] = dict.fromkeys(("torque", "current", "joint_torque"))
         held = _Held(robot)
+        warm = {h["temperature"] for h in self.has}
+        fused = self.has_voltage and not any(held.still) and len(warm) == 1
+        motors = [ElectricsSums() for _ in range(robot.n)] if fused else None
         last = -1
         for k, chunk in self._chunks():
             if k != last:
@@ -309,6 +362,11 @@ class LogsInChunks:
                 if measured is not None and predicted is not None:
                     sums[key] = sums[key] or MetricSums(robot.n)
                     sums[key].add(measured, predicted[skip:])  # type: ignore[union-attr]
+            if motors is not None:
+                assert pred.current is not None
+                _add_electrics(motors, held.n_mat, chunk, pred.current)
+        if motors is not None:
+            self._electrics = (robot, motors)
         return Validation(**{k: None if s is None else s.metrics() for k, s in sums.items()})
 
     @property
@@ -322,17 +380,17 @@ class LogsInChunks:
     def electrics(self, robot: Robot) -> list[ElectricsFit | KinergyError]:
         """Per motor, eq 19's fit (:func:`~kinergy.identify.electrics.fit_electrics` with the
         current ``robot`` predicts as the instrument) or why it cannot be made."""
-        sums = [ElectricsSums() for _ in range(robot.n)]
-        held, n_mat = _Held(robot), transmission_matrix(robot)
-        warm = self._every("temperature")
-        for _, chunk in self._chunks():
-            assert chunk.current is not None and chunk.voltage is not None
-            predicted = _state(robot, held, chunk, warm)[0]
-            voltage, wm = equivalent_voltage(chunk.voltage), chunk.qd @ n_mat.T
-            for m, motor in enumerate(sums):
-                motor.add(chunk.current[:, m], voltage[:, m], wm[:, m], predicted[:, m])
+        if self._electrics is not None and self._electrics[0] is robot:
+            motors = self._electrics[1]
+        else:
+            motors = [ElectricsSums() for _ in range(robot.n)]
+            held = _Held(robot)
+            warm = self._every("temperature")
+            for _, chunk in self._chunks():
+                predicted = _state(robot, held, chunk, warm)[0]
+                _add_electrics(motors, held.n_mat, chunk, predicted)
         out: list[ElectricsFit | KinergyError] = []
-        for motor in sums:
+        for motor in motors:
             try:
                 out.append(motor.fit())
             except KinergyError as exc:
@@ -351,6 +409,17 @@ class LogsInChunks:
             total += float(np.sum(supply - supply_power(power).motors))
             count += len(chunk)
         return total / count
+
+
+def _add_electrics(
+    motors: list[ElectricsSums], n_mat: Array, chunk: IdentData, predicted: Array
+) -> None:
+    """Fold ``chunk``'s currents, voltages and motor speeds into each motor's eq 19, with the
+    ``predicted`` currents (N, n) as the instrument."""
+    assert chunk.current is not None and chunk.voltage is not None
+    voltage, wm = equivalent_voltage(chunk.voltage), chunk.qd @ n_mat.T
+    for m, motor in enumerate(motors):
+        motor.add(chunk.current[:, m], voltage[:, m], wm[:, m], predicted[:, m])
 
 
 def _cat(a: _Signals, b: _Signals) -> _Signals:

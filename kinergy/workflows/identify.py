@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import datetime
 import os
@@ -268,10 +269,10 @@ def identify_logs(
         datas = prepared_logs(paths, n_joints=robot.n, **reading)
         return identify_model(robot, datas, out, **options)
     with chunked_logs(paths, n_joints=robot.n, rows=rows, **reading) as segments:
-        logs = LogsInChunks(robot, segments, rows)
-        _check_seconds(logs.seconds)
-        result = sequential_from(robot, logs, friction=friction)
-        result = measured_electrics(result, logs)
+        with contextlib.closing(LogsInChunks(robot, segments, rows)) as logs:
+            _check_seconds(logs.seconds)
+            result = sequential_from(robot, logs, friction=friction)
+            result = measured_electrics(result, logs)
     what = f"{robot.name} identified ({result.method} method)"
     save_robot(result.robot, out, header=_header(what, [s.path for s in segments]))
     return result
