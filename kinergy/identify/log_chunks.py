@@ -113,6 +113,10 @@ class LogSpill:
         Time stamps and the :data:`STATE` columns of every sample, in memory.
     notes : list of str
         What reading the file said (rows dropped by ``repair``).
+    names : set of str
+        Every signal the log has (spilled or not).
+    head : Log
+        The log's first samples, every signal.
     """
 
     def __init__(self, path: str, layout: list[tuple[str, int, bool]], file: BinaryIO):
@@ -122,6 +126,8 @@ class LogSpill:
         self.file = file
         self.state = Log(path, np.empty(0))
         self.notes: list[str] = []
+        self.names = {name for name, _, _ in layout}
+        self.head = Log(path, np.empty(0))
 
     def __len__(self) -> int:
         return len(self.state)
@@ -167,22 +173,26 @@ def spill_log(
     if first is None:
         raise KinergyError(f"{path}: the log has no samples")
     names = first.signals
-    wanted = [s for s in (*SIGNALS, *STATE) if s in names]
+    # with the commanded motion, the measured positions are not used (only looked for)
+    skip = {"actual_q"} if {"target_q", "target_qd"} <= set(names) else set()
+    wanted = [s for s in (*SIGNALS, *STATE) if s in names and s not in skip]
     layout = [
         (s, 1 if names[s].ndim == 1 else names[s].shape[1], names[s].ndim == 2)
         for s in SIGNALS
-        if s in names
+        if s in wanted
     ]
     spill = LogSpill(os.fspath(path), layout, tempfile.TemporaryFile())
+    spill.names, spill.head = set(names), first
     times: list[Array] = []
     state: dict[str, list[Array]] = {s: [] for s in STATE if s in names}
     try:
         for chunk in iter_log(path, columns=columns, repair=repair, select=wanted, rows=rows):
             spill.notes += chunk.notes
             spill.append(chunk)
-            times.append(chunk.t)
+            # copies: a view would keep the chunk's whole block of values alive
+            times.append(np.array(chunk.t, dtype=float))
             for name, parts in state.items():
-                parts.append(chunk[name])
+                parts.append(np.array(chunk[name], dtype=float))
         spill.file.flush()
     except BaseException:
         spill.close()
@@ -196,7 +206,7 @@ def spill_log(
 def streamable(spill: LogSpill) -> bool:
     """Whether :func:`prepare_segment` prepares this log (it has ``target_q`` and
     ``target_qd``); others are prepared in memory (module docstring)."""
-    names = {name for name, _, _ in spill.layout}
+    names = spill.names
     return {"target_q", "target_qd"} <= names
 
 
@@ -283,7 +293,7 @@ class PreparedSegment:
 def _lag(segment: PreparedSegment) -> float:
     """:func:`~kinergy.identify.preprocess.estimate_lag` of ``segment`` from the samples near
     the compared ones (module docstring)."""
-    names = {name for name, _, _ in segment.spill.layout}
+    names = segment.spill.names
     if not {"actual_q", "actual_qd"} <= names:
         return 0.0
     size, t0, dt = len(segment), segment.t0, segment.dt
@@ -326,8 +336,8 @@ def prepare_segment(
     grid = uniform_grid(spill.state.t[rows])
     segment = PreparedSegment(path, spill, rows, grid, 0.0, "delayed target")
     head = segment.uniform(0, min(len(segment), 2))
-    check_joints(spill.read(rows.start, rows.start + 1), n_joints)
-    names = {name for name, _, _ in spill.layout}
+    check_joints(spill.head, n_joints)
+    names = spill.names
     if {"actual_q", "actual_qd"} <= names:
         fs = 1.0 / float(head.t[1] - head.t[0])
         check_cutoff(fs, default_cutoff(head.t) if cutoff is None else cutoff)
