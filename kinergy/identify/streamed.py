@@ -189,7 +189,10 @@ class _Store:
         ]
         data = b"".join(a.tobytes() for _, a in present)
         self.file.write(data)
-        shell = chunk.sliced(0, 0)
+        # no sample, and no view of the chunk's arrays (which would keep them alive)
+        shell = dataclasses.replace(
+            chunk.sliced(0, 0), **{n: np.empty((0, *a.shape[1:])) for n, a in present}
+        )
         self.index.append((segment, self.end, [(n, a.shape) for n, a in present], shell))
         self.end += len(data)
 
