@@ -285,7 +285,9 @@ class PreparedSegment:
             lo, hi = max(start - pad, 0), min(stop + pad, size)
             window = self.uniform(lo, hi)
             commanded = commanded_motion(window)
-            real = tuple(delay(window.t, x, self.lag, self.span) for x in commanded)
+            # one spline through the three signals' columns: each column as its own
+            both = delay(window.t, np.hstack(commanded), self.lag, self.span)
+            real = np.hsplit(both, 3)
             data = ident_data(window, commanded, real, (self.lag, self.source))  # type: ignore[arg-type]
             yield data.sliced(start - lo, stop - lo)
 

@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.drives.bus import supply_power
-from kinergy.drives.electrics import equivalent_voltage
+from kinergy.drives.electrics import electrical_power, equivalent_voltage, torque_constants
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import get_model
@@ -172,46 +172,63 @@ def _state(robot: Robot, held: _Held, chunk: IdentData, temperature: bool) -> Ar
     return np.stack([state.current[k:], state.power[k:]])
 
 
-class _Store:
-    """Prepared chunks written once to an unnamed temporary file (removed when closed) and read
-    back in order: later passes do not prepare them again (splines, resampling)."""
+class _Spool:
+    """Blocks of float arrays written once to an unnamed temporary file (removed when closed)
+    and read back in order."""
 
     def __init__(self) -> None:
         self.file = tempfile.TemporaryFile()
-        self.index: list[tuple[int, int, list[tuple[str, tuple[int, ...]]], IdentData]] = []
+        self.index: list[tuple[int, list[tuple[int, ...]]]] = []
         self.end = 0
 
-    def put(self, segment: int, chunk: IdentData) -> None:
-        """Append ``chunk`` of segment number ``segment``."""
-        arrays = [(name, getattr(chunk, name)) for name in _FIELDS]
-        present = [
-            (name, np.ascontiguousarray(a, dtype=float)) for name, a in arrays if a is not None
-        ]
-        data = b"".join(a.tobytes() for _, a in present)
+    def put(self, arrays: Sequence[Array]) -> None:
+        """Append one block."""
+        data = b"".join(np.ascontiguousarray(a, dtype=float).tobytes() for a in arrays)
         self.file.write(data)
-        # no sample, and no view of the chunk's arrays (which would keep them alive)
-        shell = dataclasses.replace(
-            chunk.sliced(0, 0), **{n: np.empty((0, *a.shape[1:])) for n, a in present}
-        )
-        self.index.append((segment, self.end, [(n, a.shape) for n, a in present], shell))
+        self.index.append((self.end, [np.shape(a) for a in arrays]))
         self.end += len(data)
 
-    def chunks(self) -> Iterator[tuple[int, IdentData]]:
-        """(segment number, chunk) in the order they were put."""
+    def __iter__(self) -> Iterator[list[Array]]:
         self.file.flush()
-        for k, (segment, offset, shapes, shell) in enumerate(self.index):
-            stop = self.index[k + 1][1] if k + 1 < len(self.index) else self.end
+        for k, (offset, shapes) in enumerate(self.index):
+            stop = self.index[k + 1][0] if k + 1 < len(self.index) else self.end
             raw = np.frombuffer(os.pread(self.file.fileno(), stop - offset, offset), dtype=float)
-            fields: dict[str, Any] = {}
-            at = 0
-            for name, shape in shapes:
+            out, at = [], 0
+            for shape in shapes:
                 size = int(np.prod(shape))
-                fields[name] = raw[at : at + size].reshape(shape)
+                out.append(raw[at : at + size].reshape(shape))
                 at += size
-            yield segment, dataclasses.replace(shell, **fields)
+            yield out
 
     def close(self) -> None:
         self.file.close()
+
+
+class _Store:
+    """Prepared chunks kept in a :class:`_Spool`: later passes do not prepare them again
+    (splines, resampling)."""
+
+    def __init__(self) -> None:
+        self.spool = _Spool()
+        self.shells: list[tuple[int, list[str], IdentData]] = []
+
+    def put(self, segment: int, chunk: IdentData) -> None:
+        """Append ``chunk`` of segment number ``segment``."""
+        present = [(n, getattr(chunk, n)) for n in _FIELDS if getattr(chunk, n) is not None]
+        self.spool.put([a for _, a in present])
+        # no sample, and no view of the chunk's arrays (which would keep them alive)
+        empty: dict[str, Any] = {n: np.empty((0, *a.shape[1:])) for n, a in present}
+        shell = dataclasses.replace(chunk.sliced(0, 0), **empty)
+        self.shells.append((segment, [n for n, _ in present], shell))
+
+    def chunks(self) -> Iterator[tuple[int, IdentData]]:
+        """(segment number, chunk) in the order they were put."""
+        for (segment, names, shell), arrays in zip(self.shells, self.spool, strict=True):
+            fields: dict[str, Any] = dict(zip(names, arrays, strict=True))
+            yield segment, dataclasses.replace(shell, **fields)
+
+    def close(self) -> None:
+        self.spool.close()
 
 
 class LogsInChunks:
@@ -234,6 +251,7 @@ class LogsInChunks:
         self.seconds = 0.0
         self._summary: MotionSummary | None = None
         self._electrics: tuple[Robot, list[ElectricsSums]] | None = None
+        self._drawn: tuple[Robot, _Spool] | None = None
         problem, span = Reduced.empty(robot.n), 0.0
         self.store = _Store()
         for k, segment in enumerate(self.segments):
@@ -274,10 +292,6 @@ class LogsInChunks:
         for k, chunk in self.store.chunks():
             if field is None or self.has[k][field]:
                 yield k, chunk
-
-    def close(self) -> None:
-        """Remove the prepared chunks' file."""
-        self.store.close()
 
     def summary(self) -> MotionSummary:
         assert self._summary is not None
@@ -349,6 +363,8 @@ class LogsInChunks:
         warm = {h["temperature"] for h in self.has}
         fused = self.has_voltage and not any(held.still) and len(warm) == 1
         motors = [ElectricsSums() for _ in range(robot.n)] if fused else None
+        if fused and self.has_supply:  # the predicted currents, for standby
+            self._drawn = (robot, _Spool())
         last = -1
         for k, chunk in self._chunks():
             if k != last:
@@ -368,6 +384,8 @@ class LogsInChunks:
             if motors is not None:
                 assert pred.current is not None
                 _add_electrics(motors, held.n_mat, chunk, pred.current)
+            if self._drawn is not None and pred.current is not None:
+                self._drawn[1].put([pred.current])
         if motors is not None:
             self._electrics = (robot, motors)
         return Validation(**{k: None if s is None else s.metrics() for k, s in sums.items()})
@@ -402,16 +420,32 @@ class LogsInChunks:
 
     def standby(self, robot: Robot) -> float:
         """The mean of the supply power less the motors' predicted draw, W
-        (:func:`~kinergy.identify.electrics.fit_standby`'s ``standby``)."""
+        (:func:`~kinergy.identify.electrics.fit_standby`'s ``standby``). The currents
+        :meth:`validation` predicted serve when ``robot`` differs from its model in the
+        electrics alone (its currents on the first chunk are the same to the bit): the power
+        is then ``tau_m = k_t I`` through UR5e eq 23 (:func:`electrical_power`)."""
         held, total, count = _Held(robot), 0.0, 0
         warm = self._every("temperature")
+        drawn = iter(self._drawn[1]) if self._drawn is not None else None
+        n_mat, kt = transmission_matrix(robot), torque_constants(robot)
         for _, chunk in self._chunks():
             assert chunk.supply_voltage is not None and chunk.supply_current is not None
-            power = _state(robot, held, chunk, warm)[1]
+            if drawn is not None and count > 0:
+                power = electrical_power(robot, next(drawn)[0] * kt, chunk.qd @ n_mat.T)
+            else:
+                current, power = _state(robot, held, chunk, warm)
+                if drawn is not None and not np.array_equal(current, next(drawn)[0]):
+                    drawn = None
             supply = np.asarray(chunk.supply_voltage * chunk.supply_current, dtype=float)
             total += float(np.sum(supply - supply_power(power).motors))
             count += len(chunk)
         return total / count
+
+    def close(self) -> None:
+        """Remove the prepared chunks' files."""
+        self.store.close()
+        if self._drawn is not None:
+            self._drawn[1].close()
 
 
 def _add_electrics(
