@@ -37,7 +37,7 @@ from kinergy.dynamics.regressor import base_parameters, inertial_parameters
 from kinergy.friction.registry import friction_torque
 from kinergy.identify.full import FullFit, identify_full
 from kinergy.identify.preprocess import IdentData, prepare
-from kinergy.identify.result import predict
+from kinergy.identify.result import IdentificationResult, predict
 from kinergy.io.rtde import read_log, write_log
 from kinergy.io.ur_calibration import read_ur_calibration
 from kinergy.model.robot import Robot
@@ -184,24 +184,42 @@ def _twin_log(
     return prepare(read_log(path), truth.n)
 
 
-def _drive_table(truth: Robot, ident: Robot, data: IdentData) -> float:
-    """Each drive parameter against the truth; returns the worst error (%)."""
+def _in_std(err_pct: float, value: float, std: float | None) -> str:
+    """An error (%) of ``value`` in its standard errors ``std``: ``"(+1.2 sd)"``."""
+    if std is None or not std > 0.0:
+        return ""
+    return f" ({err_pct / 100.0 * value / std:+.1f} sd)"
+
+
+def _drive_table(truth: Robot, result: IdentificationResult, data: IdentData) -> float:
+    """Each drive parameter against the truth (k_t and J_m + J_r with their errors in standard
+    errors of the fit); returns the worst error (%)."""
+    ident = result.robot
     t_state = drive_state(truth, data.q, data.qd, data.qdd, temperature=data.temperature)
     i_state = drive_state(ident, data.q, data.qd, data.qdd, temperature=data.temperature)
     worst = 0.0
     print("| joint | k_t [%] | J_m+J_r [%] | R [%] | k_b [%] | friction RMS [%] |")
     for j, (tj, ij) in enumerate(zip(truth.joints, ident.joints, strict=True)):
         td, idd = tj.drive, ij.drive
+        std = result.joints[j].std
         errs = [
             _pct(idd.torque_constant, td.torque_constant),
-            _pct(idd.motor_inertia + idd.reducer_inertia, td.motor_inertia + td.reducer_inertia),
+            _pct(idd.rotor_inertia, td.rotor_inertia),
             _pct(idd.winding_resistance or np.nan, td.winding_resistance or np.nan),
             _pct(idd.torque_constant / idd.kt_over_kb, td.torque_constant / td.kt_over_kb),
         ]
         tf, f = t_state.tau_friction[:, j], i_state.tau_friction[:, j]
         errs.append(100.0 * np.sqrt(np.mean((f - tf) ** 2) / np.mean(tf**2)))
         worst = max(worst, *(abs(e) for e in errs))
-        print(f"| {tj.name} | " + " | ".join(f"{e:+.2f}" for e in errs) + " |")
+        notes = [
+            _in_std(errs[0], idd.torque_constant, std.get("torque_constant")),
+            _in_std(errs[1], idd.rotor_inertia, std.get("rotor_inertia")),
+            "",
+            "",
+            "",
+        ]
+        cells = [f"{e:+.2f}{note}" for e, note in zip(errs, notes, strict=True)]
+        print(f"| {tj.name} | " + " | ".join(cells) + " |")
     return worst
 
 
@@ -298,7 +316,7 @@ def _identify_excitation(truth: Robot, motion: Motion, path: Path, *, table: boo
     t0 = time.perf_counter()
     result = run_method(model, [data], friction="auto")
     print(f"sequential + electrics identified in {time.perf_counter() - t0:.1f} s")
-    worst = _drive_table(truth, result.robot, data)
+    worst = _drive_table(truth, result, data)
     print(f"worst drive-parameter error {worst:.2f} % (bar 5 %)")
     print(
         f"standby: {result.robot.standby_power:.2f} W against the truth's "
@@ -376,10 +394,11 @@ def warmup(folder: Path, minutes: float = 60.0) -> None:
     # power law without, and with the load and temperature terms
     runs = ("viscous_coulomb", "thermal_viscous", "power_law", "load_thermal_power_law")
     rms = {f: _current_rms(run_method(model, [ident], friction=f).robot, held) for f in runs}
+    floor = _current_rms(truth, held)  # the truth itself: the current noise and quantisation
     print(
         "| joint | warms by [K] | "
         + " | ".join(f"{k} [A]" for k in runs)
-        + " | C+V lower by [%] | power law lower by [%] |"
+        + " | C+V lower by [%] | power law lower by [%] | the truth [A] |"
     )
     rows = [
         (name, float(np.ptp(held.temperature[:, j]))) for j, name in enumerate(model.joint_names)
@@ -388,13 +407,13 @@ def warmup(folder: Path, minutes: float = 60.0) -> None:
         a, b, c, d = (rms[f][j] for f in runs)
         print(
             f"| {name} | {warm:.1f} | {a:.4f} | {b:.4f} | {c:.4f} | {d:.4f} | "
-            f"{100 * (1 - b / a):.1f} | {100 * (1 - d / c):.1f} |"
+            f"{100 * (1 - b / a):.1f} | {100 * (1 - d / c):.1f} | {floor[j]:.4f} |"
         )
     whole = {f: float(np.sqrt(np.mean(rms[f] ** 2))) for f in runs}
     a, b, c, d = (whole[f] for f in runs)
     print(
         f"| whole log | | {a:.4f} | {b:.4f} | {c:.4f} | {d:.4f} | {100 * (1 - b / a):.1f} | "
-        f"{100 * (1 - d / c):.1f} |"
+        f"{100 * (1 - d / c):.1f} | {np.sqrt(np.mean(floor**2)):.4f} |"
     )
 
 
