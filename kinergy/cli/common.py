@@ -29,6 +29,7 @@ __all__ = [
     "print_tables",
     "progress",
     "repair_option",
+    "report_folder_option",
     "seed_option",
     "table",
     "writes",
@@ -64,8 +65,24 @@ def load(robot_name: str, payload: str | None) -> Robot:
 payload_option = click.option(
     "--payload",
     metavar="MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]",
-    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2.",
+    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2 about its "
+    "centre of mass.",
 )
+
+
+def report_folder_option(contents: str = "the figures") -> Callable[[F], F]:
+    """``--out FOLDER`` of a command that writes ``contents`` and a report.html there
+    (:func:`kinergy.files.output_folder`: a new temporary folder when not given)."""
+    return click.option(
+        "--out",
+        "out",
+        type=click.Path(file_okay=False),
+        default=None,
+        help=f"Folder for {contents} and report.html [a new folder in the system's temporary "
+        "folder; its path is printed].",
+    )
+
+
 columns_option = click.option(
     "--columns",
     metavar="SPEC",
