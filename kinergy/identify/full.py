@@ -95,7 +95,7 @@ from kinergy.identify.result import (
     DriveEstimate,
     Fit,
     IdentificationResult,
-    friction_entry,
+    drive_fields,
     validation_metrics,
 )
 from kinergy.identify.sequential import DrivesFromCurrents, drives_from_currents
@@ -399,17 +399,13 @@ def _joints(
         if drives is not None:
             flags = {"rotor_inertia": flags["rotor_inertia"], **drives.flags[m]}
             std = {"rotor_inertia": std["rotor_inertia"], **drives.std[m]}
-        friction = friction_entry(joint)
-        names = get_model(friction["model"]).linear
+        fields = drive_fields(joint, rotor_inertia=float(written.x[col]))
+        names = get_model(fields["friction"]["model"]).linear
         out.append(
             FullJoint(
-                name=joint.name,
-                rotor_inertia=float(written.x[col]),
+                **fields,
                 rotor_inertia_std=std["rotor_inertia"],
                 rotor_inertia_merged=bool(col in solved.dropped),
-                motor_inertia=joint.drive.motor_inertia,
-                torque_constant=joint.drive.torque_constant,
-                friction=friction,
                 flags=flags,
                 std=std,
                 friction_std={name: std.get(name) for name in names},

@@ -59,7 +59,7 @@ from kinergy.identify.result import (
     DriveEstimate,
     Fit,
     IdentificationResult,
-    friction_entry,
+    drive_fields,
     validation_metrics,
 )
 from kinergy.identify.ridge import RidgeFit, ridge_minimal
@@ -457,14 +457,7 @@ def _sources(robot: Robot, friction: bool, links: bool) -> Robot:
 
 def _drive_estimates(robot: Robot, identified: set[int]) -> tuple[NursingJoint, ...]:
     return tuple(
-        NursingJoint(
-            name=jt.name,
-            rotor_inertia=jt.drive.rotor_inertia,
-            motor_inertia=jt.drive.motor_inertia,
-            torque_constant=jt.drive.torque_constant,
-            friction=friction_entry(jt),
-            identified=m in identified,
-        )
+        NursingJoint(**drive_fields(jt), identified=m in identified)
         for m, jt in enumerate(robot.joints)
     )
 

@@ -38,6 +38,7 @@ __all__ = [
     "IdentificationResult",
     "Prediction",
     "Validation",
+    "drive_fields",
     "predict",
     "validation_metrics",
 ]
@@ -80,6 +81,21 @@ class Fit(Validation):
 def friction_entry(joint: Joint) -> dict[str, Any]:
     """``{"model": name, **parameters}`` of a joint's friction, as results report it."""
     return {"model": joint.drive.friction.model, **joint.drive.friction.params}
+
+
+def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> dict[str, Any]:
+    """A joint's drive as the model holds it, as :class:`DriveEstimate` fields (``name``,
+    ``rotor_inertia``, ``motor_inertia``, ``torque_constant``, ``friction``): keyword arguments
+    of a method's per-joint result. ``rotor_inertia`` (kg m^2, motor side) replaces the drive's
+    J_m + J_r where a method estimates it on its own."""
+    drive = joint.drive
+    return {
+        "name": joint.name,
+        "rotor_inertia": drive.rotor_inertia if rotor_inertia is None else rotor_inertia,
+        "motor_inertia": drive.motor_inertia,
+        "torque_constant": drive.torque_constant,
+        "friction": friction_entry(joint),
+    }
 
 
 @dataclass(frozen=True)
