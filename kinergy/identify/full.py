@@ -96,7 +96,7 @@ from kinergy.identify.result import (
     Fit,
     IdentificationResult,
     drive_fields,
-    validation_metrics,
+    fit_fields,
 )
 from kinergy.identify.sequential import DrivesFromCurrents, drives_from_currents
 from kinergy.identify.writeback import WriteBack, write_back
@@ -463,11 +463,12 @@ def _fit(
     weighted = solved.weights is not None
     b = cols.n_link
     return FullFit(
-        **vars(validation_metrics(steps.robot, datas)),
-        samples=int(y3.shape[0]),
-        logs=tuple(d.path for d in datas),
-        lag=tuple(d.lag for d in datas),
-        warnings=(*warnings, *steps.merging.warnings, *written.warnings),
+        **fit_fields(
+            steps.robot,
+            datas,
+            (*warnings, *steps.merging.warnings, *written.warnings),
+            samples=int(y3.shape[0]),
+        ),
         target=target,
         solver=solver,
         ridge=float(ridge),

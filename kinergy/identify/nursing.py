@@ -60,7 +60,7 @@ from kinergy.identify.result import (
     Fit,
     IdentificationResult,
     drive_fields,
-    validation_metrics,
+    fit_fields,
 )
 from kinergy.identify.ridge import RidgeFit, ridge_minimal
 from kinergy.jsonable import OPTIONAL
@@ -535,11 +535,7 @@ def identify_nursing(
     links = kept is not None and len(kept) < robot.n
     identified = _sources(identified, friction=bool(new_friction), links=links)
     fit_out = NursingFit(
-        **vars(validation_metrics(identified, datas)),
-        samples=int(sum(len(d) for d in datas)),
-        logs=tuple(d.path for d in datas),
-        lag=tuple(d.lag for d in datas),
-        warnings=tuple(warnings),
+        **fit_fields(identified, datas, warnings),
         friction_runs=tuple(joint_fits),
         friction_motors=tuple(motor_fits),
         ridge=summary,

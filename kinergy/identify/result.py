@@ -39,6 +39,7 @@ __all__ = [
     "Prediction",
     "Validation",
     "drive_fields",
+    "fit_fields",
     "predict",
     "validation_metrics",
 ]
@@ -173,6 +174,25 @@ def predict(robot: Robot, data: IdentData) -> Prediction:
         current = state.current if data.current is not None else None
         joint = joint_torque(robot, state.tau_m) if data.torque is not None else None
     return Prediction(torque, current, joint)
+
+
+def fit_fields(
+    robot: Robot,
+    datas: Sequence[IdentData],
+    warnings: Sequence[str],
+    *,
+    samples: int | None = None,
+) -> dict[str, Any]:
+    """The :class:`Fit` fields every method reports, as keyword arguments of its fit: the
+    identified ``robot``'s :func:`validation_metrics` on ``datas``, the samples used (all the
+    logs' unless given), the logs, their lags (s) and ``warnings``."""
+    return {
+        **vars(validation_metrics(robot, datas)),
+        "samples": int(sum(len(d) for d in datas)) if samples is None else samples,
+        "logs": tuple(d.path for d in datas),
+        "lag": tuple(d.lag for d in datas),
+        "warnings": tuple(warnings),
+    }
 
 
 def validation_metrics(robot: Robot, datas: Sequence[IdentData]) -> Validation:

@@ -51,7 +51,7 @@ from kinergy.identify.result import (
     Fit,
     IdentificationResult,
     drive_fields,
-    validation_metrics,
+    fit_fields,
 )
 from kinergy.jsonable import OPTIONAL
 from kinergy.model.robot import Joint, Robot, Source
@@ -254,11 +254,7 @@ def identify_sequential(
     sources = _sources(staged, bool(ref_logs), bool(current_logs))
     identified = dataclasses.replace(staged, sources=sources)
     fit = SequentialFit(
-        **vars(validation_metrics(identified, datas)),
-        samples=int(sum(len(d) for d in datas)),
-        logs=tuple(d.path for d in datas),
-        lag=tuple(d.lag for d in datas),
-        warnings=tuple(warnings),
+        **fit_fields(identified, datas, warnings),
         condition_rotor_inertia=cond,
         friction_holding=held,
         friction_choice=choices if friction == "auto" else None,
