@@ -46,7 +46,7 @@ from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import paper_trajectory
 from kinergy.workflows.calibration import import_calibration
 from kinergy.workflows.energy import energy_of_log
-from kinergy.workflows.identify import run_method
+from kinergy.workflows.identify import identify_model
 
 DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "datasets"
 if not DATA.exists():
@@ -144,7 +144,7 @@ def ur10e() -> None:
     rms = {}
     for friction in ("viscous_coulomb", "auto"):
         t0 = time.perf_counter()
-        result = run_method(model, logs, friction=friction)
+        result = identify_model(model, logs, friction=friction)
         rms[friction] = _current_rms(result.robot, held)
         print(f"{friction}: identified from {len(logs)} logs in {time.perf_counter() - t0:.1f} s")
         if friction == "auto":
@@ -230,7 +230,7 @@ def twin(folder: Path) -> Robot:
     truth = realistic_truth(model, SEED)
     data = _twin_log(truth, excitation(model), SEED, folder / "excitation.csv")
     t0 = time.perf_counter()
-    result = run_method(model, [data], friction="auto")
+    result = identify_model(model, [data], friction="auto")
     print(f"sequential + electrics identified in {time.perf_counter() - t0:.1f} s")
     worst = _drive_table(truth, result.robot, data)
     print(f"worst drive-parameter error {worst:.2f} % (bar 5 %)")
@@ -289,7 +289,7 @@ def warmup(folder: Path) -> None:
     # Coulomb + viscous with and without its temperature term (the one difference), and the
     # power law without, and with the load and temperature terms
     runs = ("viscous_coulomb", "thermal_viscous", "power_law", "load_thermal_power_law")
-    rms = {f: _current_rms(run_method(model, [ident], friction=f).robot, held) for f in runs}
+    rms = {f: _current_rms(identify_model(model, [ident], friction=f).robot, held) for f in runs}
     print(
         "| joint | "
         + " | ".join(f"{k} [A]" for k in runs)
