@@ -25,6 +25,7 @@ __all__ = [
     "fmt_vector",
     "load",
     "note",
+    "output_file_option",
     "payload_option",
     "print_tables",
     "progress",
@@ -68,6 +69,23 @@ payload_option = click.option(
     help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2 about its "
     "centre of mass.",
 )
+
+
+def output_file_option(
+    flag: str,
+    help: str,
+    *,
+    dest: str | None = None,
+    metavar: str | None = None,
+    required: bool = False,
+) -> Callable[[F], F]:
+    """An option naming a file the command writes (``--out``, ``--urscript``): a path that is
+    not a folder, None when not given, passed as ``dest`` (default: the flag's name); list it in
+    :func:`writes` ``files`` too."""
+    names = (flag,) if dest is None else (flag, dest)
+    return click.option(
+        *names, type=click.Path(dir_okay=False), metavar=metavar, required=required, help=help
+    )
 
 
 def report_folder_option(contents: str = "the figures") -> Callable[[F], F]:

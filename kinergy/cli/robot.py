@@ -9,7 +9,7 @@ from collections.abc import Sequence
 import click
 import numpy as np
 
-from kinergy.cli.common import fmt, fmt_vector, load, payload_option, table
+from kinergy.cli.common import fmt, fmt_vector, load, output_file_option, payload_option, table
 from kinergy.files import check_outputs
 from kinergy.jsonable import dumps
 from kinergy.model import SOURCE_CATEGORIES, Robot, library_names, load_robot, robot_to_dict
@@ -255,9 +255,7 @@ def _calibration_text(result: CalibrationImport, out: str, points: bool) -> str:
 @robot.command("import-calibration")
 @click.argument("robot_name", metavar="ROBOT")
 @click.argument("calibration", metavar="CALIBRATION.txt", type=click.Path(dir_okay=False))
-@click.option(
-    "--out", "out", required=True, type=click.Path(dir_okay=False), help="Robot file to write."
-)
+@output_file_option("--out", "Robot file to write.", required=True)
 @click.option(
     "--friction",
     default="auto",
