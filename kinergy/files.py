@@ -29,6 +29,7 @@ __all__ = [
     "MARKER",
     "MAX_TOML_BYTES",
     "Terminated",
+    "all_or_none",
     "atomic_folder",
     "atomic_write",
     "check_folder",
@@ -265,6 +266,20 @@ def output_folder(path: PathLike | None, *, prefix: str) -> Iterator[tuple[Path,
     except BaseException:
         if fresh:
             shutil.rmtree(target, ignore_errors=True)
+        raise
+
+
+@contextlib.contextmanager
+def all_or_none() -> Iterator[list[Path]]:
+    """Outputs written together: append each path written to the list this yields; should
+    anything fail (or the run be stopped) before the block ends, every path on it is removed, so
+    no partial set of outputs is left behind."""
+    written: list[Path] = []
+    try:
+        yield written
+    except BaseException:
+        for path in written:
+            path.unlink(missing_ok=True)
         raise
 
 
