@@ -56,7 +56,7 @@ from kinergy.identify.result import (
     Fit,
     IdentificationResult,
     Validation,
-    friction_entry,
+    drive_fields,
     validation_metrics,
 )
 from kinergy.jsonable import OPTIONAL
@@ -221,12 +221,8 @@ def _joints(
         fields = {k: v for k, v in vars(stats[j]).items() if k != "flags"}
         out.append(
             SequentialJoint(
-                name=joint.name,
-                rotor_inertia=float(joint.drive.motor_inertia + joint.drive.reducer_inertia),
+                **drive_fields(joint),
                 rotor_inertia_std=None if np.isnan(std[j]) else float(std[j]),
-                motor_inertia=joint.drive.motor_inertia,
-                torque_constant=joint.drive.torque_constant,
-                friction=friction_entry(joint),
                 flags=flags,
                 std=errors,
                 identified=j not in problems,
