@@ -48,8 +48,8 @@ from scipy.interpolate import CubicSpline
 
 from kinergy.errors import KinergyError
 from kinergy.identify.preprocess import (
+    JOINT_SIGNALS,
     MAX_LAG,
-    MEASURED_TORQUE,
     IdentData,
     check_cutoff,
     check_joints,
@@ -82,20 +82,7 @@ __all__ = [
 Array = NDArray[np.float64]
 
 #: the signals identification takes from a log (those it has are spilled)
-SIGNALS = (
-    "target_q",
-    "target_qd",
-    "target_qdd",
-    "actual_q",
-    "actual_qd",
-    "target_moment",
-    "actual_current",
-    MEASURED_TORQUE,
-    "joint_temperatures",
-    "actual_joint_voltage",
-    "actual_robot_voltage",
-    "actual_robot_current",
-)
+SIGNALS = (*JOINT_SIGNALS, "actual_robot_voltage", "actual_robot_current")
 #: per-sample state kept in memory: it decides segments and the samples a program runs in
 STATE = ("runtime_state", "robot_mode", "segment")
 

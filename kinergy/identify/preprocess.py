@@ -28,6 +28,7 @@ from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 
 __all__ = [
+    "JOINT_SIGNALS",
     "MAX_LAG",
     "MEASURED_TORQUE",
     "IdentData",
@@ -290,11 +291,11 @@ def delay(t: Array, x: Array, lag: float, span: tuple[float, float] | None = Non
     return np.asarray(spline(np.clip(t - lag, lo, hi)), dtype=float)
 
 
-#: (N, n) signals whose joint count must match the robot's
 #: the log signal of measured joint torques, N m (RTDE-style name, ``actual_joint_torque_k``)
 MEASURED_TORQUE = "actual_joint_torque"
 
-_JOINT_SIGNALS = (
+#: (N, n) signals whose joint count must match the robot's
+JOINT_SIGNALS = (
     "target_q",
     "target_qd",
     "target_qdd",
@@ -321,7 +322,7 @@ def _with_torque(log: Log, n_joints: int, torque: Array) -> Log:
 
 def check_joints(log: Log, n_joints: int) -> None:
     """Raise when a joint signal of ``log`` does not have ``n_joints`` columns."""
-    for name in _JOINT_SIGNALS:
+    for name in JOINT_SIGNALS:
         if name in log and (log[name].ndim != 2 or log[name].shape[1] != n_joints):
             width = 1 if log[name].ndim == 1 else log[name].shape[1]
             raise KinergyError(
