@@ -8,11 +8,21 @@ folding the chunk into a small accumulator and dropping it:
 1. on construction: the signals' sanity (:func:`~kinergy.identify.sanity.check_signals` per
    chunk), the joints' position spans and speed summary, and step 2's least squares (UR5e eqs
    7-9) folded into its QR triangle (:func:`~kinergy.identify.drive_steps.rotor_problem`: a
-   streaming QR, numerically as good as one factorisation of all rows);
+   streaming QR, numerically as good as one factorisation of all rows); the prepared chunks are
+   written to an unnamed temporary file (:class:`_Store`), which the later passes read instead of
+   preparing them again;
 2. :meth:`LogsInChunks.fitter`: eq 18's triangle per motor and standstill hold (UR5e eqs 17-18);
-3. :meth:`LogsInChunks.validation`: the fit statistics (:class:`~kinergy.identify.metrics.MetricSums`);
-4. :meth:`LogsInChunks.electrics` and :meth:`LogsInChunks.standby`: eq 19 per motor
-   (:class:`~kinergy.identify.electrics.ElectricsSums`) and the mean standby power.
+3. :meth:`LogsInChunks.validation`: the fit statistics (:class:`~kinergy.identify.metrics.MetricSums`)
+   and, in the same pass when the model holds no friction through standstill, eq 19 per motor
+   (:class:`~kinergy.identify.electrics.ElectricsSums`, :meth:`LogsInChunks.electrics`) with the
+   predicted currents kept for the standby power;
+4. :meth:`LogsInChunks.standby`: the mean standby power (from the kept currents through UR5e eq
+   23 when the model's mechanics are unchanged, else by another pass); :meth:`LogsInChunks.electrics`
+   makes its own pass only when step 3 could not.
+
+Memory holds one chunk and these accumulators, whatever the logs' length; the temporary files
+(the log's spill, :mod:`kinergy.identify.log_chunks`, and the prepared chunks) hold the samples
+on disk and are removed when closed.
 
 Friction held through standstill (:mod:`kinergy.friction.standstill`) is the one thing that
 reaches back in time without bound: a stopped joint keeps the friction of the last sample it
