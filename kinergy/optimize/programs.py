@@ -65,6 +65,9 @@ _BLEND_SHARE = 0.4
 _BLEND_MAX = 0.10
 #: processor seconds the whole optimisation aims at: the timing solver stops at what is left
 _SECONDS = 40.0
+#: the timing solver's caps are this share below the program's: its iterations end a few ms off
+#: the cycle time, and the uniform rescaling to it (:func:`_at_cycle`) must stay within the caps
+_SLACK = 0.005
 #: targets are met within these (m, rad) and the arm is at rest below this joint speed (rad/s)
 TARGET_TOL = (1e-3, np.deg2rad(0.5), 1e-3)
 
@@ -383,10 +386,7 @@ def _timed(search: _Search, say: Callable[[str], None]) -> PathRun:
     """Lever 5 on the best program: re-timed, written back as a program and re-simulated."""
     path = search.best.path
     say("timing: solving every move's v and a")
-    problem = path_problem(
-        search.robot, path, objective=search.objective, v_max=search.caps[0], a_max=search.caps[1]
-    )
-    checks = PathChecks(search.robot, path, problem, search.caps[0], search.caps[1])
+    checks = _timing_checks(search.robot, path, search.objective, search.caps)
     left = max(5.0, _SECONDS - (time.process_time() - search.started))
     result, message, _ = retime(checks, search.budget, seconds=left)
     if "StopIteration" in message:
@@ -405,7 +405,16 @@ def _timing_only(
 ) -> ProgramResult:
     """The program as written, only re-timed (the comparison)."""
     say("timing only: re-timing the program as written")
-    problem = path_problem(robot, path, objective=objective, v_max=caps[0], a_max=caps[1])
-    checks = PathChecks(robot, path, problem, caps[0], caps[1])
-    result, _, _ = retime(checks, budget)
-    return result
+    result, _, _ = retime(_timing_checks(robot, path, objective, caps), budget)
+    written = program_path(robot, _with_timing(path, result))
+    return _at_cycle(robot, written, budget, objective, caps, "timing only").result
+
+
+def _timing_checks(
+    robot: Robot, path: ProgramPath, objective: Objective, caps: tuple[float, float]
+) -> PathChecks:
+    """The timing problem of ``path`` with the caps ``_SLACK`` below ``caps`` (speed, and its
+    square for acceleration: what a uniform rescaling by ``1 + _SLACK`` needs)."""
+    v_max, a_max = caps[0] * (1.0 - _SLACK), caps[1] * (1.0 - _SLACK) ** 2
+    problem = path_problem(robot, path, objective=objective, v_max=v_max, a_max=a_max)
+    return PathChecks(robot, path, problem, v_max, a_max)
