@@ -38,7 +38,13 @@ from kinergy.dynamics.poses import tcp_pose
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 from kinergy.optimize.objectives import PROGRAM_OBJECTIVE, Objective
-from kinergy.optimize.path_costs import move_costs, symmetry_angles, target_states
+from kinergy.optimize.path_costs import (
+    TargetStates,
+    move_costs,
+    refined_turns,
+    symmetry_angles,
+    target_states,
+)
 from kinergy.optimize.problem import uniform_scaling
 from kinergy.optimize.program import serial
 from kinergy.optimize.program_search import (
@@ -63,6 +69,9 @@ Array = NDArray[np.float64]
 _BLEND_SHARE = 0.4
 #: ... at most this, m
 _BLEND_MAX = 0.10
+#: a fully symmetric tool's turns are searched every 45 degrees, then around the best every
+#: 15 and every 5 degrees (rad)
+_FINER = (np.deg2rad(15.0), np.deg2rad(5.0))
 #: processor seconds the whole optimisation aims at: the timing solver stops at what is left
 _SECONDS = 40.0
 #: the timing solver's caps are this share below the program's: its iterations end a few ms off
@@ -279,10 +288,36 @@ def _search_levers(
         )
         if not np.isfinite(estimate):
             continue
-        changed = sum(int(c != s.own) for c, s in zip(choice, states, strict=True))
-        moves = chosen_moves(path, states, choice)
+        chosen = states
+        if turn and symmetry == "z":
+            chosen, choice, estimate = _finer(search, path, states, choice, estimate, free, standby)
+        changed = sum(int(c != s.own) for c, s in zip(choice, chosen, strict=True))
+        moves = chosen_moves(path, chosen, choice)
         say(f"{name}: estimated {estimate:.1f} J, re-simulating")
         search.try_program(name, path.program.with_moves(moves), f"{changed} target states changed")
+
+
+def _finer(
+    search: _Search,
+    path: ProgramPath,
+    states: list[TargetStates],
+    choice: NDArray[np.intp],
+    estimate: float,
+    free: bool,
+    standby: float,
+) -> tuple[list[TargetStates], NDArray[np.intp], float]:
+    """A fully symmetric tool's turns searched again around the best, every ``_FINER`` step
+    (:func:`kinergy.optimize.path_costs.refined_turns`); the best states, choice and estimate."""
+    for step in _FINER:
+        turns = refined_turns(
+            np.array([s.turn[c] for s, c in zip(states, choice, strict=True)]), step
+        )
+        finer = target_states(search.robot, path, free=free, symmetry="z", turns=turns)
+        costs = move_costs(search.robot, path, finer, standby=standby)
+        pick, value = cheapest_cycle(masked(costs, lever_mask(path, finer, branch=free, turn=True)))
+        if value < estimate:
+            states, choice, estimate = finer, pick, value
+    return states, choice, estimate
 
 
 @serial
