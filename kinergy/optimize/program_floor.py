@@ -115,7 +115,7 @@ def energy_floor(robot: Robot, run: PathRun) -> EnergyFloor:
     load = payload_index(path, run.schedule, motion.t)[0]  # (N,)
     state = drive_by_payload(robot, path.payloads, load, motion.q, motion.qd, motion.qdd)
     powers = part_powers(robot, state)
-    parts = {k: np.trapezoid(p, motion.t, axis=0) for k, p in powers.items()}
+    parts = {k: np.asarray(np.trapezoid(p, motion.t, axis=0)) for k, p in powers.items()}
     still = np.zeros_like(motion.q)
     holding = drive_by_payload(robot, path.payloads, load, motion.q, still, still).power
     length = np.sum(np.abs(np.diff(motion.q, axis=0)), axis=0)
