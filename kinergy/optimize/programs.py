@@ -248,17 +248,30 @@ class _Search:
         self.started = time.process_time()
         self.levers: list[Lever] = []
 
-    def try_program(self, name: str, program: RobotProgram, note: str) -> None:
-        try:
-            path = program_path(self.robot, program)
-        except KinergyError as exc:
-            self.levers.append(Lever(name, self.best.result, False, f"not used: {exc}"))
-            return
-        run = _at_cycle(self.robot, path, self.budget, self.objective, self.caps, name)
-        kept = _better(run, self.best)
-        self.levers.append(Lever(name, run.result, kept, note if kept else f"not better: {note}"))
-        if kept:
-            self.best = run
+    def try_program(
+        self,
+        name: str,
+        program: RobotProgram,
+        note: str,
+        fallback: tuple[RobotProgram, str] | None = None,
+    ) -> None:
+        """Re-simulate ``program`` at the cycle time and keep it if better; if not, the
+        ``fallback`` program (with its note), if any. One lever is recorded: the kept run, or
+        the last one tried."""
+        lever = Lever(name, self.best.result, False, "")
+        for candidate, text in [(program, note)] + ([fallback] if fallback is not None else []):
+            try:
+                path = program_path(self.robot, candidate)
+            except KinergyError as exc:
+                lever = Lever(name, self.best.result, False, f"not used: {exc}")
+                continue
+            run = _at_cycle(self.robot, path, self.budget, self.objective, self.caps, name)
+            kept = _better(run, self.best)
+            lever = Lever(name, run.result, kept, text if kept else f"not better: {text}")
+            if kept:
+                self.best = run
+                break
+        self.levers.append(lever)
 
 
 def _search_levers(
@@ -288,13 +301,27 @@ def _search_levers(
         )
         if not np.isfinite(estimate):
             continue
-        chosen = states
         if turn and symmetry == "z":
-            chosen, choice, estimate = _finer(search, path, states, choice, estimate, free, standby)
-        changed = sum(int(c != s.own) for c, s in zip(choice, chosen, strict=True))
-        moves = chosen_moves(path, chosen, choice)
-        say(f"{name}: estimated {estimate:.1f} J, re-simulating")
-        search.try_program(name, path.program.with_moves(moves), f"{changed} target states changed")
+            finer, pick, value = _finer(search, path, states, choice, estimate, free, standby)
+        else:
+            finer, pick, value = states, choice, estimate
+        program, note = _chosen_program(path, finer, pick)
+        fallback = None
+        if finer is not states:  # the finer turns, then the 45 degree ones
+            note += " (turns to 5 degrees)"
+            coarse, text = _chosen_program(path, states, choice)
+            fallback = (coarse, f"{text} (45 degree turns: the finer ones were not better)")
+        say(f"{name}: estimated {value:.1f} J, re-simulating")
+        search.try_program(name, program, note, fallback)
+
+
+def _chosen_program(
+    path: ProgramPath, states: list[TargetStates], choice: NDArray[np.intp]
+) -> tuple[RobotProgram, str]:
+    """The program with the chosen states as its targets, and how many changed."""
+    changed = sum(int(c != s.own) for c, s in zip(choice, states, strict=True))
+    moves = chosen_moves(path, states, choice)
+    return path.program.with_moves(moves), f"{changed} target states changed"
 
 
 def _finer(
