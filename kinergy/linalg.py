@@ -29,6 +29,7 @@ __all__ = [
     "pivoted_rank",
     "reduce",
     "scaled_lstsq",
+    "scaled_solution",
     "solve_reduced",
 ]
 
@@ -140,6 +141,31 @@ class Reduced:
         more = np.column_stack([a / self.scale, y])
         return Reduced(_triangle(np.vstack([self.r, more])), self.scale, self.rows + a.shape[0])
 
+    @classmethod
+    def empty(cls, p: int) -> Reduced:
+        """No equation yet in ``p`` unknowns, unit column scale: :meth:`stack` chunks of rows
+        onto it (a streaming QR), then :meth:`unit_columns`."""
+        return cls(np.zeros((0, p + 1)), np.ones(p), 0)
+
+    def unit_columns(self) -> Reduced:
+        """This problem with the regressor's columns scaled to unit norm (:func:`column_scale`
+        of ``A``: ``|A e_k| = |R e_k|``), as :func:`reduce` scales them."""
+        norms = column_scale(self.r_a)
+        r = self.r.copy()
+        r[:, :-1] /= norms
+        return Reduced(r, self.scale * norms, self.rows)
+
+    def combine(self, t: Array) -> Reduced:
+        """The problem whose ``[A' | y']`` is this one's ``[A | y] t``, ``t`` (p + 1, k + 1), unit
+        column scale (``|[A | y] t v| = |R t v|``): columns left out, moved into the target
+        or mixed, with no pass over the rows. This problem's scale must be 1."""
+        return Reduced(_triangle(self.r @ t), np.ones(t.shape[1] - 1), self.rows)
+
+    def norm2(self, v: Array) -> float:
+        """``|[A_s | y] v|^2`` for ``v`` (p + 1,), e.g. the residual ``|y - A_s z|^2`` with
+        ``v = [-z, 1]``."""
+        return float(np.sum((self.r @ v) ** 2))
+
 
 def _triangle(m: Array) -> Array:
     """The upper triangle R (k, k) of ``m = Q R`` (m, k), m >= k, by LAPACK's geqrf."""
@@ -177,6 +203,20 @@ class ReducedSolution:
     std: Array
     cond: float
     sse: float
+
+
+def scaled_solution(problem: Reduced) -> tuple[Array, Array, float]:
+    """:func:`scaled_lstsq` of a problem folded into its triangle (chunk by chunk,
+    :meth:`Reduced.stack`): the same ``x``, standard errors and condition number, to round-off.
+
+    Parameters
+    ----------
+    problem : Reduced
+        ``[A | y]`` with unit column scale (as :meth:`Reduced.empty` starts it).
+    """
+    unit = problem.unit_columns()
+    sol = solve_reduced(unit.r_a, unit.r_y, unit.rows)
+    return sol.x / unit.scale, sol.std / unit.scale, sol.cond
 
 
 def solve_reduced(

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import click
 
 from kinergy.cli.common import (
@@ -20,7 +22,7 @@ from kinergy.identify.payload import PayloadEstimate
 from kinergy.identify.result import FLAGS, IDENTIFIED, DriveEstimate, IdentificationResult
 from kinergy.jsonable import dumps
 from kinergy.model import load_robot
-from kinergy.workflows.identify import METHODS, identify_model, identify_payload_model
+from kinergy.workflows.identify import METHODS, identify_logs, identify_payload_model
 from kinergy.workflows.logs import prepared_logs
 
 __all__ = ["identify"]
@@ -226,19 +228,20 @@ def identify(
     actual_current; the full method regresses the base inertial parameters too.
     """
     r = load_robot(robot_name)
+    reading: dict[str, Any] = {"columns": columns, "repair": repair, "cutoff": cutoff, "note": note}
     with progress() as say:
-        say(f"reading {len(logs)} log(s)")
-        datas = prepared_logs(
-            logs, n_joints=r.n, columns=columns, repair=repair, cutoff=cutoff, note=note
-        )
-        say("identifying the payload" if payload_only else f"identifying ({method} method)")
         if payload_only:
+            say(f"reading {len(logs)} log(s)")
+            datas = prepared_logs(logs, n_joints=r.n, **reading)
+            say("identifying the payload")
             _, report = identify_payload_model(r, datas, out)
         else:
-            result = identify_model(
+            say(f"reading and identifying {len(logs)} log(s) ({method} method)")
+            result = identify_logs(
                 r,
-                datas,
+                logs,
                 out,
+                reading=reading,
                 method=method,
                 friction=friction,
                 target=target,

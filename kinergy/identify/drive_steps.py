@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -36,19 +36,30 @@ from kinergy.identify.result import (
     IDENTIFIED,
     KEPT,
 )
-from kinergy.linalg import scaled_lstsq
+from kinergy.linalg import Reduced, scaled_lstsq, scaled_solution
 from kinergy.model.robot import Friction, Joint, Robot
 
 __all__ = [
     "AUTO_CANDIDATES",
+    "CurrentProblem",
     "CurrentStats",
     "FrictionChoice",
+    "JointFitter",
+    "best_hold",
     "candidates",
+    "current_fitter",
+    "current_problem",
     "current_step",
+    "fit_joints",
+    "holdings_of",
     "motor_signals",
     "rotor_inertias",
+    "rotor_problem",
+    "rotor_solution",
     "rotor_step",
+    "solve_current",
     "stack",
+    "start_params",
     "with_rotor_inertias",
 ]
 
@@ -86,34 +97,50 @@ def stack(datas: Sequence[IdentData], name: str) -> Array:
     return np.vstack([getattr(d, name) for d in datas])
 
 
-def rotor_inertias(
-    robot: Robot, datas: Sequence[IdentData], active: Sequence[int] | None = None
-) -> tuple[Array, Array, float]:
-    """Step 2: ``J_m + J_r`` per motor from ``target_moment`` (UR5e eqs 7-9).
+def rotor_problem(robot: Robot, datas: Sequence[IdentData], into: Reduced | None = None) -> Reduced:
+    """Step 2's least squares (UR5e eqs 7-9) folded into a triangle (:class:`Reduced`), every
+    motor's column: ``tau_ref - f_link = N^T diag(J) N qdd`` with ``N`` the transmission matrix,
+    linear in J; rows (sample, joint) of ``datas`` stacked onto ``into`` (default none yet)."""
+    n_mat = transmission_matrix(robot)
+    problem = Reduced.empty(robot.n) if into is None else into
+    for data in datas:
+        assert data.tau_ref is not None
+        f_link = rnea(robot, data.q_cmd, data.qd_cmd, data.qdd_cmd)
+        # rows (sample, joint), column m: contribution of J_m, n_mat[m, j] * (N qdd)_m
+        a = rotor_columns(n_mat, data.qdd_cmd @ n_mat.T).reshape(-1, robot.n)
+        problem = problem.stack(a, (data.tau_ref - f_link).reshape(-1))
+    return problem
 
-    ``tau_ref - f_link = N^T diag(J) N qdd`` with ``N`` the transmission matrix, linear in J.
+
+def rotor_solution(
+    robot: Robot, problem: Reduced, active: Sequence[int] | None = None
+) -> tuple[Array, Array, float]:
+    """Step 2 from its triangle (:func:`rotor_problem`): ``J_m + J_r`` per motor.
 
     Returns
     -------
     inertia, std : ndarray, shape (n,)
         kg m^2 (motor side) and its standard deviation; motors not in ``active`` (default all)
-        keep the model's value and a NaN deviation.
+        keep the model's value (moved into the target) and a NaN deviation.
     condition : float
     """
     active = list(range(robot.n)) if active is None else list(active)
-    q, qd, qdd = stack(datas, "q_cmd"), stack(datas, "qd_cmd"), stack(datas, "qdd_cmd")
-    tau_ref = stack(datas, "tau_ref")
-    f_link = rnea(robot, q, qd, qdd)
-    n_mat = transmission_matrix(robot)
-    # rows (sample, joint), column m: contribution of J_m, n_mat[m, j] * (N qdd)_m
-    a = rotor_columns(n_mat, qdd @ n_mat.T).reshape(-1, robot.n)
-    fixed = [m for m in range(robot.n) if m not in active]
     known = np.array([j.drive.rotor_inertia for j in robot.joints])
-    y = (tau_ref - f_link).reshape(-1) - a[:, fixed] @ known[fixed]
-    sol, sol_std, cond = scaled_lstsq(a[:, active], y)
+    pick = np.zeros((robot.n + 1, len(active) + 1))
+    pick[active, np.arange(len(active))] = 1.0
+    pick[:, -1] = np.append([0.0 if m in active else -known[m] for m in range(robot.n)], 1.0)
+    sol, sol_std, cond = scaled_solution(problem.combine(pick))
     inertia, std = known.copy(), np.full(robot.n, np.nan)
     inertia[active], std[active] = sol, sol_std
     return inertia, std, cond
+
+
+def rotor_inertias(
+    robot: Robot, datas: Sequence[IdentData], active: Sequence[int] | None = None
+) -> tuple[Array, Array, float]:
+    """Step 2: ``J_m + J_r`` per motor from ``target_moment`` (UR5e eqs 7-9): :func:`rotor_solution`
+    of :func:`rotor_problem` (kg m^2 motor side, standard deviations, condition number)."""
+    return rotor_solution(robot, rotor_problem(robot, datas), active)
 
 
 @dataclass(frozen=True, eq=False)
@@ -154,20 +181,59 @@ def _columns(model: str, params: dict[str, float], signals: _Signals) -> Array:
     return np.column_stack([s.tau_load, cols])
 
 
+def current_problem(model: str, params: dict[str, float], signals: _Signals) -> Reduced:
+    """Eq 18's least squares for one motor, ``[tau_load, friction columns | current]``, folded
+    into its triangle (:class:`Reduced`; stack more chunks onto it in time order)."""
+    a = _columns(model, params, signals)
+    return Reduced.empty(a.shape[1]).stack(a, signals.current)
+
+
+#: eq 18's least squares: the regressor ``[tau_load, friction columns]`` (N, 1 + k) and the
+#: current (N,), or both folded into a triangle (:func:`current_problem`, chunk by chunk)
+CurrentProblem = Reduced | tuple[Array, Array]
+
+
+def _eq18(problem: CurrentProblem, kt_prior: float | None = None) -> tuple[Array, Array, float]:
+    """:func:`~kinergy.linalg.scaled_lstsq` of eq 18 (x, standard errors, condition); with
+    ``kt_prior``, of the friction columns alone against ``current - tau_load / kt_prior``."""
+    if isinstance(problem, Reduced):
+        if kt_prior is None:
+            return scaled_solution(problem)
+        p = problem.r.shape[1] - 1
+        rest_of = np.zeros((p + 1, p))
+        rest_of[1:p, : p - 1] = np.eye(p - 1)
+        rest_of[0, -1], rest_of[p, -1] = -1.0 / kt_prior, 1.0
+        return scaled_solution(problem.combine(rest_of))
+    a, current = problem
+    if kt_prior is None:
+        return scaled_lstsq(a, current)
+    return scaled_lstsq(a[:, 1:], current - a[:, 0] / kt_prior)
+
+
+def solve_current(
+    model: str, params: dict[str, float], problem: CurrentProblem, kt_prior: float
+) -> _CurrentFit:
+    """Eq 18 for one motor (:func:`_current_fit`), the model's shape parameters held, from its
+    rows or its triangle (:data:`CurrentProblem`: the same fit to round-off)."""
+    x, std, cond = _eq18(problem)
+    fixed = not (x[0] > 0 and std[0] < MAX_KT_SPREAD * x[0])
+    if fixed:
+        rest, rest_std, cond = _eq18(problem, kt_prior)
+        x = np.concatenate([[1.0 / kt_prior], rest])
+        std = np.concatenate([[0.0], rest_std])
+    if isinstance(problem, Reduced):
+        sse = problem.norm2(np.append(-x, 1.0))
+    else:
+        sse = float(np.sum((problem[1] - problem[0] @ x) ** 2))
+    return _CurrentFit(model, params, x, std, cond, sse, fixed)
+
+
 def _solve_current(
     model: str, params: dict[str, float], signals: _Signals, kt_prior: float
 ) -> _CurrentFit:
     """Eq 18 for one motor with the model's shape parameters held (:func:`_current_fit`)."""
-    a = _columns(model, params, signals)
-    current = signals.current
-    x, std, cond = scaled_lstsq(a, current)
-    fixed = not (x[0] > 0 and std[0] < MAX_KT_SPREAD * x[0])
-    if fixed:
-        rest, rest_std, cond = scaled_lstsq(a[:, 1:], current - signals.tau_load / kt_prior)
-        x = np.concatenate([[1.0 / kt_prior], rest])
-        std = np.concatenate([[0.0], rest_std])
-    sse = float(np.sum((current - a @ x) ** 2))
-    return _CurrentFit(model, params, x, std, cond, sse, fixed)
+    problem = (_columns(model, params, signals), signals.current)
+    return solve_current(model, params, problem, kt_prior)
 
 
 def _current_fit(
@@ -192,16 +258,17 @@ def _current_fit(
 
 
 def rotor_step(
-    robot: Robot, ref_logs: Sequence[IdentData], active: list[int], warnings: list[str]
+    robot: Robot, problem: Reduced | None, active: list[int], warnings: list[str]
 ) -> tuple[Array, Array, float | None]:
-    """Rotor inertias (kg m^2, motor side), their standard errors (NaN where not identified) and
+    """Rotor inertias (kg m^2, motor side) from step 2's triangle (:func:`rotor_problem`; None
+    when no log has ``target_moment``), their standard errors (NaN where not identified) and
     the regression's condition number (None without ``target_moment``). A rotor inertia that
     comes out negative is not written: the model's is kept (NaN standard error) with a warning."""
     rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
     rotor_std = np.full(robot.n, np.nan)
     cond = None
-    if ref_logs:
-        rotor, rotor_std, cond = rotor_inertias(robot, ref_logs, active)
+    if problem is not None:
+        rotor, rotor_std, cond = rotor_solution(robot, problem, active)
         if cond > MAX_CONDITION:
             raise KinergyError(
                 f"rotor inertia regression is singular (condition {cond:.3g}): too little acceleration"
@@ -265,7 +332,7 @@ def motor_signals(robot: Robot, rotor: Array, logs: Sequence[IdentData]) -> list
     ]
 
 
-def _start(joint: Joint, model: str, standstill: float, holding: float) -> dict[str, float]:
+def start_params(joint: Joint, model: str, standstill: float, holding: float) -> dict[str, float]:
     """Parameters to fit ``model`` from, holding ``holding`` of the friction through standstill."""
     params = start_parameters(model, joint.drive.friction.model, joint.drive.friction.params)
     params.pop("standstill", None)
@@ -284,14 +351,24 @@ def _best_hold(
     holdings: Sequence[float],
 ) -> _CurrentFit:
     """Eq 18 with each fraction of ``holdings`` of the friction held through standstill (below
-    ``standstill`` rad/s, motor side); the first whose squared current error no later one cuts by
+    ``standstill`` rad/s, motor side): :func:`best_hold`."""
+
+    def fit(holding: float) -> _CurrentFit:
+        params = start_params(joint, model, standstill, holding)
+        return _current_fit(model, params, signals, joint.drive.torque_constant)
+
+    return best_hold(holdings, fit)
+
+
+def best_hold(holdings: Sequence[float], fit: Callable[[float], _CurrentFit]) -> _CurrentFit:
+    """Of the fits of eq 18 holding each fraction of ``holdings`` of the friction through
+    standstill (``fit(holding)``), the first whose squared current error no later one cuts by
     :data:`MIN_GAIN`."""
     best: _CurrentFit | None = None
     for holding in holdings:
-        params = _start(joint, model, standstill, holding)
-        fit = _current_fit(model, params, signals, joint.drive.torque_constant)
-        if best is None or fit.sse < best.sse * (1.0 - MIN_GAIN):
-            best = fit
+        this = fit(holding)
+        if best is None or this.sse < best.sse * (1.0 - MIN_GAIN):
+            best = this
     assert best is not None
     return best
 
@@ -341,7 +418,7 @@ def _auto_fit(
     kt = joint.drive.torque_constant
     fits, scores = {}, {}
     for model in candidates(signals):
-        fit = _current_fit(model, _start(joint, model, standstill, holding), signals, kt)
+        fit = _current_fit(model, start_params(joint, model, standstill, holding), signals, kt)
         if fit.cond <= MAX_CONDITION:
             fits[model], scores[model] = fit, _cv_rms(fit, signals, kt)
     ranked = sorted(scores, key=scores.__getitem__)
@@ -439,27 +516,60 @@ def current_step(
     ``options`` = (friction model, ``"auto"`` or None; hold). Returns the robot, each joint's
     statistics, the friction fraction held through standstill and, with ``"auto"``, how each
     joint's model was chosen (None where not fitted)."""
+    fitter = current_fitter(staged, rotor, logs, options)
+    return fit_joints(staged, problems, fitter, warnings)
+
+
+def current_fitter(
+    staged: Robot,
+    rotor: Array,
+    logs: Sequence[IdentData],
+    options: tuple[str | None, str | bool],
+) -> JointFitter:
+    """Step 3's fit of one joint on ``logs`` held whole (:data:`JointFitter`); ``options`` as
+    :func:`current_step`."""
     friction, hold = options
     signals = motor_signals(staged, rotor, logs)
-    holdings = HOLDINGS if hold == "auto" else ((1.0,) if hold else (0.0,))
+    holdings = holdings_of(hold)
+
+    def fit_joint(
+        m: int, joint: Joint, standstill: float
+    ) -> tuple[_CurrentFit, FrictionChoice | None]:
+        if friction == "auto":
+            return _auto_fit(joint, standstill, signals[m], holdings)
+        model = friction or joint.drive.friction.model
+        return _best_hold(joint, model, standstill, signals[m], holdings), None
+
+    return fit_joint
+
+
+def holdings_of(hold: str | bool) -> tuple[float, ...]:
+    """The friction fractions held through standstill that ``hold`` tries (:data:`HOLDINGS`)."""
+    return HOLDINGS if hold == "auto" else ((1.0,) if hold else (0.0,))
+
+
+#: one joint's eq 18 fit: (motor index, joint, standstill speed in rad/s motor side) -> the fit
+#: and, with ``friction="auto"``, how its model was chosen
+JointFitter = Callable[[int, Joint, float], tuple[_CurrentFit, "FrictionChoice | None"]]
+
+
+def fit_joints(
+    staged: Robot, problems: dict[int, str], fit_joint: JointFitter, warnings: list[str]
+) -> tuple[Robot, list[CurrentStats], tuple[float | None, ...], tuple[FrictionChoice | None, ...]]:
+    """Step 3 over the joints: each identifiable joint fitted by ``fit_joint`` and written
+    (:func:`_apply_current_fit`); returns as :func:`current_step`."""
     joints: list[Joint] = []
     stats: list[CurrentStats] = []
     held: list[float | None] = []
     chosen: list[FrictionChoice | None] = []
     for m, joint in enumerate(staged.joints):
-        choice = None
         if m in problems:
             joints.append(joint)
             stats.append(CurrentStats())
             held.append(None)
             chosen.append(None)
             continue
-        standstill = STILL_SPEED * abs(joint.drive.gear_ratio)
-        if friction == "auto":
-            fit, choice = _auto_fit(joint, standstill, signals[m], holdings)
-        else:
-            model = friction or joint.drive.friction.model
-            fit = _best_hold(joint, model, standstill, signals[m], holdings)
+        fit, choice = fit_joint(m, joint, STILL_SPEED * abs(joint.drive.gear_ratio))
         held.append(float(fit.params.get("holding", 0.0)))
         chosen.append(choice)
         new, stat = _apply_current_fit(m, joint, fit, warnings)

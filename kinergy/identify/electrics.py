@@ -16,18 +16,25 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kinergy.drives.bus import supply_power
 from kinergy.errors import KinergyError
-from kinergy.linalg import scaled_lstsq
+from kinergy.linalg import Reduced, scaled_lstsq, scaled_solution
 from kinergy.model.robot import Robot
 from kinergy.predict import drive_state
 
-__all__ = ["ElectricsFit", "StandbyFit", "fit_electrics", "fit_standby", "with_electrics"]
+__all__ = [
+    "ElectricsFit",
+    "ElectricsSums",
+    "StandbyFit",
+    "fit_electrics",
+    "fit_standby",
+    "with_electrics",
+]
 
 Array = NDArray[np.float64]
 
@@ -79,16 +86,57 @@ def fit_electrics(
     wt = np.ones(i.size) if weights is None else np.asarray(weights, dtype=float).ravel()
     a = np.column_stack([i, w])
     x, std, cond = scaled_lstsq(a * wt[:, None], v * wt)
-    if not np.isfinite(cond) or cond > 1e8:
-        raise KinergyError(
-            "the voltages cannot separate the winding resistance from the back-EMF constant "
-            "(current and speed move together)"
-        )
+    _check_separable(cond)
     if instrument is not None:
         z = np.column_stack([np.asarray(instrument, dtype=float).ravel(), w]) * wt[:, None]
         x = np.linalg.solve(z.T @ (a * wt[:, None]), z.T @ (v * wt))
     rms = float(np.sqrt(np.mean((a @ x - v) ** 2)))
     return ElectricsFit(float(x[0]), float(x[1]), float(std[0]), float(std[1]), rms, int(i.size))
+
+
+def _check_separable(cond: float) -> None:
+    """Raise unless eq 19's column-scaled condition number ``cond`` separates ``R`` from ``k_b``."""
+    if not np.isfinite(cond) or cond > 1e8:
+        raise KinergyError(
+            "the voltages cannot separate the winding resistance from the back-EMF constant "
+            "(current and speed move together)"
+        )
+
+
+@dataclass
+class ElectricsSums:
+    """:func:`fit_electrics` (unweighted, with an instrument) of one motor accumulated block by
+    block: eq 19's least squares folded into its triangle and the instrumental normal
+    equations ``Z^T A`` (2, 2), ``Z^T V`` (2,), ``Z = [instrument, wm]``, ``A = [I, wm]``."""
+
+    problem: Reduced = field(default_factory=lambda: Reduced.empty(2))
+    zta: Array = field(default_factory=lambda: np.zeros((2, 2)))
+    ztv: Array = field(default_factory=lambda: np.zeros(2))
+
+    def add(self, current: Array, voltage: Array, wm: Array, instrument: Array) -> None:
+        """Fold in a block of samples, each (k,): A, V, rad/s and the instrument, A."""
+        a = np.column_stack([current, wm])
+        z = np.column_stack([instrument, wm])
+        self.problem = self.problem.stack(a, voltage)
+        self.zta += z.T @ a
+        self.ztv += z.T @ voltage
+
+    def fit(self) -> ElectricsFit:
+        """The :class:`ElectricsFit` of every block (as :func:`fit_electrics` of them all).
+
+        Raises
+        ------
+        KinergyError
+            As :func:`fit_electrics`.
+        """
+        samples = self.problem.rows
+        if samples < 3:
+            raise KinergyError(f"fitting R and k_b needs at least 3 points, got {samples}")
+        _, std, cond = scaled_solution(self.problem)
+        _check_separable(cond)
+        x = np.linalg.solve(self.zta, self.ztv)
+        rms = float(np.sqrt(self.problem.norm2(np.append(x, -1.0)) / samples))
+        return ElectricsFit(float(x[0]), float(x[1]), float(std[0]), float(std[1]), rms, samples)
 
 
 def with_electrics(robot: Robot, fits: Sequence[ElectricsFit | None]) -> Robot:

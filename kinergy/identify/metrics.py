@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["JointMetrics", "fit_metrics", "r_squared", "rmse"]
+__all__ = ["JointMetrics", "MetricSums", "fit_metrics", "r_squared", "rmse"]
 
 Array = NDArray[np.float64]
 
@@ -57,3 +57,52 @@ def fit_metrics(measured: ArrayLike, predicted: ArrayLike) -> tuple[JointMetrics
         )
         for j in range(y.shape[1])
     )
+
+
+class MetricSums:
+    """:func:`fit_metrics` accumulated block by block (the same figures to round-off): per
+    joint the count, sum, largest ``|.|`` and sum of squares of the error, and the measured
+    signal's mean and sum of squared deviations (merged by Chan's formula, no cancellation)."""
+
+    def __init__(self, n: int):
+        self.count = 0
+        self.err_sum = np.zeros(n)
+        self.err_max = np.zeros(n)
+        self.err_sq = np.zeros(n)
+        self.mean = np.zeros(n)
+        self.dev_sq = np.zeros(n)
+        self.sq = np.zeros(n)
+
+    def add(self, measured: ArrayLike, predicted: ArrayLike) -> None:
+        """Fold in a block of ``measured`` and ``predicted`` (N, n)."""
+        y = np.asarray(measured, dtype=float)
+        err = y - np.asarray(predicted, dtype=float)
+        k = y.shape[0]
+        if k == 0:
+            return
+        self.err_sum += err.sum(axis=0)
+        self.err_max = np.maximum(self.err_max, np.abs(err).max(axis=0))
+        self.err_sq += np.sum(err**2, axis=0)
+        mean = y.mean(axis=0)
+        dev = np.sum((y - mean) ** 2, axis=0)
+        total = self.count + k
+        delta = mean - self.mean
+        self.dev_sq += dev + delta**2 * self.count * k / total
+        self.mean += delta * k / total
+        self.sq += np.sum(y**2, axis=0)
+        self.count = total
+
+    def metrics(self) -> tuple[JointMetrics, ...]:
+        """Per joint :class:`JointMetrics`, as :func:`fit_metrics` of all the blocks."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            varies = self.dev_sq > 1e-20 * np.maximum(self.sq, 1e-300)
+            r2 = np.where(varies, 1.0 - self.err_sq / self.dev_sq, np.nan)
+        return tuple(
+            JointMetrics(
+                mean=float(self.err_sum[j] / self.count),
+                max=float(self.err_max[j]),
+                rms=float(np.sqrt(self.err_sq[j] / self.count)),
+                r2=float(r2[j]),
+            )
+            for j in range(self.mean.size)
+        )

@@ -28,13 +28,26 @@ from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 
 __all__ = [
+    "JOINT_SIGNALS",
+    "MAX_LAG",
     "MEASURED_TORQUE",
     "IdentData",
+    "check_cutoff",
+    "check_joints",
+    "commanded_motion",
+    "default_cutoff",
+    "delay",
     "estimate_lag",
+    "ident_data",
+    "lag_samples",
+    "lag_search",
     "lowpass",
     "prepare",
+    "resample",
     "running",
+    "running_range",
     "uniform",
+    "uniform_grid",
 ]
 
 Array = NDArray[np.float64]
@@ -127,9 +140,9 @@ class IdentData:
         )
 
 
-def running(log: Log) -> Log:
-    """Keep the samples where a program runs (``runtime_state`` 2, ``robot_mode`` 7) when the
-    log has those columns; the log unchanged otherwise.
+def running_range(log: Log) -> slice:
+    """The samples :func:`running` keeps: the longest run of consecutive samples where a
+    program runs (all of them when the log has neither column).
 
     Raises
     ------
@@ -142,7 +155,7 @@ def running(log: Log) -> Log:
     if "robot_mode" in log:
         keep &= log["robot_mode"] == _RUNNING
     if keep.all():
-        return log
+        return slice(0, len(log))
     if not keep.any():
         raise KinergyError(
             f"{log.path}: no sample where the program runs (runtime_state 2, robot_mode 7)"
@@ -151,18 +164,38 @@ def running(log: Log) -> Log:
     edges = np.flatnonzero(np.diff(np.concatenate([[0], keep.astype(int), [0]])))
     starts, stops = edges[::2], edges[1::2]
     k = int(np.argmax(stops - starts))
-    sl = slice(starts[k], stops[k])
+    return slice(int(starts[k]), int(stops[k]))
+
+
+def running(log: Log) -> Log:
+    """Keep the samples where a program runs (``runtime_state`` 2, ``robot_mode`` 7) when the
+    log has those columns (:func:`running_range`); the log unchanged otherwise.
+
+    Raises
+    ------
+    KinergyError
+        No sample is left.
+    """
+    sl = running_range(log)
+    if sl.start == 0 and sl.stop == len(log):
+        return log
     return Log(log.path, log.t[sl], {name: x[sl] for name, x in log.signals.items()})
 
 
-def uniform(log: Log, *, tolerance: float = 0.01) -> Log:
-    """Resample an irregularly sampled log to a uniform grid at its median period (linear
-    interpolation); a log whose periods are within ``tolerance`` of the median is returned as is."""
-    step = np.diff(log.t)
+def uniform_grid(t: Array, *, tolerance: float = 0.01) -> tuple[float, int] | None:
+    """The uniform grid :func:`uniform` resamples time stamps ``t`` (N,) to, as its period (s)
+    and size (the grid is ``t[0] + period * arange(size)``); None when every period is within
+    ``tolerance`` of the median (the log is kept as is)."""
+    step = np.diff(t)
     dt = float(np.median(step))
     if np.max(np.abs(step - dt)) <= tolerance * dt:
-        return log
-    grid = log.t[0] + dt * np.arange(int(np.floor((log.t[-1] - log.t[0]) / dt + 1e-9)) + 1)
+        return None
+    return dt, int(np.floor((t[-1] - t[0]) / dt + 1e-9)) + 1
+
+
+def resample(log: Log, grid: Array) -> Log:
+    """``log``'s signals at the times ``grid`` (linear interpolation; a row depends only on the
+    two samples around it)."""
     signals = {}
     for name, x in log.signals.items():
         if x.ndim == 1:
@@ -174,7 +207,17 @@ def uniform(log: Log, *, tolerance: float = 0.01) -> Log:
     return Log(log.path, grid, signals)
 
 
-def _check_cutoff(fs: float, cutoff: float) -> None:
+def uniform(log: Log, *, tolerance: float = 0.01) -> Log:
+    """Resample an irregularly sampled log to a uniform grid at its median period (linear
+    interpolation); a log whose periods are within ``tolerance`` of the median is returned as is."""
+    spec = uniform_grid(log.t, tolerance=tolerance)
+    if spec is None:
+        return log
+    dt, size = spec
+    return resample(log, log.t[0] + dt * np.arange(size))
+
+
+def check_cutoff(fs: float, cutoff: float) -> None:
     """Raise unless ``0 < cutoff < fs / 2`` (Hz)."""
     if not 0.0 < cutoff < fs / 2.0:
         raise KinergyError(
@@ -186,26 +229,46 @@ def lowpass(x: Array, fs: float, cutoff: float, order: int = 4) -> Array:
     """Zero-phase Butterworth low-pass of ``x`` (N, ...) along time; ``cutoff`` Hz, ``fs`` Hz."""
     from scipy.signal import butter, sosfiltfilt  # slow to import; only filtering needs it
 
-    _check_cutoff(fs, cutoff)
+    check_cutoff(fs, cutoff)
     sos = butter(order, cutoff / (fs / 2.0), output="sos")
     # pad by several periods of the cutoff so the ends have settled
     padlen = min(int(np.ceil(6.0 * fs / cutoff)), x.shape[0] - 1)
     return np.asarray(sosfiltfilt(sos, x, axis=0, padlen=padlen), dtype=float)
 
 
-def estimate_lag(t: Array, commanded: Array, measured: Array, *, max_lag: float = 0.05) -> float:
-    """Delay of ``measured`` behind ``commanded`` (both (N, n) speeds), s, by least squares over
-    sub-sample shifts up to ``max_lag`` (a coarse grid then a golden-section refinement)."""
-    dt = float(t[1] - t[0])
-    spline = CubicSpline(t, commanded, axis=0)
+#: s: the largest lag :func:`estimate_lag` looks for
+MAX_LAG = 0.05
+
+
+def lag_samples(t: Array, *, max_lag: float = MAX_LAG) -> NDArray[np.intp]:
+    """The samples of uniform time stamps ``t`` (N,) :func:`estimate_lag` compares: those more
+    than ``max_lag`` from either end, thinned to a few thousand (empty: too few to tell)."""
     inner = np.flatnonzero((t > t[0] + max_lag) & (t < t[-1] - max_lag))
     if inner.size < 10:
-        return 0.0
+        return inner[:0]
     # a few thousand samples pin a lag of milliseconds down; evaluating every one is waste
-    inner = inner[:: max(1, inner.size // 4000)]
+    return inner[:: max(1, inner.size // 4000)]
+
+
+def estimate_lag(t: Array, commanded: Array, measured: Array, *, max_lag: float = MAX_LAG) -> float:
+    """Delay of ``measured`` behind ``commanded`` (both (N, n) speeds), s, by least squares over
+    sub-sample shifts up to ``max_lag`` (a coarse grid then a golden-section refinement) at the
+    samples :func:`lag_samples` picks."""
+    inner = lag_samples(t, max_lag=max_lag)
+    if inner.size == 0:
+        return 0.0
+    spline = CubicSpline(t, commanded, axis=0)
+    return lag_search(spline, t[inner], measured[inner], float(t[1] - t[0]), max_lag=max_lag)
+
+
+def lag_search(
+    spline: CubicSpline, t: Array, measured: Array, dt: float, *, max_lag: float = MAX_LAG
+) -> float:
+    """The shift (s) of the commanded speeds ``spline`` that best matches ``measured`` (k, n) at
+    the times ``t`` (k,): a grid of whole periods ``dt`` then a golden-section refinement."""
 
     def cost(lag: float) -> float:
-        return float(np.sum((spline(t[inner] - lag) - measured[inner]) ** 2))
+        return float(np.sum((spline(t - lag) - measured) ** 2))
 
     grid = np.arange(-2, int(np.ceil(max_lag / dt)) + 1) * dt
     best = grid[int(np.argmin([cost(g) for g in grid]))]
@@ -220,17 +283,19 @@ def estimate_lag(t: Array, commanded: Array, measured: Array, *, max_lag: float 
     return float(0.5 * (lo + hi))
 
 
-def _delay(t: Array, x: Array, lag: float) -> Array:
-    """``x(t - lag)`` by cubic spline, held at ``x(t0)`` before the start."""
+def delay(t: Array, x: Array, lag: float, span: tuple[float, float] | None = None) -> Array:
+    """``x(t - lag)`` by a cubic spline through ``t`` (N,), ``x`` (N, n), held at the value at
+    the start of ``span`` (default ``t``'s ends: the whole log) before it."""
+    lo, hi = (t[0], t[-1]) if span is None else span
     spline = CubicSpline(t, x, axis=0)
-    return np.asarray(spline(np.clip(t - lag, t[0], t[-1])), dtype=float)
+    return np.asarray(spline(np.clip(t - lag, lo, hi)), dtype=float)
 
 
-#: (N, n) signals whose joint count must match the robot's
 #: the log signal of measured joint torques, N m (RTDE-style name, ``actual_joint_torque_k``)
 MEASURED_TORQUE = "actual_joint_torque"
 
-_JOINT_SIGNALS = (
+#: (N, n) signals whose joint count must match the robot's
+JOINT_SIGNALS = (
     "target_q",
     "target_qd",
     "target_qdd",
@@ -255,9 +320,9 @@ def _with_torque(log: Log, n_joints: int, torque: Array) -> Log:
     return Log(log.path, log.t, {**log.signals, "_torque": torque}, log.notes)
 
 
-def _check_joints(log: Log, n_joints: int) -> None:
+def check_joints(log: Log, n_joints: int) -> None:
     """Raise when a joint signal of ``log`` does not have ``n_joints`` columns."""
-    for name in _JOINT_SIGNALS:
+    for name in JOINT_SIGNALS:
         if name in log and (log[name].ndim != 2 or log[name].shape[1] != n_joints):
             width = 1 if log[name].ndim == 1 else log[name].shape[1]
             raise KinergyError(
@@ -267,6 +332,14 @@ def _check_joints(log: Log, n_joints: int) -> None:
 
 #: (q, qd, qdd), each (N, n)
 _Motion3 = tuple[Array, Array, Array]
+
+
+def commanded_motion(log: Log) -> _Motion3:
+    """``target_q``, ``target_qd`` and ``target_qdd`` of a uniform ``log`` (the acceleration
+    differentiated from the speed when the log lacks it: a row depends on its neighbours only)."""
+    q_cmd, qd_cmd = log["target_q"], log["target_qd"]
+    qdd_cmd = log["target_qdd"] if "target_qdd" in log else np.gradient(qd_cmd, log.t, axis=0)
+    return q_cmd, qd_cmd, qdd_cmd
 
 
 def _motions(log: Log, cutoff: float) -> tuple[_Motion3, _Motion3, float, str]:
@@ -281,13 +354,12 @@ def _motions(log: Log, cutoff: float) -> tuple[_Motion3, _Motion3, float, str]:
     if not (has_target or has_actual):
         log.require("actual_q", "actual_qd", purpose="identification")
     if has_actual:
-        _check_cutoff(fs, cutoff)
+        check_cutoff(fs, cutoff)
     if has_target:
-        q_cmd, qd_cmd = log["target_q"], log["target_qd"]
-        qdd_cmd = log["target_qdd"] if "target_qdd" in log else np.gradient(qd_cmd, t, axis=0)
-        lag = estimate_lag(t, qd_cmd, log["actual_qd"]) if has_actual else 0.0
-        q, qd, qdd = (_delay(t, x, lag) for x in (q_cmd, qd_cmd, qdd_cmd))
-        return (q_cmd, qd_cmd, qdd_cmd), (q, qd, qdd), lag, "delayed target"
+        commanded = commanded_motion(log)
+        lag = estimate_lag(t, commanded[1], log["actual_qd"]) if has_actual else 0.0
+        q, qd, qdd = (delay(t, x, lag) for x in commanded)
+        return commanded, (q, qd, qdd), lag, "delayed target"
     qd_f = lowpass(log["actual_qd"], fs, cutoff)
     measured = (log["actual_q"], qd_f, np.gradient(qd_f, t, axis=0))
     return measured, measured, 0.0, "filtered actual"
@@ -308,7 +380,7 @@ def prepare(
     n_joints : int
         The robot's joint count, checked against the log.
     cutoff : float, optional
-        Low-pass cutoff for measured speeds, Hz; default min(10 Hz, a fifth of the sample rate).
+        Low-pass cutoff for measured speeds, Hz; default :func:`default_cutoff`.
     torque : ndarray, optional
         Measured joint torques aligned with the log's samples (arms with torque sensors).
 
@@ -321,12 +393,32 @@ def prepare(
         log = _with_torque(log, n_joints, torque)
     log = uniform(running(log))
     torque = log.signals.pop("_torque", None) if torque is not None else None
+    cutoff = default_cutoff(log.t) if cutoff is None else cutoff
+    check_joints(log, n_joints)
+    commanded, real, lag, source = _motions(log, cutoff)
+    return ident_data(log, commanded, real, (lag, source), torque=torque)
+
+
+def default_cutoff(t: Array) -> float:
+    """The low-pass cutoff for measured speeds of uniform time stamps ``t``: min(10 Hz, a fifth
+    of the sample rate)."""
+    fs = 1.0 / float(t[1] - t[0])
+    return min(10.0, fs / 5.0)
+
+
+def ident_data(
+    log: Log,
+    commanded: _Motion3,
+    real: _Motion3,
+    how: tuple[float, str],
+    *,
+    torque: Array | None = None,
+) -> IdentData:
+    """:class:`IdentData` of a uniform ``log`` with its ``commanded`` and ``real`` motions (each
+    (q, qd, qdd)), ``how`` = (lag in s, how the real motion was obtained); measured joint
+    torques from ``torque`` or else the log's :data:`MEASURED_TORQUE`."""
     if torque is None and MEASURED_TORQUE in log:  # arms with joint torque sensors
         torque = np.asarray(log[MEASURED_TORQUE], dtype=float)
-    fs = 1.0 / float(log.t[1] - log.t[0])
-    cutoff = min(10.0, fs / 5.0) if cutoff is None else cutoff
-    _check_joints(log, n_joints)
-    commanded, real, lag, source = _motions(log, cutoff)
     q_cmd, qd_cmd, qdd_cmd = (np.asarray(x, dtype=float) for x in commanded)
     q, qd, qdd = (np.asarray(x, dtype=float) for x in real)
     return IdentData(
@@ -341,8 +433,8 @@ def prepare(
         tau_ref=log["target_moment"] if "target_moment" in log else None,
         current=log["actual_current"] if "actual_current" in log else None,
         torque=torque,
-        lag=lag,
-        source=source,
+        lag=how[0],
+        source=how[1],
         temperature=_signal(log, "joint_temperatures"),
         voltage=_signal(log, "actual_joint_voltage"),
         supply_voltage=_signal(log, "actual_robot_voltage"),

@@ -23,6 +23,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,8 +37,12 @@ from kinergy.identify.drive_steps import (
     STILL_SPEED,
     CurrentStats,
     FrictionChoice,
+    JointFitter,
+    current_fitter,
     current_step,
+    fit_joints,
     rotor_inertias,
+    rotor_problem,
     rotor_step,
     stack,
     with_rotor_inertias,
@@ -50,21 +55,28 @@ from kinergy.identify.result import (
     DriveEstimate,
     Fit,
     IdentificationResult,
+    Validation,
     drive_fields,
-    fit_fields,
+    validation_metrics,
 )
 from kinergy.jsonable import OPTIONAL
+from kinergy.linalg import Reduced
 from kinergy.model.robot import Joint, Robot, Source
 
 __all__ = [
     "AUTO_CANDIDATES",
     "DrivesFromCurrents",
     "FrictionChoice",
+    "LogsInMemory",
+    "MotionSummary",
     "SequentialFit",
     "SequentialJoint",
+    "SequentialLogs",
     "drives_from_currents",
     "identify_sequential",
+    "motion_problems",
     "rotor_inertias",
+    "sequential_from",
 ]
 
 Array = NDArray[np.float64]
@@ -95,29 +107,56 @@ class SequentialFit(Fit):
     )
 
 
-def _diagnose_motion(robot: Robot, datas: Sequence[IdentData]) -> dict[int, str]:
-    """What the logs cannot identify, per joint (index -> reason).
+@dataclass(frozen=True)
+class MotionSummary:
+    """What :func:`motion_problems` needs of the real joint speeds: the samples, and per joint
+    the largest ``|qd|`` (rad/s) and the samples faster than :data:`STILL_SPEED` forward and
+    backward; :meth:`of` one block of speeds, :meth:`merged` with the next."""
+
+    samples: int
+    peak: Array
+    forward: NDArray[np.int_]
+    backward: NDArray[np.int_]
+
+    @classmethod
+    def of(cls, qd: Array) -> MotionSummary:
+        """The summary of joint speeds ``qd`` (N, n), rad/s."""
+        return cls(
+            qd.shape[0],
+            np.abs(qd).max(axis=0) if qd.shape[0] else np.zeros(qd.shape[1]),
+            (qd > STILL_SPEED).sum(axis=0),
+            (qd < -STILL_SPEED).sum(axis=0),
+        )
+
+    def merged(self, other: MotionSummary) -> MotionSummary:
+        return MotionSummary(
+            self.samples + other.samples,
+            np.maximum(self.peak, other.peak),
+            self.forward + other.forward,
+            self.backward + other.backward,
+        )
+
+
+def motion_problems(robot: Robot, summary: MotionSummary) -> dict[int, str]:
+    """What the logs cannot identify, per joint (index -> reason), from their speeds' summary.
 
     Raises
     ------
     KinergyError
         Too few samples, or no joint identifiable: one line naming every joint and why.
     """
-    qd = stack(datas, "qd")
-    samples = qd.shape[0]
-    if samples < 50:
+    if summary.samples < 50:
         raise KinergyError(
-            f"cannot identify from these logs: only {samples} samples (need at least 50)"
+            f"cannot identify from these logs: only {summary.samples} samples (need at least 50)"
         )
     problems: dict[int, str] = {}
     for j, joint in enumerate(robot.joints):
-        speed = np.abs(qd[:, j])
-        if speed.max() < 10 * STILL_SPEED:
+        if summary.peak[j] < 10 * STILL_SPEED:
             problems[j] = (
-                f"joint {j + 1} ({joint.name}) never moves (max |qd| {speed.max():.3g} rad/s): "
+                f"joint {j + 1} ({joint.name}) never moves (max |qd| {summary.peak[j]:.3g} rad/s): "
                 "its rotor inertia, torque constant and friction cannot be identified"
             )
-        elif (qd[:, j] > STILL_SPEED).sum() < 10 or (qd[:, j] < -STILL_SPEED).sum() < 10:
+        elif summary.forward[j] < 10 or summary.backward[j] < 10:
             problems[j] = (
                 f"joint {j + 1} ({joint.name}) never reverses: Coulomb friction in one direction "
                 "and the torque constant cannot be separated"
@@ -125,6 +164,11 @@ def _diagnose_motion(robot: Robot, datas: Sequence[IdentData]) -> dict[int, str]
     if len(problems) == robot.n:
         raise KinergyError("cannot identify from these logs: " + "; ".join(problems.values()))
     return problems
+
+
+def _diagnose_motion(robot: Robot, datas: Sequence[IdentData]) -> dict[int, str]:
+    """:func:`motion_problems` of the logs' real joint speeds."""
+    return motion_problems(robot, MotionSummary.of(stack(datas, "qd")))
 
 
 def _sources(robot: Robot, has_ref: bool, has_current: bool) -> dict[str, Source]:
@@ -228,33 +272,97 @@ def identify_sequential(
     """
     if not datas:
         raise KinergyError("no log to identify from")
-    problems = _diagnose_motion(robot, datas)
+    return sequential_from(robot, LogsInMemory(datas), friction=friction, hold=hold)
+
+
+class SequentialLogs(Protocol):
+    """What the sequential method needs of its logs, however they are held: in memory
+    (:class:`LogsInMemory`) or read in chunks (:mod:`kinergy.identify.streamed`)."""
+
+    paths: tuple[str, ...]
+    lags: tuple[float, ...]
+    samples: int
+    has_ref: bool
+    has_current: bool
+
+    def summary(self) -> MotionSummary:
+        """The real joint speeds' summary (:func:`motion_problems`)."""
+
+    def rotor_problem(self, robot: Robot) -> Reduced | None:
+        """Step 2's triangle over the logs with ``target_moment`` (None: no such log)."""
+
+    def fitter(
+        self, staged: Robot, rotor: Array, options: tuple[str | None, str | bool]
+    ) -> JointFitter:
+        """Step 3's per-joint fit of eq 18 over the logs with ``actual_current``."""
+
+    def validation(self, robot: Robot) -> Validation:
+        """:func:`~kinergy.identify.result.validation_metrics` of ``robot`` on the logs."""
+
+
+class LogsInMemory:
+    """Prepared logs held whole (:class:`SequentialLogs`)."""
+
+    def __init__(self, datas: Sequence[IdentData]):
+        self.datas = list(datas)
+        self.paths = tuple(d.path for d in datas)
+        self.lags = tuple(d.lag for d in datas)
+        self.samples = int(sum(len(d) for d in datas))
+        self.has_ref = any(d.tau_ref is not None for d in datas)
+        self.has_current = any(d.current is not None for d in datas)
+
+    def summary(self) -> MotionSummary:
+        return MotionSummary.of(stack(self.datas, "qd"))
+
+    def rotor_problem(self, robot: Robot) -> Reduced | None:
+        ref_logs = [d for d in self.datas if d.tau_ref is not None]
+        return rotor_problem(robot, ref_logs) if ref_logs else None
+
+    def fitter(
+        self, staged: Robot, rotor: Array, options: tuple[str | None, str | bool]
+    ) -> JointFitter:
+        logs = [d for d in self.datas if d.current is not None]
+        return current_fitter(staged, rotor, logs, options)
+
+    def validation(self, robot: Robot) -> Validation:
+        return validation_metrics(robot, self.datas)
+
+
+def sequential_from(
+    robot: Robot,
+    logs: SequentialLogs,
+    *,
+    friction: str | None = None,
+    hold: str | bool = "auto",
+) -> IdentificationResult:
+    """:func:`identify_sequential` on logs however held (:class:`SequentialLogs`)."""
+    problems = motion_problems(robot, logs.summary())
     warnings: list[str] = [f"{text}; kept the model's values" for text in problems.values()]
-    ref_logs = [d for d in datas if d.tau_ref is not None]
-    current_logs = [d for d in datas if d.current is not None]
-    if not (ref_logs or current_logs):
+    if not (logs.has_ref or logs.has_current):
         raise KinergyError(
             "identification needs target_moment (rotor inertia) or actual_current (torque "
             "constant and friction); the logs have neither"
         )
     active = [j for j in range(robot.n) if j not in problems]
-    rotor, rotor_std, cond = rotor_step(robot, ref_logs, active, warnings)
+    rotor, rotor_std, cond = rotor_step(robot, logs.rotor_problem(robot), active, warnings)
     staged = with_rotor_inertias(robot, rotor, warnings)
     stats: list[CurrentStats] = [CurrentStats() for _ in range(robot.n)]
     held = choices = None
-    if current_logs:
-        options = (friction, hold)
-        staged, stats, held, choices = current_step(
-            staged, rotor, current_logs, problems, options, warnings
-        )
+    if logs.has_current:
+        fitter = logs.fitter(staged, rotor, (friction, hold))
+        staged, stats, held, choices = fit_joints(staged, problems, fitter, warnings)
     else:
         warnings.append(
             "the logs have no actual_current: torque constants and friction kept from the model"
         )
-    sources = _sources(staged, bool(ref_logs), bool(current_logs))
+    sources = _sources(staged, logs.has_ref, logs.has_current)
     identified = dataclasses.replace(staged, sources=sources)
     fit = SequentialFit(
-        **fit_fields(identified, datas, warnings),
+        **vars(logs.validation(identified)),
+        samples=logs.samples,
+        logs=logs.paths,
+        lag=logs.lags,
+        warnings=tuple(warnings),
         condition_rotor_inertia=cond,
         friction_holding=held,
         friction_choice=choices if friction == "auto" else None,

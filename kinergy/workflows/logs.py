@@ -7,26 +7,57 @@ robot it runs on.
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+
+import numpy as np
+from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
+from kinergy.identify.log_chunks import prepare_segment, spill_log, streamable
 from kinergy.identify.preprocess import IdentData, prepare
+from kinergy.identify.streamed import Segment, WholeSegment
+from kinergy.io.formats import CHUNK_ROWS
+from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
 from kinergy.io.rtde import read_log
-from kinergy.io.segments import split_segments
+from kinergy.io.segments import segment_bounds
 from kinergy.io.urscript_reader import read_program
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.program_motion import program_motion
 from kinergy.trajectory.program_path import program_path
 
-__all__ = ["MIN_SEGMENT", "prepared_logs", "read_motion"]
+__all__ = ["MIN_SEGMENT", "chunked_logs", "prepared_logs", "read_motion"]
+
+Array = NDArray[np.float64]
 
 
 MIN_SEGMENT = 1.0
 """Shortest segment of a log (s) :func:`prepared_logs` identifies from."""
+
+
+def _segments(
+    path: str | os.PathLike[str], t: Array, bounds: list[tuple[int, int]]
+) -> tuple[list[tuple[str, tuple[int, int]]], str | None]:
+    """The segments ``bounds`` of the log at ``path`` (time stamps ``t``) identified from, each
+    with the name :func:`~kinergy.io.segments.split_segments` gives it, and what was done when
+    there are several (None for one): those shorter than :data:`MIN_SEGMENT` are left out."""
+    name = os.fspath(path)
+    if len(bounds) == 1:
+        return [(name, bounds[0])], None
+    parts = [(f"{name}#{k}", ab) for k, ab in enumerate(bounds)]
+    kept = [p for p in parts if t[p[1][1] - 1] - t[p[1][0]] >= MIN_SEGMENT] or [
+        max(parts, key=lambda p: p[1][1] - p[1][0])
+    ]
+    gaps = [t[b[0]] - t[a[1] - 1] for a, b in itertools.pairwise(bounds)]
+    message = (
+        f"{path}: {len(parts)} segments (gaps up to {max(gaps):.3f} s), each prepared on "
+        f"its own; {len(parts) - len(kept)} shorter than {MIN_SEGMENT:g} s left out"
+    )
+    return kept, message
 
 
 def prepared_logs(
@@ -39,7 +70,7 @@ def prepared_logs(
     note: Callable[[str], None] | None = None,
 ) -> list[IdentData]:
     """Read and prepare every log (:func:`kinergy.identify.preprocess.prepare`), each segment of
-    a log on its own (:func:`kinergy.io.segments.split_segments`: nothing is filtered or
+    a log on its own (:func:`kinergy.io.segments.segment_bounds`: nothing is filtered or
     differentiated across a gap or a reconnection).
 
     ``note`` receives what reading changed (rows dropped by ``repair``, segments), one message
@@ -48,23 +79,54 @@ def prepared_logs(
     datas: list[IdentData] = []
     for path in paths:
         log = read_log(path, columns=columns, repair=repair)
-        messages = list(log.notes)
-        parts = split_segments(log)
-        if len(parts) > 1:
-            kept = [p for p in parts if p.t[-1] - p.t[0] >= MIN_SEGMENT] or [
-                max(parts, key=lambda p: p.t.size)
-            ]
-            gaps = [b.t[0] - a.t[-1] for a, b in itertools.pairwise(parts)]
-            messages.append(
-                f"{path}: {len(parts)} segments (gaps up to {max(gaps):.3f} s), each prepared on "
-                f"its own; {len(parts) - len(kept)} shorter than {MIN_SEGMENT:g} s left out"
-            )
-            parts = kept
-        for message in messages:
+        kept, message = _segments(path, log.t, segment_bounds(log.t, log.signals.get("segment")))
+        for text in [*log.notes, *([message] if message else [])]:
             if note is not None:
-                note(message)
-        datas.extend(prepare(part, n_joints, cutoff=cutoff) for part in parts)
+                note(text)
+        for name, (a, b) in kept:
+            part = Log(
+                name, log.t[a:b], {k: v[a:b] for k, v in log.signals.items()}, list(log.notes)
+            )
+            datas.append(prepare(part, n_joints, cutoff=cutoff))
     return datas
+
+
+@contextlib.contextmanager
+def chunked_logs(
+    paths: Sequence[str | os.PathLike[str]],
+    *,
+    n_joints: int,
+    columns: str | None = None,
+    repair: bool = False,
+    cutoff: float | None = None,
+    note: Callable[[str], None] | None = None,
+    rows: int = CHUNK_ROWS,
+) -> Iterator[list[Segment]]:
+    """:func:`prepared_logs` as segments that yield their samples in chunks of ``rows``
+    (:mod:`kinergy.identify.log_chunks`: each log read once into a temporary spill, removed on
+    leaving the context). A log without the commanded motion is prepared whole
+    (:class:`~kinergy.identify.streamed.WholeSegment`)."""
+    with contextlib.ExitStack() as stack:
+        segments: list[Segment] = []
+        for path in paths:
+            spill = spill_log(path, columns=columns, repair=repair, rows=rows)
+            stack.callback(spill.close)
+            t = spill.state.t
+            kept, message = _segments(
+                path, t, segment_bounds(t, spill.state.signals.get("segment"))
+            )
+            for text in [*spill.notes, *([message] if message else [])]:
+                if note is not None:
+                    note(text)
+            for name, ab in kept:
+                if streamable(spill):
+                    segments.append(prepare_segment(spill, ab, name, n_joints, cutoff))
+                else:
+                    part = spill.read(*ab)
+                    state = {k: v[ab[0] : ab[1]] for k, v in spill.state.signals.items()}
+                    log = Log(name, part.t, {**part.signals, **state})
+                    segments.append(WholeSegment(prepare(log, n_joints, cutoff=cutoff)))
+        yield segments
 
 
 def read_motion(

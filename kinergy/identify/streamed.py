@@ -1,0 +1,485 @@
+"""The sequential identification and the motor electrics from logs read in chunks: memory
+bounded by a chunk, whatever the logs' length.
+
+:class:`LogsInChunks` gives :func:`kinergy.identify.sequential.sequential_from` what it needs of
+the logs (:class:`~kinergy.identify.sequential.SequentialLogs`) by passes over their chunks, each
+folding the chunk into a small accumulator and dropping it:
+
+1. on construction: the signals' sanity (:func:`~kinergy.identify.sanity.check_signals` per
+   chunk), the joints' position spans and speed summary, and step 2's least squares (UR5e eqs
+   7-9) folded into its QR triangle (:func:`~kinergy.identify.drive_steps.rotor_problem`: a
+   streaming QR, numerically as good as one factorisation of all rows); the prepared chunks are
+   written to an unnamed temporary file (:class:`_Store`), which the later passes read instead of
+   preparing them again;
+2. :meth:`LogsInChunks.fitter`: eq 18's triangle per motor and standstill hold (UR5e eqs 17-18);
+3. :meth:`LogsInChunks.validation`: the fit statistics (:class:`~kinergy.identify.metrics.MetricSums`)
+   and, in the same pass when the model holds no friction through standstill, eq 19 per motor
+   (:class:`~kinergy.identify.electrics.ElectricsSums`, :meth:`LogsInChunks.electrics`) with the
+   predicted currents kept for the standby power;
+4. :meth:`LogsInChunks.standby`: the mean standby power (from the kept currents through UR5e eq
+   23 when the model's mechanics are unchanged, else by another pass); :meth:`LogsInChunks.electrics`
+   makes its own pass only when step 3 could not.
+
+Memory holds one chunk and these accumulators, whatever the logs' length; the temporary files
+(the log's spill, :mod:`kinergy.identify.log_chunks`, and the prepared chunks) hold the samples
+on disk and are removed when closed.
+
+Friction held through standstill (:mod:`kinergy.friction.standstill`) is the one thing that
+reaches back in time without bound: a stopped joint keeps the friction of the last sample it
+moved in. Each pass carries, per motor, that sample into the next chunk and puts it in front of
+the chunk (then drops its result), so the hold sees what it would see in the whole log; it
+restarts at each log where the in-memory code restarts it (the fit statistics are per log, the
+current fit and the electrics run over all logs stacked).
+
+Which fits stream: the sequential method with a fixed friction model whose shape needs no search
+(``friction="auto"``'s cross-validation and ``power_law``'s exponent search refit many times:
+:func:`streams` says no, and they run in memory).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import tempfile
+from collections.abc import Iterator, Sequence
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kinergy.drives.bus import supply_power
+from kinergy.drives.electrics import electrical_power, equivalent_voltage, torque_constants
+from kinergy.drives.transmission import transmission_matrix
+from kinergy.errors import KinergyError
+from kinergy.friction.registry import get_model
+from kinergy.friction.standstill import STILL_RATE
+from kinergy.identify.drive_steps import (
+    STILL_SPEED,
+    FrictionChoice,
+    JointFitter,
+    _columns,
+    _CurrentFit,
+    _Signals,
+    best_hold,
+    holdings_of,
+    motor_signals,
+    rotor_problem,
+    solve_current,
+    start_params,
+)
+from kinergy.identify.electrics import ElectricsFit, ElectricsSums
+from kinergy.identify.metrics import MetricSums
+from kinergy.identify.preprocess import IdentData
+from kinergy.identify.result import Validation, predict
+from kinergy.identify.sanity import STILL_SPAN, check_signals
+from kinergy.identify.sequential import MotionSummary
+from kinergy.io.formats import CHUNK_ROWS
+from kinergy.linalg import Reduced
+from kinergy.model.robot import Joint, Robot
+from kinergy.predict import drive_state
+
+__all__ = ["LogsInChunks", "Segment", "WholeSegment", "streams"]
+
+Array = NDArray[np.float64]
+
+#: IdentData fields that hold samples, (N, ...) each
+_FIELDS = tuple(
+    f.name for f in dataclasses.fields(IdentData) if f.name not in ("path", "lag", "source")
+)
+
+
+class Segment(Protocol):
+    """One log (segment) that yields its prepared samples in chunks, in time order."""
+
+    @property
+    def path(self) -> str: ...
+
+    @property
+    def lag(self) -> float: ...
+
+    def __len__(self) -> int: ...
+
+    def chunks(self, rows: int = CHUNK_ROWS) -> Iterator[IdentData]: ...
+
+
+class WholeSegment:
+    """A prepared log held whole, cut into chunks (:class:`Segment`)."""
+
+    def __init__(self, data: IdentData):
+        self.data = data
+        self.path = data.path
+        self.lag = data.lag
+
+    def __len__(self) -> int:
+        return len(self.data)
+
+    def chunks(self, rows: int = CHUNK_ROWS) -> Iterator[IdentData]:
+        for start in range(0, len(self.data), rows):
+            yield self.data.sliced(start, min(start + rows, len(self.data)))
+
+
+def streams(robot: Robot, method: str, friction: str | None) -> bool:
+    """Whether :class:`LogsInChunks` runs this identification (module docstring)."""
+    if method != "sequential" or friction == "auto":
+        return False
+    models = {friction or j.drive.friction.model for j in robot.joints}
+    return not any(get_model(m).search for m in models)
+
+
+def _join(parts: Sequence[IdentData]) -> IdentData:
+    """Samples of ``parts`` one after the other (a field is None when any part lacks it)."""
+    fields: dict[str, Array | None] = {}
+    for name in _FIELDS:
+        values = [getattr(p, name) for p in parts]
+        fields[name] = None if any(v is None for v in values) else np.concatenate(values)
+    last = parts[-1]
+    return IdentData(path=last.path, lag=last.lag, source=last.source, **fields)  # type: ignore[arg-type]
+
+
+class _Held:
+    """Per motor, the last sample in which it moved (friction held through standstill recalls
+    it), for the motors whose friction has a ``standstill`` speed (rad/s, motor side)."""
+
+    def __init__(self, robot: Robot):
+        self.n_mat = transmission_matrix(robot)
+        self.still = [float(j.drive.friction.params.get("standstill", 0.0)) for j in robot.joints]
+        self.rows: dict[int, tuple[int, IdentData]] = {}
+        self.seen = 0
+
+    def reset(self) -> None:
+        self.rows = {}
+
+    def ahead(self, chunk: IdentData) -> tuple[IdentData, int]:
+        """``chunk`` with the remembered samples in front, in time order, and their count."""
+        keep = sorted({k: row for k, row in self.rows.values()}.items())
+        if not keep:
+            return chunk, 0
+        return _join([row for _, row in keep] + [chunk]), len(keep)
+
+    def update(self, chunk: IdentData) -> None:
+        """Remember each motor's last moving sample of ``chunk`` (after the earlier chunks)."""
+        if any(s > 0.0 for s in self.still):
+            wm, dwm = chunk.qd @ self.n_mat.T, chunk.qdd @ self.n_mat.T
+            for m, still in enumerate(self.still):
+                if still <= 0.0:
+                    continue
+                moving = np.flatnonzero(
+                    (np.abs(wm[:, m]) >= still) | (np.abs(dwm[:, m]) >= STILL_RATE * still)
+                )
+                if moving.size:
+                    k = int(moving[-1])
+                    self.rows[m] = (self.seen + k, chunk.sliced(k, k + 1))
+        self.seen += len(chunk)
+
+
+def _state(robot: Robot, held: _Held, chunk: IdentData, temperature: bool) -> Array:
+    """The chunk's motor currents and electrical powers under ``robot`` (:func:`drive_state`,
+    friction held as over the stacked logs), each (N, n)."""
+    data, k = held.ahead(chunk)
+    temp = data.temperature if temperature else None
+    state = drive_state(robot, data.q, data.qd, data.qdd, temperature=temp)
+    held.update(chunk)
+    return np.stack([state.current[k:], state.power[k:]])
+
+
+class _Spool:
+    """Blocks of float arrays written once to an unnamed temporary file (removed when closed)
+    and read back in order."""
+
+    def __init__(self) -> None:
+        self.file = tempfile.TemporaryFile()
+        self.index: list[tuple[int, list[tuple[int, ...]]]] = []
+        self.end = 0
+
+    def put(self, arrays: Sequence[Array]) -> None:
+        """Append one block."""
+        data = b"".join(np.ascontiguousarray(a, dtype=float).tobytes() for a in arrays)
+        self.file.write(data)
+        self.index.append((self.end, [np.shape(a) for a in arrays]))
+        self.end += len(data)
+
+    def __iter__(self) -> Iterator[list[Array]]:
+        self.file.flush()
+        for k, (offset, shapes) in enumerate(self.index):
+            stop = self.index[k + 1][0] if k + 1 < len(self.index) else self.end
+            raw = np.frombuffer(os.pread(self.file.fileno(), stop - offset, offset), dtype=float)
+            out, at = [], 0
+            for shape in shapes:
+                size = int(np.prod(shape))
+                out.append(raw[at : at + size].reshape(shape))
+                at += size
+            yield out
+
+    def close(self) -> None:
+        self.file.close()
+
+
+class _Store:
+    """Prepared chunks kept in a :class:`_Spool`: later passes do not prepare them again
+    (splines, resampling)."""
+
+    def __init__(self) -> None:
+        self.spool = _Spool()
+        self.shells: list[tuple[int, list[str], IdentData]] = []
+
+    def put(self, segment: int, chunk: IdentData) -> None:
+        """Append ``chunk`` of segment number ``segment``."""
+        present = [(n, getattr(chunk, n)) for n in _FIELDS if getattr(chunk, n) is not None]
+        self.spool.put([a for _, a in present])
+        # no sample, and no view of the chunk's arrays (which would keep them alive)
+        empty: dict[str, Any] = {n: np.empty((0, *a.shape[1:])) for n, a in present}
+        shell = dataclasses.replace(chunk.sliced(0, 0), **empty)
+        self.shells.append((segment, [n for n, _ in present], shell))
+
+    def chunks(self) -> Iterator[tuple[int, IdentData]]:
+        """(segment number, chunk) in the order they were put."""
+        for (segment, names, shell), arrays in zip(self.shells, self.spool, strict=True):
+            fields: dict[str, Any] = dict(zip(names, arrays, strict=True))
+            yield segment, dataclasses.replace(shell, **fields)
+
+    def close(self) -> None:
+        self.spool.close()
+
+
+class LogsInChunks:
+    """Prepared logs read in chunks of ``rows`` samples (:class:`~kinergy.identify.sequential.SequentialLogs`
+    for :func:`~kinergy.identify.sequential.sequential_from`); step 2's rows for ``robot``.
+
+    Raises
+    ------
+    KinergyError
+        As :func:`~kinergy.identify.sanity.check_signals` and
+        :func:`~kinergy.identify.sanity.check_motion`.
+    """
+
+    def __init__(self, robot: Robot, segments: Sequence[Segment], rows: int = CHUNK_ROWS):
+        self.segments, self.rows, self.robot = list(segments), rows, robot
+        self.paths = tuple(s.path for s in self.segments)
+        self.lags = tuple(s.lag for s in self.segments)
+        self.samples = int(sum(len(s) for s in self.segments))
+        self.has: list[dict[str, bool]] = []
+        self.seconds = 0.0
+        self._summary: MotionSummary | None = None
+        self._electrics: tuple[Robot, list[ElectricsSums]] | None = None
+        self._drawn: tuple[Robot, _Spool] | None = None
+        problem, span = Reduced.empty(robot.n), 0.0
+        self.store = _Store()
+        for k, segment in enumerate(self.segments):
+            low = high = None
+            first = True
+            for chunk in segment.chunks(rows):
+                check_signals([chunk])
+                self.store.put(k, chunk)
+                if first:
+                    self.has.append({f: getattr(chunk, f) is not None for f in _FIELDS})
+                    t0, first = float(chunk.t[0]), False
+                low = chunk.q.min(axis=0) if low is None else np.minimum(low, chunk.q.min(axis=0))
+                high = (
+                    chunk.q.max(axis=0) if high is None else np.maximum(high, chunk.q.max(axis=0))
+                )
+                summary = MotionSummary.of(chunk.qd)
+                self._summary = summary if self._summary is None else self._summary.merged(summary)
+                if chunk.tau_ref is not None:
+                    problem = rotor_problem(robot, [chunk], into=problem)
+                t1 = float(chunk.t[-1])
+            assert low is not None and high is not None
+            span = max(span, float(np.max(high - low)))
+            self.seconds += t1 - t0
+        if span < STILL_SPAN:
+            raise KinergyError(
+                f"no joint moves in these logs (largest position span {span:.2g} rad, below "
+                f"{STILL_SPAN} rad): nothing to identify from"
+            )
+        self.has_ref = any(h["tau_ref"] for h in self.has)
+        self.has_current = any(h["current"] for h in self.has)
+        self._rotor = problem if self.has_ref else None
+
+    def _every(self, *fields: str) -> bool:
+        return bool(self.segments) and all(all(h[f] for f in fields) for h in self.has)
+
+    def _chunks(self, field: str | None = None) -> Iterator[tuple[int, IdentData]]:
+        """(segment index, chunk) of every segment (that has ``field``), in order."""
+        for k, chunk in self.store.chunks():
+            if field is None or self.has[k][field]:
+                yield k, chunk
+
+    def summary(self) -> MotionSummary:
+        assert self._summary is not None
+        return self._summary
+
+    def rotor_problem(self, robot: Robot) -> Reduced | None:
+        if robot is not self.robot:
+            raise ValueError("step 2 was folded in for another robot")
+        return self._rotor
+
+    def fitter(
+        self, staged: Robot, rotor: Array, options: tuple[str | None, str | bool]
+    ) -> JointFitter:
+        """Eq 18's triangles of every motor and standstill hold, in one pass (module docstring)."""
+        friction, hold = options
+        if not streams(staged, "sequential", friction):
+            raise KinergyError(f"friction {friction!r} is not fitted in chunks")
+        holdings = holdings_of(hold)
+        models = [friction or j.drive.friction.model for j in staged.joints]
+        stills = [STILL_SPEED * abs(j.drive.gear_ratio) for j in staged.joints]
+        params = [
+            [start_params(j, models[m], stills[m], h) for h in holdings]
+            for m, j in enumerate(staged.joints)
+        ]
+        problems = [
+            [Reduced.empty(1 + len(get_model(models[m]).linear)) for _ in holdings]
+            for m in range(staged.n)
+        ]
+        carry: list[_Signals | None] = [None] * staged.n
+        # as motor_signals: temperatures only when every log with currents has them
+        warm = all(h["temperature"] for h in self.has if h["current"])
+        for _, chunk in self._chunks("current"):
+            for m, s in enumerate(motor_signals(staged, rotor, [chunk])):
+                if not warm:
+                    s = _Signals(s.tau_load, s.wm, s.dwm, s.current, None)
+                before = carry[m]
+                joined = s if before is None else _cat(before, s)
+                skip = 0 if before is None else 1
+                for h, p in enumerate(params[m]):
+                    cols = _columns(models[m], p, joined)[skip:]
+                    problems[m][h] = problems[m][h].stack(cols, s.current)
+                moving = np.flatnonzero(
+                    (np.abs(s.wm) >= stills[m]) | (np.abs(s.dwm) >= STILL_RATE * stills[m])
+                )
+                if moving.size:
+                    carry[m] = s.rows(np.arange(s.wm.size) == moving[-1])
+
+        index = {h: k for k, h in enumerate(holdings)}
+
+        def fit_joint(m: int, joint: Joint, _: float) -> tuple[_CurrentFit, FrictionChoice | None]:
+            def fit(h: float) -> _CurrentFit:
+                k = index[h]
+                return solve_current(
+                    models[m], params[m][k], problems[m][k], joint.drive.torque_constant
+                )
+
+            return best_hold(holdings, fit), None
+
+        return fit_joint
+
+    def validation(self, robot: Robot) -> Validation:
+        """The fit statistics of ``robot`` on the logs, pooled (friction held per log, as
+        :func:`~kinergy.identify.result.validation_metrics`). When the model holds no friction
+        through standstill and the logs' temperatures are all there or all missing, its
+        predicted currents are the instrument of :meth:`electrics` too: the same pass
+        accumulates that fit."""
+        sums: dict[str, MetricSums | None] = dict.fromkeys(("torque", "current", "joint_torque"))
+        held = _Held(robot)
+        warm = {h["temperature"] for h in self.has}
+        fused = self.has_voltage and not any(held.still) and len(warm) == 1
+        motors = [ElectricsSums() for _ in range(robot.n)] if fused else None
+        if fused and self.has_supply:  # the predicted currents, for standby
+            self._drawn = (robot, _Spool())
+        last = -1
+        for k, chunk in self._chunks():
+            if k != last:
+                held.reset()
+                last = k
+            data, skip = held.ahead(chunk)
+            pred = predict(robot, data)
+            held.update(chunk)
+            for key, measured, predicted in (
+                ("torque", chunk.tau_ref, pred.torque),
+                ("current", chunk.current, pred.current),
+                ("joint_torque", chunk.torque, pred.joint_torque),
+            ):
+                if measured is not None and predicted is not None:
+                    sums[key] = sums[key] or MetricSums(robot.n)
+                    sums[key].add(measured, predicted[skip:])  # type: ignore[union-attr]
+            if motors is not None:
+                assert pred.current is not None
+                _add_electrics(motors, held.n_mat, chunk, pred.current)
+            if self._drawn is not None and pred.current is not None:
+                self._drawn[1].put([pred.current])
+        if motors is not None:
+            self._electrics = (robot, motors)
+        return Validation(**{k: None if s is None else s.metrics() for k, s in sums.items()})
+
+    @property
+    def has_voltage(self) -> bool:
+        return self._every("voltage", "current")
+
+    @property
+    def has_supply(self) -> bool:
+        return self._every("supply_voltage", "supply_current")
+
+    def electrics(self, robot: Robot) -> list[ElectricsFit | KinergyError]:
+        """Per motor, eq 19's fit (:func:`~kinergy.identify.electrics.fit_electrics` with the
+        current ``robot`` predicts as the instrument) or why it cannot be made."""
+        if self._electrics is not None and self._electrics[0] is robot:
+            motors = self._electrics[1]
+        else:
+            motors = [ElectricsSums() for _ in range(robot.n)]
+            held = _Held(robot)
+            warm = self._every("temperature")
+            for _, chunk in self._chunks():
+                predicted = _state(robot, held, chunk, warm)[0]
+                _add_electrics(motors, held.n_mat, chunk, predicted)
+        out: list[ElectricsFit | KinergyError] = []
+        for motor in motors:
+            try:
+                out.append(motor.fit())
+            except KinergyError as exc:
+                out.append(exc)
+        return out
+
+    def standby(self, robot: Robot) -> float:
+        """The mean of the supply power less the motors' predicted draw, W
+        (:func:`~kinergy.identify.electrics.fit_standby`'s ``standby``). The currents
+        :meth:`validation` predicted serve when ``robot`` differs from its model in the
+        electrics alone (its currents on the first chunk are the same to the bit): the power
+        is then ``tau_m = k_t I`` through UR5e eq 23 (:func:`electrical_power`)."""
+        held, total, count = _Held(robot), 0.0, 0
+        warm = self._every("temperature")
+        drawn = iter(self._drawn[1]) if self._drawn is not None else None
+        n_mat, kt = transmission_matrix(robot), torque_constants(robot)
+        for _, chunk in self._chunks():
+            assert chunk.supply_voltage is not None and chunk.supply_current is not None
+            if drawn is not None and count > 0:
+                power = electrical_power(robot, next(drawn)[0] * kt, chunk.qd @ n_mat.T)
+            else:
+                current, power = _state(robot, held, chunk, warm)
+                if drawn is not None and not np.array_equal(current, next(drawn)[0]):
+                    drawn = None
+            supply = np.asarray(chunk.supply_voltage * chunk.supply_current, dtype=float)
+            total += float(np.sum(supply - supply_power(power).motors))
+            count += len(chunk)
+        return total / count
+
+    def close(self) -> None:
+        """Remove the prepared chunks' files."""
+        self.store.close()
+        if self._drawn is not None:
+            self._drawn[1].close()
+
+
+def _add_electrics(
+    motors: list[ElectricsSums], n_mat: Array, chunk: IdentData, predicted: Array
+) -> None:
+    """Fold ``chunk``'s currents, voltages and motor speeds into each motor's eq 19, with the
+    ``predicted`` currents (N, n) as the instrument."""
+    assert chunk.current is not None and chunk.voltage is not None
+    voltage, wm = equivalent_voltage(chunk.voltage), chunk.qd @ n_mat.T
+    for m, motor in enumerate(motors):
+        motor.add(chunk.current[:, m], voltage[:, m], wm[:, m], predicted[:, m])
+
+
+def _cat(a: _Signals, b: _Signals) -> _Signals:
+    """Motor signals ``a`` then ``b``."""
+    temp = (
+        None
+        if a.temperature is None or b.temperature is None
+        else np.concatenate([a.temperature, b.temperature])
+    )
+    return _Signals(
+        np.concatenate([a.tau_load, b.tau_load]),
+        np.concatenate([a.wm, b.wm]),
+        np.concatenate([a.dwm, b.dwm]),
+        np.concatenate([a.current, b.current]),
+        temp,
+    )
