@@ -23,6 +23,8 @@ Array = NDArray[np.float64]
 OPTIONAL_PARAMETERS = {"standstill": 0.0, "holding": 1.0}
 #: a motor is stopped when |wm| < standstill and |dwm| < STILL_RATE * standstill (1/s)
 STILL_RATE = 100.0
+#: a run of motion shorter than this many samples does not set the held friction
+MIN_RUN = 5
 
 
 def hold_standstill(columns: Array, moving: NDArray[np.bool_]) -> Array:
@@ -42,7 +44,18 @@ def hold(params: Mapping[str, float], columns: Array, wm: Array, dwm: Array | No
     if threshold <= 0.0:
         return columns
     moving = np.abs(wm) >= threshold
+    stopped = ~moving
     if dwm is not None:
-        moving |= np.abs(np.asarray(dwm, dtype=float)) >= STILL_RATE * threshold
-    held = params.get("holding", 1.0) * hold_standstill(columns, moving)
-    return np.where(moving[:, None], columns, held)
+        stopped &= np.abs(np.asarray(dwm, dtype=float)) < STILL_RATE * threshold
+    held = params.get("holding", 1.0) * hold_standstill(columns, sustained(moving))
+    return np.where(stopped[:, None], held, columns)
+
+
+def sustained(moving: NDArray[np.bool_], min_run: int = MIN_RUN) -> NDArray[np.bool_]:
+    """``moving`` (N,) without its runs shorter than ``min_run`` samples."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], moving.astype(np.int8), [0]])))
+    out = moving.copy()
+    for start, stop in zip(edges[::2], edges[1::2], strict=True):
+        if stop - start < min_run:
+            out[start:stop] = False
+    return out

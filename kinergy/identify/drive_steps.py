@@ -119,18 +119,28 @@ def rotor_inertias(
 @dataclass(frozen=True, eq=False)
 class _Signals:
     """One motor's signals for eq 18, motor side, each (N,): load torque ``tau_load`` (N m),
-    speed ``wm`` (rad/s), acceleration ``dwm`` (rad/s^2), measured ``current`` (A) and the
-    joint ``temperature`` (deg C, None when not logged)."""
+    speed ``wm`` (rad/s), acceleration ``dwm`` (rad/s^2), measured ``current`` (A), the joint
+    ``temperature`` (deg C, None when not logged) and the stretch of time each row belongs to
+    (``piece``, int: one per log; a friction held through standstill never crosses into the
+    next piece)."""
 
     tau_load: Array
     wm: Array
     dwm: Array
     current: Array
     temperature: Array | None = None
+    piece: NDArray[np.int64] | None = None
 
     def rows(self, keep: NDArray[np.bool_]) -> _Signals:
+        """The rows ``keep``; where rows are left out between two kept ones, a new piece."""
         t = None if self.temperature is None else self.temperature[keep]
-        return _Signals(self.tau_load[keep], self.wm[keep], self.dwm[keep], self.current[keep], t)
+        piece = None
+        if self.piece is not None:
+            index = np.flatnonzero(keep)
+            cut = (np.diff(index) > 1) | (np.diff(self.piece[keep]) != 0)
+            piece = np.concatenate([[0], np.cumsum(cut)])
+        s = (self.tau_load, self.wm, self.dwm, self.current)
+        return _Signals(*(x[keep] for x in s), t, piece)
 
 
 @dataclass(frozen=True, eq=False)
@@ -150,8 +160,15 @@ class _CurrentFit:
 def _columns(model: str, params: dict[str, float], signals: _Signals) -> Array:
     """Eq 18's regressor ``[tau_load, friction columns]`` (N, 1 + k)."""
     s = signals
-    cols = friction_columns(model, params, s.wm, s.tau_load, s.dwm, temperature=s.temperature)
-    return np.column_stack([s.tau_load, cols])
+    bounds = [0, s.wm.size]
+    if s.piece is not None:
+        bounds[1:1] = list(np.flatnonzero(np.diff(s.piece)) + 1)
+    parts = []
+    for lo, hi in itertools.pairwise(bounds):
+        t = None if s.temperature is None else s.temperature[lo:hi]
+        w, load, dw = s.wm[lo:hi], s.tau_load[lo:hi], s.dwm[lo:hi]
+        parts.append(friction_columns(model, params, w, load, dw, temperature=t))
+    return np.column_stack([s.tau_load, np.vstack(parts)])
 
 
 def _solve_current(
@@ -253,6 +270,7 @@ def motor_signals(robot: Robot, rotor: Array, logs: Sequence[IdentData]) -> list
     temps = None
     if all(d.temperature is not None for d in logs):
         temps = stack(logs, "temperature")
+    piece = np.repeat(np.arange(len(logs)), [d.qd.shape[0] for d in logs])
     return [
         _Signals(
             tau_load[:, m],
@@ -260,6 +278,7 @@ def motor_signals(robot: Robot, rotor: Array, logs: Sequence[IdentData]) -> list
             dwm[:, m],
             current[:, m],
             None if temps is None else temps[:, m],
+            piece,
         )
         for m in range(robot.n)
     ]
