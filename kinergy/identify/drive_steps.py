@@ -36,6 +36,7 @@ from kinergy.identify.result import (
     IDENTIFIED,
     KEPT,
 )
+from kinergy.jsonable import OPTIONAL
 from kinergy.linalg import scaled_lstsq
 from kinergy.model.robot import Friction, Joint, Robot
 
@@ -318,13 +319,16 @@ def _best_hold(
 @dataclass(frozen=True)
 class FrictionChoice:
     """How ``friction="auto"`` chose a joint's model: each candidate's cross-validated current
-    RMS (A, :data:`FOLDS` contiguous blocks), the winner, and how much lower its RMS is than
-    Coulomb + viscous's and than the runner-up's (%)."""
+    RMS (A, :data:`FOLDS` contiguous blocks), the winner, how much lower its RMS is than
+    Coulomb + viscous's and than the runner-up's (%), and the standard error of the first (%,
+    from the spread of the per-block differences). A model other than Coulomb + viscous wins
+    only if it beats it by more than that standard error (the one-standard-error rule)."""
 
     model: str
     cv_rms: dict[str, float]
     gain_over_viscous_coulomb: float | None
     margin: float | None
+    gain_std: float | None = field(default=None, metadata=OPTIONAL)
 
 
 def candidates(signals: _Signals) -> list[str]:
@@ -335,46 +339,61 @@ def candidates(signals: _Signals) -> list[str]:
     return [m for m in AUTO_CANDIDATES if warm or not get_model(m).needs_temperature]
 
 
-def _cv_rms(fit: _CurrentFit, signals: _Signals, kt_prior: float) -> float:
-    """Current RMS (A) of ``fit``'s model (its shape held) on each of :data:`FOLDS` contiguous
-    blocks of the samples, fitted on the others."""
+def _cv_errors(fit: _CurrentFit, signals: _Signals, kt_prior: float) -> Array:
+    """Squared current error (A^2) summed over each of :data:`FOLDS` contiguous blocks of the
+    samples, ``fit``'s model (its shape and hold held) fitted on the others, shape (FOLDS,)."""
     index = np.arange(signals.current.size)
     edges = np.linspace(0, index.size, FOLDS + 1).astype(int)
+    fold = np.searchsorted(edges, index, side="right") - 1
+    if signals.piece is not None and np.unique(signals.piece).size >= 3:
+        fold = signals.piece
     a = _columns(fit.model, fit.params, signals)
-    squared = 0.0
-    for lo, hi in itertools.pairwise(edges):
-        held = (index >= lo) & (index < hi)
+    squared = []
+    for k in np.unique(fold):
+        held = fold == k
         train = _solve_current(fit.model, fit.params, signals.rows(~held), kt_prior)
-        squared += float(np.sum((signals.current[held] - a[held] @ train.x) ** 2))
-    return float(np.sqrt(squared / index.size))
+        squared.append(float(np.sum((signals.current[held] - a[held] @ train.x) ** 2)))
+    return np.array(squared)
+
+
+def _gain(errors: dict[str, Array], model: str, other: str) -> tuple[float, float]:
+    """How much lower ``model``'s cross-validated RMS is than ``other``'s (%), and the standard
+    error of that gain from the per-block differences of the squared error (%)."""
+    a, b = errors[model], errors[other]
+    gain = 100.0 * (1.0 - np.sqrt(a.sum() / b.sum()))
+    # gain ~ -(sum a - sum b) / (2 sum b); the blocks' differences give that sum's spread
+    std = 50.0 * np.sqrt(a.size) * float(np.std(a - b, ddof=1)) / float(b.sum())
+    return float(gain), std
 
 
 def _auto_fit(
     joint: Joint, standstill: float, signals: _Signals, holdings: Sequence[float]
 ) -> tuple[_CurrentFit, FrictionChoice]:
-    """``friction="auto"``: the standstill hold chosen with the joint's own model, then every
-    candidate model fitted with it and scored by cross-validation; the lowest held-out RMS wins.
-    Candidates whose regression is singular on these logs are left out."""
-    own = _best_hold(joint, joint.drive.friction.model, standstill, signals, holdings)
-    holding = float(own.params.get("holding", 0.0))
+    """``friction="auto"``: every candidate model fitted with its own standstill hold and scored
+    by cross-validation; the lowest held-out RMS wins unless it beats Coulomb + viscous by no
+    more than the standard error of that gain. Candidates whose regression is singular on these
+    logs are left out."""
     kt = joint.drive.torque_constant
-    fits, scores = {}, {}
+    fits, errors = {}, {}
     for model in candidates(signals):
-        fit = _current_fit(model, _start(joint, model, standstill, holding), signals, kt)
+        fit = _best_hold(joint, model, standstill, signals, holdings)
         if fit.cond <= MAX_CONDITION:
-            fits[model], scores[model] = fit, _cv_rms(fit, signals, kt)
+            fits[model], errors[model] = fit, _cv_errors(fit, signals, kt)
+    scores = {m: float(np.sqrt(e.sum() / signals.current.size)) for m, e in errors.items()}
     ranked = sorted(scores, key=scores.__getitem__)
-    best = ranked[0]
-
-    def lower(other: str) -> float:
-        return 100.0 * (1.0 - scores[best] / scores[other])
-
-    vc = scores.get("viscous_coulomb")
+    best, gain, std = ranked[0], None, None
+    if "viscous_coulomb" in scores:
+        gain, std = _gain(errors, best, "viscous_coulomb")
+        if gain <= std:
+            best = "viscous_coulomb"
+            gain, std = 0.0, None
+    others = [m for m in ranked if m != best]
     choice = FrictionChoice(
         model=best,
         cv_rms=scores,
-        gain_over_viscous_coulomb=None if vc is None else lower("viscous_coulomb"),
-        margin=lower(ranked[1]) if len(ranked) > 1 else None,
+        gain_over_viscous_coulomb=gain,
+        margin=100.0 * (1.0 - scores[best] / scores[others[0]]) if others else None,
+        gain_std=std,
     )
     return fits[best], choice
 
