@@ -26,6 +26,7 @@ import json
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -357,7 +358,13 @@ def every_log() -> list[tuple[Path, str, str | None]]:
     return logs
 
 
+def _refusal(err: str) -> list[str]:
+    """The lines of a refusal on stderr, without the reader's notes."""
+    return [ln for ln in err.strip().splitlines() if ln and not ln.startswith("kinergy: note")]
+
+
 def bench_sweep(out: Path) -> dict:
+    start = time.perf_counter()
     rows = []
     panda = [(p, "panda", None) for p in panda_log(out)]
     for log, robot, columns in every_log() + panda:
@@ -370,12 +377,20 @@ def bench_sweep(out: Path) -> dict:
                 "--out", model, log,
             )  # fmt: skip
             problems = physical_problems(model) if rc == 0 else []
-            last = err.strip().splitlines()[-1] if rc != 0 and err.strip() else ""
-            rows.append((log.name, method, rc, problems, last))
+            said = _refusal(err) if rc != 0 else []
+            last = said[-1] if said else ""
+            rows.append((log.name, method, rc, problems, last, len(said)))
             print(f"{log.name:40s} {method:10s} exit {rc} {problems or ''} {last[:110]}")
     bad = [r for r in rows if r[2] == 0 and r[3]]
-    print(f"{len(rows)} runs, {sum(r[2] == 0 for r in rows)} wrote a model, {len(bad)} unphysical")
-    return {"runs": len(rows), "written": sum(r[2] == 0 for r in rows), "unphysical": bad}
+    refused = [r for r in rows if r[2] != 0]
+    one_line = sum(r[5] == 1 for r in refused)
+    wall = time.perf_counter() - start
+    print(
+        f"{len(rows)} runs, {len(rows) - len(refused)} wrote a model, {len(refused)} refused "
+        f"({one_line} in one line), {len(bad)} unphysical with exit 0; wall time {wall:.0f} s"
+    )
+    return {"runs": len(rows), "written": len(rows) - len(refused), "refused": len(refused),
+            "one_line": one_line, "unphysical": bad, "wall_s": wall}  # fmt: skip
 
 
 def bench_bad(out: Path) -> dict:
