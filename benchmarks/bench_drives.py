@@ -7,14 +7,16 @@ Each part prints its figures and a markdown-ready line; ``--part`` runs one of t
   voltage against the measured ``U``.
 - ``ur10e``: identify the UR10e on its unloaded Fourier runs with ``--friction auto`` and with
   Coulomb + viscous, predict the held-out ``ptp_10_points`` log: current RMS per joint.
-- ``twin``: a realistic twin (:func:`kinergy.simulate.realistic_truth`), one 60 s excitation log,
-  identified (sequential with ``friction="auto"``, then the electrics and standby from the
-  logged voltages and supply): each drive parameter against the truth; the full method's base
-  parameters against the truth's.
+- ``twin``: a realistic twin (:func:`kinergy.simulate.realistic_truth`), one 60 s excitation log
+  (the one ``kinergy excite`` designs, then a random Fourier one for contrast), identified
+  (sequential with ``friction="auto"``, then the electrics and standby from the logged voltages
+  and supply): each drive parameter against the truth; the full method's base parameters
+  against the truth's, with their standard errors.
 - ``supply``: the model identified on that log predicts test A run on the same twin: predicted
   against logged supply energy.
-- ``warmup``: two 30-minute warm-up logs of the twin from cold (50 Hz): identify on one with and
-  without the temperature term, predict the other's currents.
+- ``warmup``: two 60-minute warm-up logs of the twin from cold (50 Hz, a designed excitation
+  repeated): identify on one with and without the temperature term, predict the other's
+  currents.
 
     python benchmarks/bench_drives.py [--part all|calibration|ur10e|twin|supply|warmup]
 """
@@ -33,9 +35,9 @@ from kinergy.accounting.energy import energy
 from kinergy.drives.electrics import DQ_VOLTAGE_FACTOR, back_emf_constants, winding_resistances
 from kinergy.dynamics.regressor import base_parameters, inertial_parameters
 from kinergy.friction.registry import friction_torque
-from kinergy.identify.full import identify_full
+from kinergy.identify.full import FullFit, identify_full
 from kinergy.identify.preprocess import IdentData, prepare
-from kinergy.identify.result import predict
+from kinergy.identify.result import IdentificationResult, predict
 from kinergy.io.rtde import read_log, write_log
 from kinergy.io.ur_calibration import read_ur_calibration
 from kinergy.model.robot import Robot
@@ -46,6 +48,7 @@ from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import paper_trajectory
 from kinergy.workflows.calibration import import_calibration
 from kinergy.workflows.energy import energy_of_log
+from kinergy.workflows.excite import ExciteOptions, run_excite
 from kinergy.workflows.identify import run_method
 
 DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "datasets"
@@ -181,65 +184,159 @@ def _twin_log(
     return prepare(read_log(path), truth.n)
 
 
-def _drive_table(truth: Robot, ident: Robot, data: IdentData) -> float:
-    """Each drive parameter against the truth; returns the worst error (%)."""
+def _in_std(err_pct: float, value: float, std: float | None) -> str:
+    """An error (%) of ``value`` in its standard errors ``std``: ``"(+1.2 sd)"``."""
+    if std is None or not std > 0.0:
+        return ""
+    return f" ({err_pct / 100.0 * value / std:+.1f} sd)"
+
+
+def _drive_table(truth: Robot, result: IdentificationResult, data: IdentData) -> float:
+    """Each drive parameter against the truth (k_t and J_m + J_r with their errors in standard
+    errors of the fit); returns the worst error (%)."""
+    ident = result.robot
     t_state = drive_state(truth, data.q, data.qd, data.qdd, temperature=data.temperature)
     i_state = drive_state(ident, data.q, data.qd, data.qdd, temperature=data.temperature)
     worst = 0.0
     print("| joint | k_t [%] | J_m+J_r [%] | R [%] | k_b [%] | friction RMS [%] |")
     for j, (tj, ij) in enumerate(zip(truth.joints, ident.joints, strict=True)):
         td, idd = tj.drive, ij.drive
+        std = result.joints[j].std
         errs = [
             _pct(idd.torque_constant, td.torque_constant),
-            _pct(idd.motor_inertia + idd.reducer_inertia, td.motor_inertia + td.reducer_inertia),
+            _pct(idd.rotor_inertia, td.rotor_inertia),
             _pct(idd.winding_resistance or np.nan, td.winding_resistance or np.nan),
             _pct(idd.torque_constant / idd.kt_over_kb, td.torque_constant / td.kt_over_kb),
         ]
         tf, f = t_state.tau_friction[:, j], i_state.tau_friction[:, j]
         errs.append(100.0 * np.sqrt(np.mean((f - tf) ** 2) / np.mean(tf**2)))
         worst = max(worst, *(abs(e) for e in errs))
-        print(f"| {tj.name} | " + " | ".join(f"{e:+.2f}" for e in errs) + " |")
+        notes = [
+            _in_std(errs[0], idd.torque_constant, std.get("torque_constant")),
+            _in_std(errs[1], idd.rotor_inertia, std.get("rotor_inertia")),
+            "",
+            "",
+            "",
+        ]
+        cells = [f"{e:+.2f}{note}" for e, note in zip(errs, notes, strict=True)]
+        print(f"| {tj.name} | " + " | ".join(cells) + " |")
     return worst
 
 
-def _base_errors(truth: Robot, model: Robot, data: IdentData) -> None:
-    """The full method's base parameters against the truth's, regressed against the twin's
-    ``target_moment`` (computed from its truth without noise) and against its currents."""
+def _effective_truth(truth: Robot, base_true: np.ndarray, fit: FullFit) -> np.ndarray:
+    """The truth's base parameters as the regression can see them: a rotor inertia whose column
+    is merged into link base columns keeps the model's value, and the parameters it merges into
+    carry ``coefficient * (J_true - J_model)`` (``fit.merged``); comparing with the links' own
+    base parameters alone would count that share as an error."""
+    out = base_true.copy()
+    b = out.size
+    index = {p.name: k for k, p in enumerate(fit.parameters)}
+    for merged in fit.merged:
+        k = index.get(merged.parameter)
+        if k is None or fit.parameters[k].group != "rotor":
+            continue
+        delta = truth.joints[k - b].drive.rotor_inertia - merged.value
+        for into in merged.into:
+            if into.index < b:
+                out[into.index] += into.coefficient * delta
+    return out
+
+
+def _verdict(rel: float, z: float) -> str:
+    """Within 10 %; else badly excited (within 2 standard errors of the truth) or biased."""
+    if rel <= 0.10:
+        return "ok"
+    return "badly excited" if abs(z) <= 2.0 else "biased"
+
+
+def _base_errors(truth: Robot, model: Robot, data: IdentData, *, table: bool = False) -> None:
+    """The full method's base parameters against the truth's (merged rotor inertias included,
+    :func:`_effective_truth`), regressed against the twin's ``target_moment`` (computed from its
+    truth without noise) and against its currents, with the model's own friction and with the
+    truth's friction family (``load_thermal_power_law``); with ``table``, every parameter above
+    1 % of the largest with its standard error."""
     base = base_parameters(model)
     true = base.project(inertial_parameters(truth))
+    names = base.expressions()
     big = np.abs(true) > 0.01 * np.max(np.abs(true))
-    for target in ("moment", "current"):
+    runs = (
+        ("moment", None),
+        ("current", None),
+        ("current", "power_law"),
+        ("current", "load_thermal_power_law"),
+    )
+    for target, friction in runs:
+        label = f"against {target}" + (f", friction {friction}" if friction else "")
         try:
-            result = identify_full(model, [data], target=target)
+            result = identify_full(model, [data], target=target, friction=friction)
         except Exception as exc:  # report, do not stop the benchmark
-            print(f"full method against {target}: failed: {exc}")
+            print(f"full method {label}: failed: {exc}")
             continue
+        assert isinstance(result.fit, FullFit)
+        eff = _effective_truth(truth, true, result.fit)
         got = np.array([p.value for p in result.fit.base_parameters])
-        rel = np.abs(got - true) / np.maximum(np.abs(true), 1e-12)
+        std = np.array([np.nan if p.std is None else p.std for p in result.fit.base_parameters])
+        rel = np.abs(got - eff) / np.maximum(np.abs(eff), 1e-12)
+        z = (got - eff) / std
+        verdicts = [_verdict(float(r), float(s)) for r, s in zip(rel[big], z[big], strict=True)]
         print(
-            f"full method against {target}: {np.sum(rel[big] <= 0.10)} of {big.sum()} base "
-            f"parameters above 1 % of the largest within 10 % (median error "
-            f"{100 * np.median(rel[big]):.2f} %, worst {100 * np.max(rel[big]):.1f} %); all "
-            f"{rel.size}: {np.sum(rel <= 0.10)} within 10 %"
+            f"full method {label}: {np.sum(rel[big] <= 0.10)} of {big.sum()} base parameters "
+            f"above 1 % of the largest within 10 % (median error {100 * np.median(rel[big]):.2f} "
+            f"%, worst {100 * np.max(rel[big]):.1f} %; outside 10 %: "
+            f"{verdicts.count('badly excited')} badly excited, {verdicts.count('biased')} "
+            f"biased); all {rel.size}: {np.sum(rel <= 0.10)} within 10 %"
         )
+        if table:
+            print(
+                "| base parameter | truth | identified | error [%] | std error | error / std | verdict |"
+            )
+            for k in np.flatnonzero(big)[np.argsort(-np.abs(true[big]))]:
+                print(
+                    f"| {names[k][:40]} | {eff[k]:+.4f} | {got[k]:+.4f} | "
+                    f"{100 * (got[k] / eff[k] - 1):+.1f} | {std[k]:.2g} | {z[k]:+.1f} | "
+                    f"{_verdict(float(rel[k]), float(z[k]))} |"
+                )
 
 
-def twin(folder: Path) -> Robot:
-    """The realistic twin's 60 s excitation, identified; returns the identified model."""
+def designed_excitation(robot: Robot, folder: Path, seconds: float = 60.0, seed: int = 0) -> Motion:
+    """The excitation ``kinergy excite ROBOT --periods N --seed SEED`` designs (default options:
+    5 harmonics, period 10 s, minimum condition number), ``seconds`` long; its motion file is
+    kept in ``folder``."""
+    options = ExciteOptions(
+        out=folder / f"designed-{seed}.csv", periods=round(seconds / 10.0), seed=seed
+    )
+    return run_excite(robot, options).motion
+
+
+def _identify_excitation(truth: Robot, motion: Motion, path: Path, *, table: bool) -> Robot:
+    """One excitation log of the twin, identified: drives and base parameters against the
+    truth; returns the identified model."""
     model = kinergy.load_robot("ur5e")
-    truth = realistic_truth(model, SEED)
-    data = _twin_log(truth, excitation(model), SEED, folder / "excitation.csv")
+    data = _twin_log(truth, motion, SEED, path)
     t0 = time.perf_counter()
     result = run_method(model, [data], friction="auto")
     print(f"sequential + electrics identified in {time.perf_counter() - t0:.1f} s")
-    worst = _drive_table(truth, result.robot, data)
+    worst = _drive_table(truth, result, data)
     print(f"worst drive-parameter error {worst:.2f} % (bar 5 %)")
     print(
         f"standby: {result.robot.standby_power:.2f} W against the truth's "
         f"{truth.standby_power:.2f} W ({_pct(result.robot.standby_power, truth.standby_power):+.2f} %)"
     )
-    _base_errors(truth, model, data)
+    _base_errors(truth, model, data, table=table)
     return result.robot
+
+
+def twin(folder: Path) -> Robot:
+    """The realistic twin's 60 s excitation logs (the designed one ``kinergy excite`` writes,
+    then the random Fourier one), identified; returns the model identified on the designed."""
+    model = kinergy.load_robot("ur5e")
+    truth = realistic_truth(model, SEED)
+    print("## designed excitation (kinergy excite ur5e --periods 6), 60 s")
+    designed = designed_excitation(model, folder)
+    identified = _identify_excitation(truth, designed, folder / "excitation.csv", table=True)
+    print("## random Fourier excitation, 60 s")
+    _identify_excitation(truth, excitation(model), folder / "random.csv", table=False)
+    return identified
 
 
 def supply(folder: Path, identified: Robot) -> None:
@@ -275,32 +372,49 @@ def _tiled(motion: Motion, minutes: float, rate: float) -> Motion:
     return Motion(t, *parts)
 
 
-def warmup(folder: Path) -> None:
-    """Identify on one warm-up log with and without the temperature term, predict the other."""
+def warmup(folder: Path, minutes: float = 60.0) -> None:
+    """Two warm-up logs of ``minutes`` from a cold start: each the designed excitation of
+    ``kinergy excite`` (seeds 0 and 1, one 10 s period) repeated, as the warm-up studies repeat
+    their identification trajectory; identify on one with and without the temperature term,
+    predict the other's currents (per joint and over the whole log)."""
     model = kinergy.load_robot("ur5e")
     truth = realistic_truth(model, SEED)
     rate = 50.0
-    one = _tiled(excitation(model, 20.0, 500.0, seed=0), 30.0, rate)
-    two = _tiled(excitation(model, 20.0, 500.0, seed=3), 30.0, rate)
+    one, two = (
+        _tiled(designed_excitation(model, folder, 10.0, seed=s), minutes, rate) for s in (0, 1)
+    )
     ident = _twin_log(truth, one, SEED, folder / "warm1.csv", reuse=True)
     held = _twin_log(truth, two, SEED + 1, folder / "warm2.csv", reuse=True)
     assert ident.temperature is not None and held.temperature is not None
-    print(f"warm-up: joints warm by {np.ptp(ident.temperature, axis=0).round(1)} K over 30 min")
+    print(
+        f"warm-up: joints warm by {np.ptp(ident.temperature, axis=0).round(1)} K (held-out log "
+        f"{np.ptp(held.temperature, axis=0).round(1)} K) over {minutes:g} min"
+    )
     # Coulomb + viscous with and without its temperature term (the one difference), and the
     # power law without, and with the load and temperature terms
     runs = ("viscous_coulomb", "thermal_viscous", "power_law", "load_thermal_power_law")
     rms = {f: _current_rms(run_method(model, [ident], friction=f).robot, held) for f in runs}
+    floor = _current_rms(truth, held)  # the truth itself: the current noise and quantisation
     print(
-        "| joint | "
+        "| joint | warms by [K] | "
         + " | ".join(f"{k} [A]" for k in runs)
-        + " | C+V lower by [%] | power law lower by [%] |"
+        + " | C+V lower by [%] | power law lower by [%] | the truth [A] |"
     )
-    for j, name in enumerate(model.joint_names):
+    rows = [
+        (name, float(np.ptp(held.temperature[:, j]))) for j, name in enumerate(model.joint_names)
+    ]
+    for j, (name, warm) in enumerate(rows):
         a, b, c, d = (rms[f][j] for f in runs)
         print(
-            f"| {name} | {a:.4f} | {b:.4f} | {c:.4f} | {d:.4f} | {100 * (1 - b / a):.1f} "
-            f"| {100 * (1 - d / c):.1f} |"
+            f"| {name} | {warm:.1f} | {a:.4f} | {b:.4f} | {c:.4f} | {d:.4f} | "
+            f"{100 * (1 - b / a):.1f} | {100 * (1 - d / c):.1f} | {floor[j]:.4f} |"
         )
+    whole = {f: float(np.sqrt(np.mean(rms[f] ** 2))) for f in runs}
+    a, b, c, d = (whole[f] for f in runs)
+    print(
+        f"| whole log | | {a:.4f} | {b:.4f} | {c:.4f} | {d:.4f} | {100 * (1 - b / a):.1f} | "
+        f"{100 * (1 - d / c):.1f} | {np.sqrt(np.mean(floor**2)):.4f} |"
+    )
 
 
 def main() -> None:

@@ -17,8 +17,9 @@ motion is sampled (the controller's 500 Hz), the RTDE signals the UR5e doc works
 - ``actual_robot_voltage`` and ``actual_robot_current``: the arm's supply, the DC bus voltage
   (with ripple) and the current it draws for the bus model's power (:mod:`kinergy.drives.bus`:
   motors summed on the bus, surplus braking power to the shunt, plus standby);
-- ``joint_temperatures``: each joint warmed by its losses (:mod:`kinergy.drives.thermal`), when
-  the true robot has thermal models; temperature-dependent friction follows them;
+- ``joint_temperatures``: each joint warmed by its losses and its share of the arm's standby
+  power (:mod:`kinergy.drives.thermal`), when the true robot has thermal models;
+  temperature-dependent friction follows them;
 - ``robot_mode`` 7 (running) and ``runtime_state`` 2 (playing), as a program run logs them.
 
 The twin is not the model: :func:`realistic_truth` makes a true robot that differs from a model
@@ -145,7 +146,7 @@ def _warm_state(
     robot: Robot, real: Motion, settings: TwinSettings
 ) -> tuple[DriveState, Array | None]:
     """The drive state on the real motion and the joint temperatures (None without thermal
-    models): temperatures from the losses, friction at the temperatures, three times (the
+    models): temperatures from the losses (the standby power included), friction at the temperatures, three times (the
     thermal time constant is minutes, the coupling weak: the third pass moves them by < 0.01 K)."""
     if any(j.drive.thermal is None for j in robot.joints):
         return drive_state(robot, real.q, real.qd, real.qdd), None
@@ -155,7 +156,9 @@ def _warm_state(
     temperature = np.full(real.q.shape, start)
     for _ in range(3):
         state = drive_state(robot, real.q, real.qd, real.qdd, temperature=temperature)
-        losses = joint_losses(robot, state.current, state.tau_friction, state.wm)
+        losses = joint_losses(
+            robot, state.current, state.tau_friction, state.wm, standby=robot.standby_power
+        )
         temperature = joint_temperatures(
             robot, real.t, losses, ambient=settings.ambient, initial=start
         )

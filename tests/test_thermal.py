@@ -46,6 +46,28 @@ def test_losses_are_copper_and_friction_and_never_negative(ur5e: kinergy.Robot) 
     assert p[0, 1] == pytest.approx(r[1] * 4.0)  # friction driving the motion adds no heat
     assert p[0, 2] == pytest.approx(0.6)
     assert np.all(p >= 0)
+    # the arm's standby power heats its joints in equal shares
+    shared = joint_losses(ur5e, current, friction, wm, standby=30.0)
+    np.testing.assert_allclose(shared - p, 5.0)
+
+
+def test_a_still_twin_warms_by_its_standby_power(ur5e: kinergy.Robot) -> None:
+    truth = realistic_truth(ur5e, 2)
+    t = np.arange(0.0, 600.0, 0.5)
+    still = kinergy.Motion(t, np.zeros((t.size, 6)), np.zeros((t.size, 6)), np.zeros((t.size, 6)))
+    temps = simulate(truth, still, TwinSettings.exact())["joint_temperatures"]
+    models = [j.drive.thermal for j in truth.joints]
+    want = [
+        25.0
+        + m.resistance
+        * truth.standby_power
+        / 6
+        * (1 - np.exp(-t[-1] / (m.resistance * m.capacity)))
+        for m in models
+        if m is not None
+    ]
+    # copper losses holding the arm against gravity add a little: at least the standby share
+    assert np.all(temps[-1] >= np.array(want) - 1e-3)
 
 
 def test_a_robot_without_thermal_models_is_named(ur5e: kinergy.Robot) -> None:

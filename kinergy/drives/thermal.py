@@ -3,11 +3,14 @@
 Each joint is one heat capacity ``C`` (J/K) connected to the ambient air through one thermal
 resistance ``R_th`` (K/W) (:class:`kinergy.model.robot.Thermal`)::
 
-    C dT/dt = P_loss - (T - T_ambient) / R_th,        P_loss = R I^2 + tau_f wm
+    C dT/dt = P_loss - (T - T_ambient) / R_th,        P_loss = R I^2 + tau_f wm + P_standby / n
 
-heated by the copper loss of its motor (UR5e eq 21's ``R I^2``, the equivalent DC motor) and the
+heated by the copper loss of its motor (UR5e eq 21's ``R I^2``, the equivalent DC motor), the
 friction its drive dissipates (``tau_f wm``, motor side, >= 0 for friction that opposes the
-motion). Over a sample the losses are held; the step is then exact::
+motion) and its share of the arm's standby power: what the arm draws from its supply for its
+electronics and brakes (:mod:`kinergy.drives.bus`) is turned into heat in the arm, where each
+UR joint carries its own drive electronics and brake; the ``n`` joints take equal shares. Over a
+sample the losses are held; the step is then exact::
 
     T_k = T_amb + (T_{k-1} - T_amb) a + R_th P_{k-1} (1 - a),      a = exp(-dt / (R_th C))
 
@@ -47,8 +50,15 @@ def thermal_models(robot: Robot) -> list[Thermal]:
     return [j.drive.thermal for j in robot.joints if j.drive.thermal is not None]
 
 
-def joint_losses(robot: Robot, current: ArrayLike, tau_friction: ArrayLike, wm: ArrayLike) -> Array:
-    """Heat each joint's drive makes, ``R I^2 + tau_f wm`` (W), shape (N, n).
+def joint_losses(
+    robot: Robot,
+    current: ArrayLike,
+    tau_friction: ArrayLike,
+    wm: ArrayLike,
+    *,
+    standby: float = 0.0,
+) -> Array:
+    """Heat each joint makes, ``R I^2 + tau_f wm + standby / n`` (W), shape (N, n).
 
     Parameters
     ----------
@@ -57,10 +67,14 @@ def joint_losses(robot: Robot, current: ArrayLike, tau_friction: ArrayLike, wm: 
     tau_friction, wm : array_like, shape (N, n)
         Friction torque (N m) and speed (rad/s), motor side; friction that opposes the motion
         heats the joint, the product is clipped at 0.
+    standby : float
+        The arm's standby power, W (its electronics and brakes, ``Robot.standby_power``), shared
+        equally by the joints (module docstring); 0: the drives' losses alone.
     """
     i = np.asarray(current, dtype=float)
     friction = np.maximum(np.asarray(tau_friction, dtype=float) * np.asarray(wm, dtype=float), 0.0)
-    return np.asarray(winding_resistances(robot) * i**2 + friction, dtype=float)
+    heat = winding_resistances(robot) * i**2 + friction + standby / robot.n
+    return np.asarray(heat, dtype=float)
 
 
 def _step(t: Array, losses: Array, x0: float, capacity: float, resistance: float) -> Array:
