@@ -140,8 +140,9 @@ class _Signals:
             index = np.flatnonzero(keep)
             cut = (np.diff(index) > 1) | (np.diff(self.piece[keep]) != 0)
             piece = np.concatenate([[0], np.cumsum(cut)])
-        s = (self.tau_load, self.wm, self.dwm, self.current)
-        return _Signals(*(x[keep] for x in s), t, piece)
+        return _Signals(
+            self.tau_load[keep], self.wm[keep], self.dwm[keep], self.current[keep], t, piece
+        )
 
 
 @dataclass(frozen=True, eq=False)

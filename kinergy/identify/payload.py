@@ -169,7 +169,8 @@ def _disagreement(fits: list[tuple[Array, Array]]) -> tuple[tuple[str, ...], set
     by what angle about it they differ: equal distances at different angles, each well
     determined, is a payload that sat differently on the flange, not a poor motion.
     """
-    notes, axes = [], set()
+    notes: list[str] = []
+    axes: set[str] = set()
     for (i, (c1, s1)), (j, (c2, s2)) in itertools.combinations(enumerate(fits), 2):
         bad = [k for k in range(3) if abs(c1[k] - c2[k]) > 2.0 * np.hypot(s1[k], s2[k])]
         if not bad:
