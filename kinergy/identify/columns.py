@@ -162,6 +162,9 @@ class Stacked:
         Motor speeds (rad/s) and accelerations (rad/s^2).
     starts : ndarray of int
         Log boundaries in the samples.
+    temperature : ndarray, shape (N, n), or None
+        ``joint_temperatures`` (deg C) where every log has them, for temperature-dependent
+        friction; None: the models' reference temperature.
     """
 
     cols: Columns
@@ -177,6 +180,7 @@ class Stacked:
     wm: Array
     dwm: Array
     starts: NDArray[np.intp]
+    temperature: Array | None = None
 
     @property
     def a_flat(self) -> Array:
@@ -195,7 +199,12 @@ class Stacked:
 
     @property
     def needs_load(self) -> bool:
-        """Whether any friction model depends on the direction of power flow."""
+        """Whether any friction model takes the load torque (``needs_load`` in the registry)."""
+        return any(get_model(m).needs_load for m in self.models)
+
+    @property
+    def needs_flow(self) -> bool:
+        """Whether any friction model depends on the direction of power flow (``power_flow``)."""
         return any(m in LOAD_DEPENDENT for m in self.models)
 
 
@@ -222,10 +231,11 @@ def stack(
     motion: tuple[Array, Array, Array],
     y3: Array,
     lengths: Sequence[int],
+    temperature: Array | None = None,
 ) -> Stacked:
     """The link base and rotor columns of ``motion`` (q, qd, qdd, each (N, n)); the friction
     block is left to :func:`set_friction`. ``y3`` (N, n) is the target as joint torques, N m;
-    ``lengths`` the samples of each log."""
+    ``lengths`` the samples of each log; ``temperature`` (N, n) deg C or None."""
     q, qd, qdd = motion
     n, samples, n_link = robot.n, q.shape[0], cols.n_link
     n_mat = transmission_matrix(robot)
@@ -235,7 +245,7 @@ def stack(
     a[:, :, n_link : n_link + n] = rotor_columns(n_mat, dwm)
     tau_m = np.asarray(np.linalg.solve(n_mat.T, y3.T).T, dtype=float)
     starts = np.cumsum([0, *lengths])
-    return Stacked(cols, *frictions, n_mat, q, qd, qdd, a, y3, tau_m, wm, dwm, starts)
+    return Stacked(cols, *frictions, n_mat, q, qd, qdd, a, y3, tau_m, wm, dwm, starts, temperature)
 
 
 def set_friction(stacked: Stacked, load: Array) -> None:
@@ -245,7 +255,12 @@ def set_friction(stacked: Stacked, load: Array) -> None:
     Columns are built log by log (``stacked.starts`` bounds them) so friction held through
     standstill sees each log's samples in time order.
     """
-    n_mat, models, params = stacked.n_mat, stacked.models, stacked.params
+    n_mat, models, params, temps = (
+        stacked.n_mat,
+        stacked.models,
+        stacked.params,
+        stacked.temperature,
+    )
     col = stacked.n_fixed
     for m, model in enumerate(models):
         width = len(get_model(model).linear)
@@ -254,7 +269,12 @@ def set_friction(stacked: Stacked, load: Array) -> None:
         f = np.vstack(
             [
                 friction_columns(
-                    model, params[m], stacked.wm[a:b, m], load[a:b, m], stacked.dwm[a:b, m]
+                    model,
+                    params[m],
+                    stacked.wm[a:b, m],
+                    load[a:b, m],
+                    stacked.dwm[a:b, m],
+                    temperature=None if temps is None else temps[a:b, m],
                 )
                 for a, b in itertools.pairwise(stacked.starts)
             ]

@@ -342,7 +342,10 @@ def _stack(
     q, qd, qdd = (np.vstack([getattr(d, k) for d in datas]) for k in names)
     _diagnose(robot, qd, cols.prior.size)
     y3 = _target_torques(robot, datas, target)
-    return stack(robot, base, cols, frictions, (q, qd, qdd), y3, [len(d) for d in datas])
+    temps = [d.temperature for d in datas if d.temperature is not None]
+    temperature = np.vstack(temps) if len(temps) == len(datas) else None
+    lengths = [len(d) for d in datas]
+    return stack(robot, base, cols, frictions, (q, qd, qdd), y3, lengths, temperature)
 
 
 def _optional(value: float) -> float | None:

@@ -20,13 +20,21 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
-from kinergy.identify.columns import Columns, Stacked, power_flow_load, set_friction
+from kinergy.friction import get_model
+from kinergy.identify.columns import (
+    LOAD_DEPENDENT,
+    Columns,
+    Stacked,
+    power_flow_load,
+    set_friction,
+)
 from kinergy.linalg import Reduced, ReducedSolution, pivoted_rank, reduce, solve_reduced
 from kinergy.model.robot import Robot
 from kinergy.predict import drive_state
 
 __all__ = [
     "DEPENDENT_TOL",
+    "LOAD_RTOL",
     "MAX_CONDITION",
     "MAX_FLOW_ITERATIONS",
     "FlowFit",
@@ -52,6 +60,9 @@ MAX_CONDITION = 1e10
 DEPENDENT_TOL = 1e-8
 #: passes of the power-flow fixed point
 MAX_FLOW_ITERATIONS = 10
+#: relative change of a load-proportional friction's load torque between passes that counts as
+#: settled
+LOAD_RTOL = 1e-10
 
 
 # ---------------------------------------------------------------------------------------------
@@ -156,20 +167,47 @@ def _own_load(stacked: Stacked, x: Array) -> Array:
 
 
 def _initial_load(robot: Robot, stacked: Stacked) -> Array:
-    """The measurement less the model's friction (power-flow directions from the model's own
-    load torque where the measurement is ambiguous); zeros without power-flow friction."""
+    """The load torques the friction columns start from (motor side, (N, n)): the model's own
+    for load-dependent friction (``load_coulomb``, ``load_thermal_power_law``: the load is the
+    link side's, which friction does not change), and for ``power_flow`` the measurement less the
+    model's friction (directions from the model's own load where the measurement is ambiguous);
+    zeros where no model takes a load."""
     if not stacked.needs_load:
         return np.zeros_like(stacked.q)
     predicted = np.asarray(drive_state(robot, stacked.q, stacked.qd, stacked.qdd).tau_load)
+    if not stacked.needs_flow:
+        return predicted
     cols = stacked.cols
     values = [cols.friction(cols.prior, m) for m in range(robot.n)]
     return power_flow_load(stacked, values, predicted)
 
 
+def _next_load(stacked: Stacked, x: Array, load: Array) -> tuple[Array, bool]:
+    """The loads for the next pass after a fit with unknowns ``x``, and whether they settled:
+    ``power_flow`` directions from the measurement less the fitted friction
+    (:func:`kinergy.identify.columns.power_flow_load`; settled when no direction changes), the
+    other load-dependent models the fitted model's own load torque (settled when it moves by less
+    than :data:`LOAD_RTOL` of its largest value)."""
+    values = [stacked.cols.friction(x, m) for m in range(len(stacked.models))]
+    new = power_flow_load(stacked, values, load) if stacked.needs_flow else load.copy()
+    wm = stacked.wm
+    settled = bool(np.array_equal(np.sign(wm * new), np.sign(wm * load)))
+    own_models = [m for m, name in enumerate(stacked.models) if name not in LOAD_DEPENDENT]
+    own_models = [m for m in own_models if get_model(stacked.models[m]).needs_load]
+    if own_models:
+        own = _own_load(stacked, x)[:, own_models]
+        moved = float(np.max(np.abs(own - load[:, own_models])))
+        settled &= moved <= LOAD_RTOL * max(float(np.max(np.abs(own))), 1e-300)
+        new[:, own_models] = own
+    return new, settled
+
+
 def fit_power_flow(robot: Robot, stacked: Stacked, expressions: list[str]) -> FlowFit:
-    """OLS, with ``power_flow`` friction's directions taken from the measurement less the fitted
-    friction (:func:`kinergy.identify.columns.power_flow_load`) until they settle (at most
-    :data:`MAX_FLOW_ITERATIONS` passes). ``stacked``'s friction block is left at the load used."""
+    """OLS with the friction's load torques settled (at most :data:`MAX_FLOW_ITERATIONS`
+    passes, :func:`_next_load`): ``power_flow`` directions from the measurement less the fitted
+    friction, load-proportional friction (``load_coulomb``, ``load_thermal_power_law``) from the
+    fitted model's own load torque, a fixed point that converges because friction is a few
+    per cent of the load. ``stacked``'s friction block is left at the load used."""
     load = _initial_load(robot, stacked)
     iterations, settled = 0, not stacked.needs_load
     while True:
@@ -178,17 +216,15 @@ def fit_power_flow(robot: Robot, stacked: Stacked, expressions: list[str]) -> Fl
         fit = fit_ols(stacked, expressions, iterations == 1)
         if settled or iterations >= MAX_FLOW_ITERATIONS:
             break
-        values = [stacked.cols.friction(fit.x, m) for m in range(robot.n)]
-        new = power_flow_load(stacked, values, load)
-        wm = stacked.wm
-        settled = bool(np.array_equal(np.sign(wm * new), np.sign(wm * load)))
+        new, settled = _next_load(stacked, fit.x, load)
         if settled:
             break
         load = new
     mismatch = 0
-    if stacked.needs_load:  # how often the fitted model's own load torque disagrees
-        own = _own_load(stacked, fit.x)
-        mismatch = int(np.sum(np.sign(stacked.wm * own) != np.sign(stacked.wm * load)))
+    if stacked.needs_flow:  # how often the fitted model's own load torque disagrees
+        flow = [m in LOAD_DEPENDENT for m in stacked.models]
+        own, wm = _own_load(stacked, fit.x)[:, flow], stacked.wm[:, flow]
+        mismatch = int(np.sum(np.sign(wm * own) != np.sign(wm * load[:, flow])))
     return FlowFit(fit, load, iterations if stacked.needs_load else 0, settled, mismatch)
 
 
