@@ -49,7 +49,7 @@ from kinergy.trajectory.programs import paper_trajectory
 from kinergy.workflows.calibration import import_calibration
 from kinergy.workflows.energy import energy_of_log
 from kinergy.workflows.excite import ExciteOptions, run_excite
-from kinergy.workflows.identify import run_method
+from kinergy.workflows.identify import identify_model
 
 DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "datasets"
 if not DATA.exists():
@@ -147,7 +147,7 @@ def ur10e() -> None:
     rms = {}
     for friction in ("viscous_coulomb", "auto"):
         t0 = time.perf_counter()
-        result = run_method(model, logs, friction=friction)
+        result = identify_model(model, logs, friction=friction)
         rms[friction] = _current_rms(result.robot, held)
         print(f"{friction}: identified from {len(logs)} logs in {time.perf_counter() - t0:.1f} s")
         if friction == "auto":
@@ -314,7 +314,7 @@ def _identify_excitation(truth: Robot, motion: Motion, path: Path, *, table: boo
     model = kinergy.load_robot("ur5e")
     data = _twin_log(truth, motion, SEED, path)
     t0 = time.perf_counter()
-    result = run_method(model, [data], friction="auto")
+    result = identify_model(model, [data], friction="auto")
     print(f"sequential + electrics identified in {time.perf_counter() - t0:.1f} s")
     worst = _drive_table(truth, result, data)
     print(f"worst drive-parameter error {worst:.2f} % (bar 5 %)")
@@ -393,7 +393,7 @@ def warmup(folder: Path, minutes: float = 60.0) -> None:
     # Coulomb + viscous with and without its temperature term (the one difference), and the
     # power law without, and with the load and temperature terms
     runs = ("viscous_coulomb", "thermal_viscous", "power_law", "load_thermal_power_law")
-    rms = {f: _current_rms(run_method(model, [ident], friction=f).robot, held) for f in runs}
+    rms = {f: _current_rms(identify_model(model, [ident], friction=f).robot, held) for f in runs}
     floor = _current_rms(truth, held)  # the truth itself: the current noise and quantisation
     print(
         "| joint | warms by [K] | "

@@ -4,7 +4,11 @@ For every program: the supply energy (model-predicted: motor electrical energy s
 bus, braking surplus lost, no standby) of the program as written, after each lever in turn (2 pi
 wraps, IK configurations, tool symmetry, via-point blends, timing), and of re-timing alone, all
 re-simulated at 500 Hz at the program's own cycle time; the optimised program written as URScript,
-read back and simulated again; limits and targets checked. Run::
+read back and simulated again; limits and targets checked. Where the energy goes after
+optimisation (per joint: friction, copper) and what no lever touches
+(:func:`kinergy.optimize.program_floor.energy_floor`: the friction floor of the optimised joint
+path at one constant speed over the moving time, plus the copper loss of holding the arm against
+gravity): ``ceiling`` is one minus that over the program's figure. Run::
 
     PYTHONPATH=. python benchmarks/bench_programs.py [--json OUT.json] [NAME ...]
 """
@@ -20,6 +24,7 @@ from pathlib import Path
 from kinergy.io.urscript import program_script
 from kinergy.io.urscript_reader import parse_program, read_program
 from kinergy.model.library import load_robot
+from kinergy.optimize.program_floor import energy_floor
 from kinergy.optimize.program_verify import simulate_path
 from kinergy.optimize.programs import optimize_program
 from kinergy.trajectory.program_path import program_path
@@ -71,8 +76,29 @@ def run(name: str) -> dict[str, object]:
         "within_limits": result.optimized.result.ok,
         "targets_met": result.targets_met,
         "seconds": seconds,
+        "floor_program": energy_floor(robot, result.program).to_dict(),
+        "floor_optimized": energy_floor(robot, result.optimized).to_dict(),
     }
+    out["ceiling"] = 1.0 - out["floor_optimized"]["untouched"] / own
     return out
+
+
+def _print_floor(row: dict) -> None:
+    """Per joint, as written and optimised: path, friction, copper; the floor and the ceiling."""
+    for tag in ("program", "optimized"):
+        f = row[f"floor_{tag}"]
+        fmt = lambda xs: " ".join(f"{x:6.1f}" for x in xs)  # noqa: E731
+        print(f"    {tag:9s} path rad  {fmt(f['path_length'])}")
+        print(
+            f"    {'':9s} friction  {fmt(f['parts']['friction'])}  floor {fmt(f['friction_floor'])}"
+        )
+        print(
+            f"    {'':9s} copper    {fmt(f['parts']['copper'])}  holding {f['holding_copper']:.1f} J"
+        )
+    print(
+        f"    untouched by any lever {row['floor_optimized']['untouched']:.1f} J: ceiling "
+        f"{100 * row['ceiling']:.1f} % saving"
+    )
 
 
 def main() -> None:
@@ -93,8 +119,11 @@ def main() -> None:
         )
         for lever, e, kept, ok in row["levers"]:
             print(f"    {lever:15s} {e:8.1f} J  kept {kept}  within limits {ok}")
+        _print_floor(row)
     mean = sum(r["saving"] for r in rows) / len(rows)
     print(f"mean saving {100 * mean:.1f} % over {len(rows)} programs")
+    ceiling = sum(r["ceiling"] for r in rows) / len(rows)
+    print(f"mean ceiling {100 * ceiling:.1f} % (friction floor + holding copper untouched)")
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
 

@@ -29,12 +29,14 @@ __all__ = [
     "MARKER",
     "MAX_TOML_BYTES",
     "Terminated",
+    "all_or_none",
     "atomic_folder",
     "atomic_write",
     "check_folder",
     "check_output",
     "check_outputs",
     "output_folder",
+    "read_text",
     "read_toml",
     "terminate_on_signals",
 ]
@@ -267,29 +269,63 @@ def output_folder(path: PathLike | None, *, prefix: str) -> Iterator[tuple[Path,
         raise
 
 
+@contextlib.contextmanager
+def all_or_none() -> Iterator[list[Path]]:
+    """Outputs written together: append each path written to the list this yields; should
+    anything fail (or the run be stopped) before the block ends, every path on it is removed, so
+    no partial set of outputs is left behind."""
+    written: list[Path] = []
+    try:
+        yield written
+    except BaseException:
+        for path in written:
+            path.unlink(missing_ok=True)
+        raise
+
+
+def read_text(path: PathLike, what: str, *, max_bytes: int | None = None) -> str:
+    """The text of a UTF-8 file; ``what`` names the kind of file in messages ("robot file").
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    what : str
+        The kind of file, as messages name it.
+    max_bytes : int, optional
+        A larger file is refused before it is read.
+
+    Raises
+    ------
+    KinergyError
+        ``PATH: cannot read WHAT (reason)``, ``PATH: not a text (UTF-8) file``, or
+        ``PATH: S MB is too large for a WHAT (at most M MiB)``.
+    """
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+        if max_bytes is not None and size > max_bytes:
+            raise KinergyError(
+                f"{path}: {size / 1e6:.1f} MB is too large for a {what} "
+                f"(at most {max_bytes // (1024 * 1024)} MiB)"
+            )
+        return path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise KinergyError(f"{path}: cannot read {what} ({exc.strerror})") from None
+    except UnicodeDecodeError:
+        raise KinergyError(f"{path}: not a text (UTF-8) file") from None
+
+
 def read_toml(path: PathLike, what: str) -> dict[str, Any]:
     """Parse a TOML file; ``what`` names the kind of file in messages ("robot file").
 
     Raises
     ------
     KinergyError
-        ``PATH: cannot read WHAT (reason)``, ``PATH: not a text (UTF-8) file``,
-        ``PATH: not valid TOML: ... (line L column C)``, a file over :data:`MAX_TOML_BYTES`, or
-        nesting too deep to be a robot or task file.
+        The messages of :func:`read_text` (with at most :data:`MAX_TOML_BYTES`),
+        ``PATH: not valid TOML: ... (line L column C)``, or nesting too deep to be a robot or
+        task file.
     """
-    path = Path(path)
-    try:
-        size = path.stat().st_size
-        if size > MAX_TOML_BYTES:
-            raise KinergyError(
-                f"{path}: {size / 1e6:.1f} MB is too large for a {what} "
-                f"(at most {MAX_TOML_BYTES // (1024 * 1024)} MiB)"
-            )
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise KinergyError(f"{path}: cannot read {what} ({exc.strerror})") from None
-    except UnicodeDecodeError:
-        raise KinergyError(f"{path}: not a text (UTF-8) file") from None
+    text = read_text(path, what, max_bytes=MAX_TOML_BYTES)
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

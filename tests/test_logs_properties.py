@@ -97,7 +97,9 @@ def tables(
     n_cols = sum(max(w, 1) for _, w in layout)
     fmt = draw(st.sampled_from(FORMATS))
     t0 = draw(st.floats(-10.0, 1000.0))
-    steps = draw(st.lists(st.floats(1e-3, 1.0), min_size=n_rows - 1, max_size=n_rows - 1))
+    # periods up to 0.5 s: a step of 1 s, printed and read back a hair above 1, is refused as
+    # ambiguous (1 Hz in s or 1 kHz in ms, kinergy.io.log.time_unit) by design
+    steps = draw(st.lists(st.floats(1e-3, 0.5), min_size=n_rows - 1, max_size=n_rows - 1))
     t = [fmt.format(float(x)) for x in t0 + np.concatenate([[0.0], np.cumsum(steps)])]
     parsed = [float(x) for x in t]
     assume(all(b > a for a, b in itertools.pairwise(parsed)))

@@ -14,7 +14,7 @@ from kinergy.identify.preprocess import prepare
 from kinergy.io.rtde import read_log, write_log
 from kinergy.simulate import TwinSettings, realistic_truth, simulate
 from kinergy.trajectory.fourier import fourier_motion
-from kinergy.workflows.identify import run_method
+from kinergy.workflows.identify import identify_model
 
 
 def test_the_truth_is_seeded_and_differs_from_the_model_within_its_spreads(
@@ -73,7 +73,7 @@ def test_identification_recovers_the_truth_not_the_model(
     ur5e: kinergy.Robot, twin_log: tuple[Path, kinergy.Robot]
 ) -> None:
     path, truth = twin_log
-    result = run_method(ur5e, [prepare(read_log(path), 6)], friction="auto")
+    result = identify_model(ur5e, [prepare(read_log(path), 6)], friction="auto")
     got, want = result.robot, truth
     for gj, tj in zip(got.joints, want.joints, strict=True):
         assert gj.drive.torque_constant == pytest.approx(tj.drive.torque_constant, rel=0.05)

@@ -100,3 +100,30 @@ def test_cycle_time_too_short_names_a_line(tmp_path: Path) -> None:
     message = str(result.exception)
     assert "\n" not in message
     assert "small.script" in message and "shorter than the fastest possible" in message
+
+
+def test_refined_turns_keep_the_own_state_and_wrap() -> None:
+    from kinergy.optimize.path_costs import refined_turns
+
+    turns = refined_turns(np.array([0.0, 6.2]), np.deg2rad(15.0))
+    assert turns[0].size == 5 and turns[0][0] == 0.0
+    assert turns[1].size == 6 and np.all((turns[1] >= 0.0) & (turns[1] < 2.0 * np.pi))
+    assert np.allclose(np.sort(np.mod(turns[1][1:] - 6.2 + np.pi, 2 * np.pi) - np.pi)[2], 0.0)
+
+
+def test_energy_floor_is_below_the_friction_of_the_program() -> None:
+    from kinergy.io.urscript_reader import parse_program
+    from kinergy.optimize.program_floor import energy_floor
+    from kinergy.optimize.program_verify import simulate_path
+    from kinergy.trajectory.program_path import program_path
+
+    robot = load_robot("ur5e")
+    run = simulate_path(robot, program_path(robot, parse_program(SMALL, path="small.script")))
+    floor = energy_floor(robot, run)
+    friction = floor.parts["friction"]
+    moving = floor.path_length > 0.0
+    assert np.all(floor.friction_floor[moving] > 0.0)
+    assert np.all(floor.friction_floor <= friction + 1e-9)
+    for key, part in floor.parts.items():  # the same parts as the re-simulation's breakdown
+        assert part.sum() == pytest.approx(run.result.breakdown[key], rel=1e-3, abs=1e-3)
+    assert 0.0 < floor.untouched < run.result.e_elec

@@ -25,10 +25,12 @@ __all__ = [
     "fmt_vector",
     "load",
     "note",
+    "output_file_option",
     "payload_option",
     "print_tables",
     "progress",
     "repair_option",
+    "report_folder_option",
     "seed_option",
     "table",
     "writes",
@@ -64,8 +66,41 @@ def load(robot_name: str, payload: str | None) -> Robot:
 payload_option = click.option(
     "--payload",
     metavar="MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]",
-    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2.",
+    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2 about its "
+    "centre of mass.",
 )
+
+
+def output_file_option(
+    flag: str,
+    help: str,
+    *,
+    dest: str | None = None,
+    metavar: str | None = None,
+    required: bool = False,
+) -> Callable[[F], F]:
+    """An option naming a file the command writes (``--out``, ``--urscript``): a path that is
+    not a folder, None when not given, passed as ``dest`` (default: the flag's name); list it in
+    :func:`writes` ``files`` too."""
+    names = (flag,) if dest is None else (flag, dest)
+    return click.option(
+        *names, type=click.Path(dir_okay=False), metavar=metavar, required=required, help=help
+    )
+
+
+def report_folder_option(contents: str = "the figures") -> Callable[[F], F]:
+    """``--out FOLDER`` of a command that writes ``contents`` and a report.html there
+    (:func:`kinergy.files.output_folder`: a new temporary folder when not given)."""
+    return click.option(
+        "--out",
+        "out",
+        type=click.Path(file_okay=False),
+        default=None,
+        help=f"Folder for {contents} and report.html [a new folder in the system's temporary "
+        "folder; its path is printed].",
+    )
+
+
 columns_option = click.option(
     "--columns",
     metavar="SPEC",

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from kinergy.cli.common import print_tables, progress, writes
+from kinergy.cli.common import print_tables, progress, report_folder_option, writes
 from kinergy.simulate import MISMATCHES
 from kinergy.workflows.demo import run_demo
 
@@ -14,14 +14,7 @@ __all__ = ["demo"]
 
 
 @click.command()
-@click.option(
-    "--out",
-    "out",
-    type=click.Path(file_okay=False),
-    default=None,
-    help="Folder for the logs, figures and report.html [a new folder in the system's temporary "
-    "folder; its path is printed].",
-)
+@report_folder_option("the logs, figures")
 @click.option(
     "--mismatch",
     type=click.Choice(MISMATCHES),

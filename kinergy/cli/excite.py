@@ -18,7 +18,7 @@ from typing import Any
 import click
 import numpy as np
 
-from kinergy.cli.common import progress, seed_option, writes
+from kinergy.cli.common import output_file_option, progress, seed_option, writes
 from kinergy.errors import KinergyError
 from kinergy.experiments.excitation_regression import CRITERIA
 from kinergy.jsonable import dumps
@@ -158,22 +158,13 @@ def excite_text(run: ExciteRun) -> str:
     show_default=True,
     help="Periods written to the motion file (repeats help identification: cycle averaging).",
 )
-@click.option(
-    "--out",
-    "out",
-    required=True,
-    type=click.Path(dir_okay=False),
-    metavar="MOTION.csv",
-    help="Motion file to write (record.py layout, 500 Hz).",
+@output_file_option(
+    "--out", "Motion file to write (record.py layout, 500 Hz).", metavar="MOTION.csv", required=True
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
-@click.option(
+@output_file_option(
     "--urscript",
-    "urscript",
-    type=click.Path(dir_okay=False),
-    default=None,
-    metavar="FILE",
-    help="Also write a URScript program that runs the motion (movej to the start, servoj at 500 Hz).",
+    "Also write a URScript program that runs the motion (movej to the start, servoj at 500 Hz).",
 )
 @click.option(
     "--criterion",

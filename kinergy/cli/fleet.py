@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import note, progress, table
+from kinergy.cli.common import note, output_file_option, progress, table
 from kinergy.fleet.analysis import LogResult
 from kinergy.jsonable import dumps
 from kinergy.workflows.fleet import fleet_energy
@@ -20,7 +20,7 @@ def fleet() -> None:
 @fleet.command("energy")
 @click.argument("logs", nargs=-1, metavar="LOGS...", type=click.Path(dir_okay=False))
 @click.option("--manifest", required=True, type=click.Path(dir_okay=False), help="FLEET.toml.")
-@click.option("--out", required=True, type=click.Path(dir_okay=False), help="FLEET.parquet.")
+@output_file_option("--out", "FLEET.parquet.", required=True)
 @click.option("--report", type=click.Path(file_okay=False), help="Write the HTML report here.")
 @click.option("--scheduler", metavar="ADDRESS", help="A Dask scheduler (default: a local cluster).")
 @click.option("--workers", type=int, help="Local cluster worker processes [one per core].")

@@ -7,6 +7,7 @@ import click
 from kinergy.cli.common import (
     columns_option,
     note,
+    output_file_option,
     progress,
     repair_option,
     table,
@@ -156,13 +157,7 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     show_default=True,
     help="sequential: the UR5e doc's procedure; full: base-parameter regression.",
 )
-@click.option(
-    "--out",
-    "out",
-    required=True,
-    type=click.Path(dir_okay=False),
-    help="Model file to write (TOML).",
-)
+@output_file_option("--out", "Model file to write (TOML).", required=True)
 @columns_option
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (DESIGN.md shape).")
 @click.option(

@@ -10,7 +10,7 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from kinergy.cli.common import progress, seed_option, table, writes
+from kinergy.cli.common import output_file_option, progress, seed_option, table, writes
 from kinergy.files import atomic_write
 from kinergy.jsonable import dumps
 from kinergy.model import load_robot
@@ -125,13 +125,8 @@ def study_text(study: NursingStudy) -> str:
     help="The twin's default lag and noise, or exact signals.",
 )
 @seed_option
-@click.option(
-    "--out",
-    "out",
-    type=click.Path(dir_okay=False),
-    default=None,
-    metavar="STUDY.json",
-    help="Also write the study (the --json output) to this file.",
+@output_file_option(
+    "--out", "Also write the study (the --json output) to this file.", metavar="STUDY.json"
 )
 @writes(files=("out",), inputs=("robot_name",))
 def nursing(robot_name: str, as_json: bool, noise: bool, seed: int, out: str | None) -> None:

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import click
 
-from kinergy.cli.common import load, payload_option, progress, table, writes
+from kinergy.cli.common import load, output_file_option, payload_option, progress, table, writes
 from kinergy.errors import KinergyError
 from kinergy.jsonable import dumps
 from kinergy.optimize import ParetoPoint, ProgramResult, TimingResult
@@ -210,20 +210,11 @@ def program_text(run: ProgramRun) -> str:
     help="Cycle-time budget; 'same': the program's own.",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
-@click.option(
-    "--urscript",
-    "urscript",
-    type=click.Path(dir_okay=False),
-    default=None,
-    help="Write the optimised program as URScript (movej per move) to this file.",
+@output_file_option(
+    "--urscript", "Write the optimised program as URScript (movej per move) to this file."
 )
-@click.option(
-    "--plot",
-    "plot",
-    type=click.Path(dir_okay=False),
-    default=None,
-    metavar="FILE.png",
-    help="Write the Pareto plot (energy against cycle time) to this PNG.",
+@output_file_option(
+    "--plot", "Write the Pareto plot (energy against cycle time) to this PNG.", metavar="FILE.png"
 )
 @payload_option
 @click.option(

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import progress, writes
+from kinergy.cli.common import output_file_option, progress, writes
 from kinergy.workflows.record import record_to_file
 
 __all__ = ["record"]
@@ -12,7 +12,7 @@ __all__ = ["record"]
 
 @click.command()
 @click.argument("address", metavar="HOST[:PORT]")
-@click.option("--out", required=True, type=click.Path(dir_okay=False), help="Log file to write.")
+@output_file_option("--out", "Log file to write.", required=True)
 @click.option(
     "--frequency", type=float, default=500.0, show_default=True, help="Packages per second, Hz."
 )

@@ -12,6 +12,7 @@ from kinergy.cli.common import (
     print_tables,
     progress,
     repair_option,
+    report_folder_option,
     writes,
 )
 from kinergy.errors import KinergyError
@@ -43,14 +44,7 @@ __all__ = ["report"]
     metavar="LOG_OR_MOTION",
     help="Account the energy of this log's or motion file's motion (repeatable).",
 )
-@click.option(
-    "--out",
-    "out",
-    type=click.Path(file_okay=False),
-    default=None,
-    help="Folder for the figures and report.html [a new folder in the system's temporary "
-    "folder; its path is printed].",
-)
+@report_folder_option()
 @columns_option
 @payload_option
 @repair_option

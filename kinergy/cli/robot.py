@@ -9,7 +9,7 @@ from collections.abc import Sequence
 import click
 import numpy as np
 
-from kinergy.cli.common import fmt, fmt_vector, load, table
+from kinergy.cli.common import fmt, fmt_vector, load, output_file_option, payload_option, table
 from kinergy.files import check_outputs
 from kinergy.jsonable import dumps
 from kinergy.model import SOURCE_CATEGORIES, Robot, library_names, load_robot, robot_to_dict
@@ -186,11 +186,7 @@ def show_text(r: Robot) -> str:
 @robot.command("show")
 @click.argument("robot_name", metavar="ROBOT")
 @click.option("--json", "as_json", is_flag=True, help="Print the model as JSON (DESIGN.md shape).")
-@click.option(
-    "--payload",
-    metavar="MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]",
-    help="Payload at the flange: kg, m (flange frame), kg m^2 about its centre of mass.",
-)
+@payload_option
 def robot_show(robot_name: str, as_json: bool, payload: str | None) -> None:
     """Show a robot model: a built-in name (ur5e) or a robot file (.toml, .urdf)."""
     r = load(robot_name, payload)
@@ -259,9 +255,7 @@ def _calibration_text(result: CalibrationImport, out: str, points: bool) -> str:
 @robot.command("import-calibration")
 @click.argument("robot_name", metavar="ROBOT")
 @click.argument("calibration", metavar="CALIBRATION.txt", type=click.Path(dir_okay=False))
-@click.option(
-    "--out", "out", required=True, type=click.Path(dir_okay=False), help="Robot file to write."
-)
+@output_file_option("--out", "Robot file to write.", required=True)
 @click.option(
     "--friction",
     default="auto",

@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import columns_option, load, payload_option, seed_option, writes
+from kinergy.cli.common import (
+    columns_option,
+    load,
+    output_file_option,
+    payload_option,
+    seed_option,
+    writes,
+)
 from kinergy.simulate import MISMATCHES, TwinSettings
 from kinergy.workflows.twin import simulate_to_file
 
@@ -19,7 +26,7 @@ __all__ = ["simulate"]
     metavar="test-a|test-b|FILE",
     help="The UR5e doc's test programs, or a motion file (record.py layout with target_q).",
 )
-@click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Log to write.")
+@output_file_option("--out", "Log to write.", required=True)
 @click.option(
     "--mismatch",
     type=click.Choice(MISMATCHES),
@@ -29,12 +36,10 @@ __all__ = ["simulate"]
     "(inertias, k_t, electrics, concave load- and temperature-dependent friction) with a real "
     "controller's current steps, voltage noise and supply ripple.",
 )
-@click.option(
+@output_file_option(
     "--truth",
-    "truth_out",
-    type=click.Path(dir_okay=False),
-    default=None,
-    help="Write the twin's true robot file here (with --mismatch realistic).",
+    "Write the twin's true robot file here (with --mismatch realistic).",
+    dest="truth_out",
 )
 @click.option("--exact", is_flag=True, help="No lag and no noise: the model's equations exactly.")
 @click.option(

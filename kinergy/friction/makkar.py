@@ -16,6 +16,8 @@ from kinergy.friction.model import FrictionModel
 
 Array = NDArray[np.float64]
 
+__all__ = ["MODEL", "PARAMETERS", "makkar", "makkar_columns"]
+
 PARAMETERS = tuple(f"gamma{k}" for k in range(1, 7))
 
 
@@ -24,6 +26,29 @@ def makkar(gamma: Sequence[float] | ArrayLike, speed: ArrayLike) -> Array:
     g1, g2, g3, g4, g5, g6 = (float(g) for g in np.asarray(gamma, dtype=float))
     v = np.asarray(speed, dtype=float)
     return g1 * (np.tanh(g2 * v) - np.tanh(g3 * v)) + g4 * np.tanh(g5 * v) + g6 * v
+
+
+def makkar_columns(rates: ArrayLike, speed: ArrayLike) -> Array:
+    """Nursing eq 13's columns for its gains ``gamma1, gamma4, gamma6``, one set per row of rates.
+
+    Parameters
+    ----------
+    rates : array_like, shape (3,) or (P, 3)
+        ``gamma2, gamma3, gamma5``, s/rad.
+    speed : array_like, shape (M,)
+        rad/s.
+
+    Returns
+    -------
+    ndarray, shape (M, 3) or (P, M, 3)
+        ``[tanh(gamma2 v) - tanh(gamma3 v), tanh(gamma5 v), v]``: the curve is this times
+        ``[gamma1, gamma4, gamma6]``.
+    """
+    r = np.asarray(rates, dtype=float)
+    v = np.asarray(speed, dtype=float)
+    g2, g3, g5 = (r[..., k, None] for k in range(3))
+    hump = np.tanh(g2 * v) - np.tanh(g3 * v)
+    return np.stack([hump, np.tanh(g5 * v), np.broadcast_to(v, hump.shape)], axis=-1)
 
 
 def _torque(
@@ -35,9 +60,7 @@ def _torque(
 def _columns(
     p: Mapping[str, float], wm: Array, tau_load: Array | None, temperature: Array | None
 ) -> Array:
-    return np.column_stack(
-        [np.tanh(p["gamma2"] * wm) - np.tanh(p["gamma3"] * wm), np.tanh(p["gamma5"] * wm), wm]
-    )
+    return makkar_columns([p["gamma2"], p["gamma3"], p["gamma5"]], wm)
 
 
 MODEL = FrictionModel(

@@ -95,8 +95,8 @@ from kinergy.identify.result import (
     DriveEstimate,
     Fit,
     IdentificationResult,
-    friction_entry,
-    validation_metrics,
+    drive_fields,
+    fit_fields,
 )
 from kinergy.identify.sequential import DrivesFromCurrents, drives_from_currents
 from kinergy.identify.writeback import WriteBack, write_back
@@ -402,17 +402,13 @@ def _joints(
         if drives is not None:
             flags = {"rotor_inertia": flags["rotor_inertia"], **drives.flags[m]}
             std = {"rotor_inertia": std["rotor_inertia"], **drives.std[m]}
-        friction = friction_entry(joint)
-        names = get_model(friction["model"]).linear
+        fields = drive_fields(joint, rotor_inertia=float(written.x[col]))
+        names = get_model(fields["friction"]["model"]).linear
         out.append(
             FullJoint(
-                name=joint.name,
-                rotor_inertia=float(written.x[col]),
+                **fields,
                 rotor_inertia_std=std["rotor_inertia"],
                 rotor_inertia_merged=bool(col in solved.dropped),
-                motor_inertia=joint.drive.motor_inertia,
-                torque_constant=joint.drive.torque_constant,
-                friction=friction,
                 flags=flags,
                 std=std,
                 friction_std={name: std.get(name) for name in names},
@@ -470,11 +466,12 @@ def _fit(
     weighted = solved.weights is not None
     b = cols.n_link
     return FullFit(
-        **vars(validation_metrics(steps.robot, datas)),
-        samples=int(y3.shape[0]),
-        logs=tuple(d.path for d in datas),
-        lag=tuple(d.lag for d in datas),
-        warnings=(*warnings, *steps.merging.warnings, *written.warnings),
+        **fit_fields(
+            steps.robot,
+            datas,
+            (*warnings, *steps.merging.warnings, *written.warnings),
+            samples=int(y3.shape[0]),
+        ),
         target=target,
         solver=solver,
         ridge=float(ridge),

@@ -24,7 +24,7 @@ from scipy.ndimage import minimum_filter
 
 from kinergy.errors import KinergyError
 from kinergy.friction.makkar import PARAMETERS as _MAKKAR
-from kinergy.friction.makkar import makkar
+from kinergy.friction.makkar import makkar, makkar_columns
 from kinergy.friction.registry import get_model
 from kinergy.identify.metrics import r_squared, rmse
 from kinergy.identify.pso import SwarmResult, particle_swarm
@@ -113,14 +113,7 @@ def _gains(rates: Array, v: Array, f: Array, positive: bool = True) -> tuple[Arr
     """Variable projection: the best ``gamma1, gamma4, gamma6`` for each row of ``rates`` (P, 3) =
     ``(gamma2, gamma3, gamma5)`` by linear least squares (non-negative with ``positive``), and the
     mean squared error (P,)."""
-    cols = np.stack(
-        [
-            np.tanh(rates[:, 0:1] * v) - np.tanh(rates[:, 1:2] * v),
-            np.tanh(rates[:, 2:3] * v),
-            np.broadcast_to(v, (rates.shape[0], v.size)),
-        ],
-        axis=2,
-    )  # (P, M, 3)
+    cols = makkar_columns(rates, v)  # (P, M, 3)
     scale = np.sqrt(np.einsum("pmk,pmk->pk", cols, cols)) + 1e-300
     cs = cols / scale[:, None, :]
     if positive:

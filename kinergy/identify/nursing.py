@@ -59,8 +59,8 @@ from kinergy.identify.result import (
     DriveEstimate,
     Fit,
     IdentificationResult,
-    friction_entry,
-    validation_metrics,
+    drive_fields,
+    fit_fields,
 )
 from kinergy.identify.ridge import RidgeFit, ridge_minimal
 from kinergy.jsonable import OPTIONAL
@@ -457,14 +457,7 @@ def _sources(robot: Robot, friction: bool, links: bool) -> Robot:
 
 def _drive_estimates(robot: Robot, identified: set[int]) -> tuple[NursingJoint, ...]:
     return tuple(
-        NursingJoint(
-            name=jt.name,
-            rotor_inertia=jt.drive.rotor_inertia,
-            motor_inertia=jt.drive.motor_inertia,
-            torque_constant=jt.drive.torque_constant,
-            friction=friction_entry(jt),
-            identified=m in identified,
-        )
+        NursingJoint(**drive_fields(jt), identified=m in identified)
         for m, jt in enumerate(robot.joints)
     )
 
@@ -542,11 +535,7 @@ def identify_nursing(
     links = kept is not None and len(kept) < robot.n
     identified = _sources(identified, friction=bool(new_friction), links=links)
     fit_out = NursingFit(
-        **vars(validation_metrics(identified, datas)),
-        samples=int(sum(len(d) for d in datas)),
-        logs=tuple(d.path for d in datas),
-        lag=tuple(d.lag for d in datas),
-        warnings=tuple(warnings),
+        **fit_fields(identified, datas, warnings),
         friction_runs=tuple(joint_fits),
         friction_motors=tuple(motor_fits),
         ridge=summary,

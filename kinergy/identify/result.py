@@ -38,6 +38,8 @@ __all__ = [
     "IdentificationResult",
     "Prediction",
     "Validation",
+    "drive_fields",
+    "fit_fields",
     "predict",
     "validation_metrics",
 ]
@@ -80,6 +82,21 @@ class Fit(Validation):
 def friction_entry(joint: Joint) -> dict[str, Any]:
     """``{"model": name, **parameters}`` of a joint's friction, as results report it."""
     return {"model": joint.drive.friction.model, **joint.drive.friction.params}
+
+
+def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> dict[str, Any]:
+    """A joint's drive as the model holds it, as :class:`DriveEstimate` fields (``name``,
+    ``rotor_inertia``, ``motor_inertia``, ``torque_constant``, ``friction``): keyword arguments
+    of a method's per-joint result. ``rotor_inertia`` (kg m^2, motor side) replaces the drive's
+    J_m + J_r where a method estimates it on its own."""
+    drive = joint.drive
+    return {
+        "name": joint.name,
+        "rotor_inertia": drive.rotor_inertia if rotor_inertia is None else rotor_inertia,
+        "motor_inertia": drive.motor_inertia,
+        "torque_constant": drive.torque_constant,
+        "friction": friction_entry(joint),
+    }
 
 
 @dataclass(frozen=True)
@@ -157,6 +174,25 @@ def predict(robot: Robot, data: IdentData) -> Prediction:
         current = state.current if data.current is not None else None
         joint = joint_torque(robot, state.tau_m) if data.torque is not None else None
     return Prediction(torque, current, joint)
+
+
+def fit_fields(
+    robot: Robot,
+    datas: Sequence[IdentData],
+    warnings: Sequence[str],
+    *,
+    samples: int | None = None,
+) -> dict[str, Any]:
+    """The :class:`Fit` fields every method reports, as keyword arguments of its fit: the
+    identified ``robot``'s :func:`validation_metrics` on ``datas``, the samples used (all the
+    logs' unless given), the logs, their lags (s) and ``warnings``."""
+    return {
+        **vars(validation_metrics(robot, datas)),
+        "samples": int(sum(len(d) for d in datas)) if samples is None else samples,
+        "logs": tuple(d.path for d in datas),
+        "lag": tuple(d.lag for d in datas),
+        "warnings": tuple(warnings),
+    }
 
 
 def validation_metrics(robot: Robot, datas: Sequence[IdentData]) -> Validation:

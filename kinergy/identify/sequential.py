@@ -50,8 +50,8 @@ from kinergy.identify.result import (
     DriveEstimate,
     Fit,
     IdentificationResult,
-    friction_entry,
-    validation_metrics,
+    drive_fields,
+    fit_fields,
 )
 from kinergy.jsonable import OPTIONAL
 from kinergy.model.robot import Joint, Robot, Source
@@ -177,12 +177,8 @@ def _joints(
         fields = {k: v for k, v in vars(stats[j]).items() if k != "flags"}
         out.append(
             SequentialJoint(
-                name=joint.name,
-                rotor_inertia=float(joint.drive.motor_inertia + joint.drive.reducer_inertia),
+                **drive_fields(joint),
                 rotor_inertia_std=None if np.isnan(std[j]) else float(std[j]),
-                motor_inertia=joint.drive.motor_inertia,
-                torque_constant=joint.drive.torque_constant,
-                friction=friction_entry(joint),
                 flags=flags,
                 std=errors,
                 identified=j not in problems,
@@ -258,11 +254,7 @@ def identify_sequential(
     sources = _sources(staged, bool(ref_logs), bool(current_logs))
     identified = dataclasses.replace(staged, sources=sources)
     fit = SequentialFit(
-        **vars(validation_metrics(identified, datas)),
-        samples=int(sum(len(d) for d in datas)),
-        logs=tuple(d.path for d in datas),
-        lag=tuple(d.lag for d in datas),
-        warnings=tuple(warnings),
+        **fit_fields(identified, datas, warnings),
         condition_rotor_inertia=cond,
         friction_holding=held,
         friction_choice=choices if friction == "auto" else None,

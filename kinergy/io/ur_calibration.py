@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.errors import KinergyError
+from kinergy.files import read_text
 
 __all__ = ["Calibration", "JointCalibration", "read_ur_calibration"]
 
@@ -176,12 +177,7 @@ def read_ur_calibration(path: str | os.PathLike[str]) -> Calibration:
         header, the ``K_tau`` line, a speed point of six numbers); joints not numbered 0, 1, ...
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise KinergyError(f"{path}: cannot read calibration file ({exc.strerror})") from None
-    except UnicodeDecodeError:
-        raise KinergyError(f"{path}: not a text (UTF-8) file") from None
+    text = read_text(path, "calibration file")
     reader = _Reader(path, text.splitlines())
     joints = []
     while reader.peek():

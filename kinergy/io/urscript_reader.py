@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from kinergy.errors import KinergyError
+from kinergy.files import read_text
 from kinergy.model.robot import Payload
 from kinergy.trajectory.robot_program import MOVE_DEFAULTS, Event, Move, RobotProgram, Step
 
@@ -364,10 +365,5 @@ def read_program(path: str | os.PathLike[str]) -> RobotProgram:
         The file cannot be read, or ``FILE:LINE: what cannot be handled``.
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise KinergyError(f"{p}: cannot read the program ({exc.strerror})") from None
-    except UnicodeDecodeError:
-        raise KinergyError(f"{p}: not a text (UTF-8) file") from None
+    text = read_text(p, "the program")
     return parse_program(text, path=str(p), name=p.stem)

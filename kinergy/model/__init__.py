@@ -1,48 +1,13 @@
-"""Robot models as data: dataclasses, robot files (TOML, URDF) and the built-in library."""
+"""Robot models as data: dataclasses, robot files (TOML, URDF) and the built-in library.
 
-from kinergy.model.library import library_names, load_robot
-from kinergy.model.robot import (
-    CONVENTIONS,
-    SOURCE_CATEGORIES,
-    SOURCE_STATUSES,
-    Drive,
-    Friction,
-    Joint,
-    Limits,
-    Link,
-    Payload,
-    Robot,
-    Source,
-    Thermal,
-    inertia_matrix,
-)
-from kinergy.model.toml import (
-    parse_payload,
-    read_robot_file,
-    robot_from_dict,
-    robot_to_dict,
-    save_robot,
-)
+The public names are those of :mod:`~kinergy.model.robot` (the dataclasses),
+:mod:`~kinergy.model.toml` (robot files) and :mod:`~kinergy.model.library` (built-in robots),
+re-exported here as each module lists them in its ``__all__``.
+"""
 
-__all__ = [
-    "CONVENTIONS",
-    "SOURCE_CATEGORIES",
-    "SOURCE_STATUSES",
-    "Drive",
-    "Friction",
-    "Joint",
-    "Limits",
-    "Link",
-    "Payload",
-    "Robot",
-    "Source",
-    "Thermal",
-    "inertia_matrix",
-    "library_names",
-    "load_robot",
-    "parse_payload",
-    "read_robot_file",
-    "robot_from_dict",
-    "robot_to_dict",
-    "save_robot",
-]
+from kinergy.model import library, robot, toml
+from kinergy.model.library import *  # noqa: F403 (re-export: library.__all__)
+from kinergy.model.robot import *  # noqa: F403 (re-export: robot.__all__)
+from kinergy.model.toml import *  # noqa: F403 (re-export: toml.__all__)
+
+__all__ = [*robot.__all__, *toml.__all__, *library.__all__]

@@ -31,6 +31,7 @@ __all__ = [
     "SOURCE_STATUSES",
     "Drive",
     "Friction",
+    "Joint",
     "Limits",
     "Link",
     "Payload",

@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import os
 import warnings
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -101,17 +101,17 @@ _ROBOT_KEYS = {
     "bus_voltage",
 }
 _JOINT_KEYS = {"name", "d", "a", "alpha", "offset", "mass", "com", "inertia", "drive", "limits"}
-_DRIVE_KEYS = {
+#: a drive's numbers every file gives, in the order files list them
+_DRIVE_NUMBERS = (
     "gear_ratio",
     "motor_inertia",
     "reducer_inertia",
     "torque_constant",
     "motor_constant",
     "kt_over_kb",
-    "friction",
-    "winding_resistance",
-    "thermal",
-}
+)
+_DRIVE_KEYS = {*_DRIVE_NUMBERS, "friction", "winding_resistance", "thermal"}
+_THERMAL_KEYS = ("capacity", "resistance")
 _LIMIT_KEYS = {"position", "speed", "torque", "acceleration"}
 #: friction parameters a file may not make negative: each is a friction (it opposes the motion)
 #: or a rate (Makkar's gamma2, gamma3, gamma5; nursing eq 13); gamma1 may take either sign
@@ -153,13 +153,29 @@ def _take(data: Mapping[str, Any], key: str, where: str) -> Any:
     return data[key]
 
 
-def _no_unknown(data: Mapping[str, Any], allowed: set[str], where: str) -> None:
-    unknown = sorted(set(data) - allowed)
+def _known(data: Any, allowed: Collection[str], where: str) -> Mapping[str, Any]:
+    """``data`` as a table whose keys are all ``allowed`` (errors name ``where``)."""
+    data = _table(data, where)
+    unknown = sorted(set(data) - set(allowed))
     if unknown:
         raise KinergyError(
             f"{where}: unknown field(s) {', '.join(repr(u) for u in unknown)} "
             f"(allowed: {', '.join(sorted(allowed))})"
         )
+    return data
+
+
+def _fields(
+    data: Mapping[str, Any],
+    where: str,
+    required: Sequence[str],
+    optional: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
+    """The ``required`` fields of a table (the first missing one is an error naming ``where``)
+    and the ``optional`` ones, their default where absent: keyword arguments of a dataclass."""
+    out = {key: _take(data, key, where) for key in required}
+    out.update({key: data.get(key, default) for key, default in (optional or {}).items()})
+    return out
 
 
 def _check_friction_values(params: Mapping[str, Any], where: str) -> None:
@@ -182,19 +198,12 @@ def _joint_from_dict(data: Any, index: int) -> Joint:
     data = _table(data, where)
     if isinstance(data.get("name"), str):
         where = f"joints[{index}] ({data['name']})"
-    _no_unknown(data, _JOINT_KEYS, where)
+    data = _known(data, _JOINT_KEYS, where)
 
-    link = _at(
-        where,
-        lambda: Link(
-            mass=_take(data, "mass", where),
-            com=_take(data, "com", where),
-            inertia=_take(data, "inertia", where),
-        ),
-    )
+    link_fields = _fields(data, where, ("mass", "com", "inertia"))
+    link = _at(where, lambda: Link(**link_fields))
     dwhere = f"{where}.drive"
-    drive_data = _table(_take(data, "drive", where), dwhere)
-    _no_unknown(drive_data, _DRIVE_KEYS, dwhere)
+    drive_data = _known(_take(data, "drive", where), _DRIVE_KEYS, dwhere)
     fwhere = f"{dwhere}.friction"
     fric_data = dict(_table(_take(drive_data, "friction", dwhere), fwhere))
     model = fric_data.pop("model", None)
@@ -203,58 +212,24 @@ def _joint_from_dict(data: Any, index: int) -> Joint:
     _check_friction_values(fric_data, fwhere)
     friction = _at(fwhere, lambda: Friction(model=model, params=fric_data))
     thermal = _thermal_from_dict(drive_data.get("thermal"), f"{dwhere}.thermal")
-    drive = _at(
-        dwhere,
-        lambda: Drive(
-            gear_ratio=_take(drive_data, "gear_ratio", dwhere),
-            motor_inertia=_take(drive_data, "motor_inertia", dwhere),
-            reducer_inertia=_take(drive_data, "reducer_inertia", dwhere),
-            torque_constant=_take(drive_data, "torque_constant", dwhere),
-            motor_constant=_take(drive_data, "motor_constant", dwhere),
-            kt_over_kb=_take(drive_data, "kt_over_kb", dwhere),
-            friction=friction,
-            winding_resistance=drive_data.get("winding_resistance"),
-            thermal=thermal,
-        ),
-    )
+    drive_fields = _fields(drive_data, dwhere, _DRIVE_NUMBERS, {"winding_resistance": None})
+    drive = _at(dwhere, lambda: Drive(**drive_fields, friction=friction, thermal=thermal))
     lwhere = f"{where}.limits"
-    lim_data = _table(_take(data, "limits", where), lwhere)
-    _no_unknown(lim_data, _LIMIT_KEYS, lwhere)
-    limits = _at(
-        where,
-        lambda: Limits(
-            position=_take(lim_data, "position", lwhere),
-            speed=_take(lim_data, "speed", lwhere),
-            torque=_take(lim_data, "torque", lwhere),
-            acceleration=lim_data.get("acceleration"),
-        ),
+    lim_data = _known(_take(data, "limits", where), _LIMIT_KEYS, lwhere)
+    limit_fields = _fields(
+        lim_data, lwhere, ("position", "speed", "torque"), {"acceleration": None}
     )
-    return _at(
-        where,
-        lambda: Joint(
-            name=_take(data, "name", where),
-            d=_take(data, "d", where),
-            a=_take(data, "a", where),
-            alpha=_take(data, "alpha", where),
-            offset=data.get("offset", 0.0),
-            link=link,
-            drive=drive,
-            limits=limits,
-        ),
-    )
+    limits = _at(where, lambda: Limits(**limit_fields))
+    joint_fields = _fields(data, where, ("name", "d", "a", "alpha"), {"offset": 0.0})
+    return _at(where, lambda: Joint(**joint_fields, link=link, drive=drive, limits=limits))
 
 
 def _thermal_from_dict(data: Any, where: str) -> Thermal | None:
     if data is None:
         return None
-    data = _table(data, where)
-    _no_unknown(data, {"capacity", "resistance"}, where)
-    return _at(
-        where,
-        lambda: Thermal(
-            capacity=_take(data, "capacity", where), resistance=_take(data, "resistance", where)
-        ),
-    )
+    data = _known(data, _THERMAL_KEYS, where)
+    fields = _fields(data, where, _THERMAL_KEYS)
+    return _at(where, lambda: Thermal(**fields))
 
 
 def rpy_matrix(rpy: Any) -> np.ndarray:
@@ -276,8 +251,7 @@ def matrix_rpy(rot: np.ndarray) -> np.ndarray:
 
 
 def _pose_from_dict(data: Any, where: str) -> np.ndarray:
-    data = _table(data, where)
-    _no_unknown(data, {"xyz", "rpy"}, where)
+    data = _known(data, ("xyz", "rpy"), where)
     try:
         xyz = np.asarray(data.get("xyz", [0.0, 0.0, 0.0]), dtype=float)
         rpy = np.asarray(data.get("rpy", [0.0, 0.0, 0.0]), dtype=float)
@@ -299,25 +273,19 @@ def robot_from_dict(data: Mapping[str, Any]) -> Robot:
     KinergyError
         Naming the field at fault (``joints[2] (elbow).drive.gear_ratio: ...``).
     """
-    data = _table(data, "robot")
-    _no_unknown(data, _ROBOT_KEYS, "robot")
+    data = _known(data, _ROBOT_KEYS, "robot")
     joints_data = _take(data, "joints", "robot")
     if not isinstance(joints_data, list) or not joints_data:
         raise KinergyError("joints: must be a non-empty array of tables ([[joints]])")
     joints = [_joint_from_dict(j, i) for i, j in enumerate(joints_data)]
     payload = None
     if "payload" in data:
-        pdata = _table(data["payload"], "payload")
-        _no_unknown(pdata, {"mass", "com", "inertia"}, "payload")
-        payload = Payload(
-            mass=_take(pdata, "mass", "payload"),
-            com=pdata.get("com", [0.0, 0.0, 0.0]),
-            inertia=pdata.get("inertia", [0.0] * 6),
-        )
+        pdata = _known(data["payload"], ("mass", "com", "inertia"), "payload")
+        optional = {"com": [0.0, 0.0, 0.0], "inertia": [0.0] * 6}
+        payload = Payload(**_fields(pdata, "payload", ("mass",), optional))
     sources = {}
     for cat, sdata in _table(data.get("sources", {}), "sources").items():
-        sdata = _table(sdata, f"sources.{cat}")
-        _no_unknown(sdata, {"status", "ref"}, f"sources.{cat}")
+        sdata = _known(sdata, ("status", "ref"), f"sources.{cat}")
         status = _take(sdata, "status", f"sources.{cat}")
         try:
             sources[cat] = Source(status=status, ref=str(sdata.get("ref", "")))
@@ -378,22 +346,12 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
     }
     joints = []
     for j in robot.joints:
-        drive: dict[str, Any] = {
-            "gear_ratio": j.drive.gear_ratio,
-            "motor_inertia": j.drive.motor_inertia,
-            "reducer_inertia": j.drive.reducer_inertia,
-            "torque_constant": j.drive.torque_constant,
-            "motor_constant": j.drive.motor_constant,
-            "kt_over_kb": j.drive.kt_over_kb,
-        }
+        drive: dict[str, Any] = {key: getattr(j.drive, key) for key in _DRIVE_NUMBERS}
         if j.drive.winding_resistance is not None:
             drive["winding_resistance"] = j.drive.winding_resistance
         drive["friction"] = {"model": j.drive.friction.model, **j.drive.friction.params}
         if j.drive.thermal is not None:
-            drive["thermal"] = {
-                "capacity": j.drive.thermal.capacity,
-                "resistance": j.drive.thermal.resistance,
-            }
+            drive["thermal"] = {key: getattr(j.drive.thermal, key) for key in _THERMAL_KEYS}
         limits: dict[str, Any] = {
             "position": _floats(j.limits.position),
             "speed": j.limits.speed,

@@ -4,7 +4,8 @@ Each move's target can be reached in several joint configurations: the inverse-k
 (:mod:`kinergy.dynamics.ik`: eight for a pose target of a movej with ``--configurations free``;
 the program's own otherwise) and, for a tool symmetric about its z axis, any turn of the target
 about that axis (:data:`kinergy.optimize.program_verify.SYMMETRIES`: 180 or 90 degree steps, or
-every 45 degrees for ``z``). :func:`target_states` lists them per move, each joint at the ``2 pi``
+every 45 degrees for ``z``, then finer around the best: :func:`refined_turns`).
+:func:`target_states` lists them per move, each joint at the ``2 pi``
 choice nearest the program's own joints there (so a cycle of states is a cycle of joints: the
 program ends where it starts), and for 180 and 90 degree turns also with the last joint the
 other way round.
@@ -36,7 +37,7 @@ from kinergy.trajectory.movej import trapezoid, trapezoid_timing
 from kinergy.trajectory.movel import joints_on_path, tool_motion, tool_segment
 from kinergy.trajectory.program_path import ProgramPath
 
-__all__ = ["TargetStates", "move_costs", "symmetry_angles", "target_states"]
+__all__ = ["TargetStates", "move_costs", "refined_turns", "symmetry_angles", "target_states"]
 
 Array = NDArray[np.float64]
 
@@ -83,6 +84,17 @@ def symmetry_angles(symmetry: str) -> Array:
     return np.arange(0.0, 2.0 * np.pi - 1e-9, step)
 
 
+def refined_turns(chosen: Array, step: float) -> list[Array]:
+    """Turns about a fully symmetric tool's axis around each target's chosen one: ``chosen_k +
+    i step`` for ``i`` in -2..2, and no turn (the program's own state), rad, one array per
+    target."""
+    out = []
+    for c in chosen:
+        turns = np.mod(c + step * np.arange(-2, 3), 2.0 * np.pi)
+        out.append(np.unique(np.concatenate([[0.0], turns])))
+    return out
+
+
 def _wrap(q: Array) -> Array:
     return np.asarray(np.pi - np.mod(np.pi - q, 2.0 * np.pi))
 
@@ -105,15 +117,21 @@ def _turn_choices(q: Array, own: Array, lo: Array, hi: Array, *, both: bool) -> 
 
 
 def target_states(
-    robot: Robot, path: ProgramPath, *, free: bool, symmetry: str
+    robot: Robot,
+    path: ProgramPath,
+    *,
+    free: bool,
+    symmetry: str,
+    turns: list[Array] | None = None,
 ) -> list[TargetStates]:
     """Every move's candidate states (module docstring): ``free`` lets a movej's pose target
-    take any branch; ``symmetry`` its turns about the tool axis."""
+    take any branch; ``symmetry`` its turns about the tool axis (``turns``: each target's own,
+    rad, each including 0)."""
     geometry = path.geometry
-    angles = symmetry_angles(symmetry)
     lo, hi = joint_limits(robot)
     out = []
     for k, move in enumerate(path.program.moves):
+        angles = symmetry_angles(symmetry) if turns is None else turns[k]
         own_q = path.q_end[k]
         if geometry is None:
             pose = tcp_pose(robot, own_q, path.tcp[k])[None]
@@ -123,7 +141,7 @@ def target_states(
         poses = rotation_about_z(base, angles)  # (A, 4, 4)
         sols = ik_branches(geometry, poses @ np.linalg.inv(path.tcp[k]), hint6=own_q[5])
         any_branch = move.tool_space or (free and move.pose)
-        few = angles.size <= 4
+        few = SYMMETRIES[symmetry] > 1  # 180 or 90 degree steps
         rows = []
         for a in range(angles.size):
             for b in range(8) if any_branch else [int(path.branch[k])]:

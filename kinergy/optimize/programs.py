@@ -38,7 +38,13 @@ from kinergy.dynamics.poses import tcp_pose
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 from kinergy.optimize.objectives import PROGRAM_OBJECTIVE, Objective
-from kinergy.optimize.path_costs import move_costs, symmetry_angles, target_states
+from kinergy.optimize.path_costs import (
+    TargetStates,
+    move_costs,
+    refined_turns,
+    symmetry_angles,
+    target_states,
+)
 from kinergy.optimize.problem import uniform_scaling
 from kinergy.optimize.program import serial
 from kinergy.optimize.program_search import (
@@ -63,8 +69,14 @@ Array = NDArray[np.float64]
 _BLEND_SHARE = 0.4
 #: ... at most this, m
 _BLEND_MAX = 0.10
+#: a fully symmetric tool's turns are searched every 45 degrees, then around the best every
+#: 15 and every 5 degrees (rad)
+_FINER = (np.deg2rad(15.0), np.deg2rad(5.0))
 #: processor seconds the whole optimisation aims at: the timing solver stops at what is left
 _SECONDS = 40.0
+#: the timing solver's caps are this share below the program's: its iterations end a few ms off
+#: the cycle time, and the uniform rescaling to it (:func:`_at_cycle`) must stay within the caps
+_SLACK = 0.005
 #: targets are met within these (m, rad) and the arm is at rest below this joint speed (rad/s)
 TARGET_TOL = (1e-3, np.deg2rad(0.5), 1e-3)
 
@@ -236,17 +248,30 @@ class _Search:
         self.started = time.process_time()
         self.levers: list[Lever] = []
 
-    def try_program(self, name: str, program: RobotProgram, note: str) -> None:
-        try:
-            path = program_path(self.robot, program)
-        except KinergyError as exc:
-            self.levers.append(Lever(name, self.best.result, False, f"not used: {exc}"))
-            return
-        run = _at_cycle(self.robot, path, self.budget, self.objective, self.caps, name)
-        kept = _better(run, self.best)
-        self.levers.append(Lever(name, run.result, kept, note if kept else f"not better: {note}"))
-        if kept:
-            self.best = run
+    def try_program(
+        self,
+        name: str,
+        program: RobotProgram,
+        note: str,
+        fallback: tuple[RobotProgram, str] | None = None,
+    ) -> None:
+        """Re-simulate ``program`` at the cycle time and keep it if better; if not, the
+        ``fallback`` program (with its note), if any. One lever is recorded: the kept run, or
+        the last one tried."""
+        lever = Lever(name, self.best.result, False, "")
+        for candidate, text in [(program, note)] + ([fallback] if fallback is not None else []):
+            try:
+                path = program_path(self.robot, candidate)
+            except KinergyError as exc:
+                lever = Lever(name, self.best.result, False, f"not used: {exc}")
+                continue
+            run = _at_cycle(self.robot, path, self.budget, self.objective, self.caps, name)
+            kept = _better(run, self.best)
+            lever = Lever(name, run.result, kept, text if kept else f"not better: {text}")
+            if kept:
+                self.best = run
+                break
+        self.levers.append(lever)
 
 
 def _search_levers(
@@ -276,10 +301,50 @@ def _search_levers(
         )
         if not np.isfinite(estimate):
             continue
-        changed = sum(int(c != s.own) for c, s in zip(choice, states, strict=True))
-        moves = chosen_moves(path, states, choice)
-        say(f"{name}: estimated {estimate:.1f} J, re-simulating")
-        search.try_program(name, path.program.with_moves(moves), f"{changed} target states changed")
+        if turn and symmetry == "z":
+            finer, pick, value = _finer(search, path, states, choice, estimate, free, standby)
+        else:
+            finer, pick, value = states, choice, estimate
+        program, note = _chosen_program(path, finer, pick)
+        fallback = None
+        if finer is not states:  # the finer turns, then the 45 degree ones
+            note += " (turns to 5 degrees)"
+            coarse, text = _chosen_program(path, states, choice)
+            fallback = (coarse, f"{text} (45 degree turns: the finer ones were not better)")
+        say(f"{name}: estimated {value:.1f} J, re-simulating")
+        search.try_program(name, program, note, fallback)
+
+
+def _chosen_program(
+    path: ProgramPath, states: list[TargetStates], choice: NDArray[np.intp]
+) -> tuple[RobotProgram, str]:
+    """The program with the chosen states as its targets, and how many changed."""
+    changed = sum(int(c != s.own) for c, s in zip(choice, states, strict=True))
+    moves = chosen_moves(path, states, choice)
+    return path.program.with_moves(moves), f"{changed} target states changed"
+
+
+def _finer(
+    search: _Search,
+    path: ProgramPath,
+    states: list[TargetStates],
+    choice: NDArray[np.intp],
+    estimate: float,
+    free: bool,
+    standby: float,
+) -> tuple[list[TargetStates], NDArray[np.intp], float]:
+    """A fully symmetric tool's turns searched again around the best, every ``_FINER`` step
+    (:func:`kinergy.optimize.path_costs.refined_turns`); the best states, choice and estimate."""
+    for step in _FINER:
+        turns = refined_turns(
+            np.array([s.turn[c] for s, c in zip(states, choice, strict=True)]), step
+        )
+        finer = target_states(search.robot, path, free=free, symmetry="z", turns=turns)
+        costs = move_costs(search.robot, path, finer, standby=standby)
+        pick, value = cheapest_cycle(masked(costs, lever_mask(path, finer, branch=free, turn=True)))
+        if value < estimate:
+            states, choice, estimate = finer, pick, value
+    return states, choice, estimate
 
 
 @serial
@@ -383,10 +448,7 @@ def _timed(search: _Search, say: Callable[[str], None]) -> PathRun:
     """Lever 5 on the best program: re-timed, written back as a program and re-simulated."""
     path = search.best.path
     say("timing: solving every move's v and a")
-    problem = path_problem(
-        search.robot, path, objective=search.objective, v_max=search.caps[0], a_max=search.caps[1]
-    )
-    checks = PathChecks(search.robot, path, problem, search.caps[0], search.caps[1])
+    checks = _timing_checks(search.robot, path, search.objective, search.caps)
     left = max(5.0, _SECONDS - (time.process_time() - search.started))
     result, message, _ = retime(checks, search.budget, seconds=left)
     if "StopIteration" in message:
@@ -405,7 +467,16 @@ def _timing_only(
 ) -> ProgramResult:
     """The program as written, only re-timed (the comparison)."""
     say("timing only: re-timing the program as written")
-    problem = path_problem(robot, path, objective=objective, v_max=caps[0], a_max=caps[1])
-    checks = PathChecks(robot, path, problem, caps[0], caps[1])
-    result, _, _ = retime(checks, budget)
-    return result
+    result, _, _ = retime(_timing_checks(robot, path, objective, caps), budget)
+    written = program_path(robot, _with_timing(path, result))
+    return _at_cycle(robot, written, budget, objective, caps, "timing only").result
+
+
+def _timing_checks(
+    robot: Robot, path: ProgramPath, objective: Objective, caps: tuple[float, float]
+) -> PathChecks:
+    """The timing problem of ``path`` with the caps ``_SLACK`` below ``caps`` (speed, and its
+    square for acceleration: what a uniform rescaling by ``1 + _SLACK`` needs)."""
+    v_max, a_max = caps[0] * (1.0 - _SLACK), caps[1] * (1.0 - _SLACK) ** 2
+    problem = path_problem(robot, path, objective=objective, v_max=v_max, a_max=a_max)
+    return PathChecks(robot, path, problem, v_max, a_max)

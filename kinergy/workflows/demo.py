@@ -39,7 +39,7 @@ from kinergy.report.html import Section, Table
 from kinergy.simulate import TwinSettings, realistic_truth, simulate
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import paper_trajectory
-from kinergy.workflows.identify import run_method
+from kinergy.workflows.identify import identify_model
 from kinergy.workflows.study import run_study, write_study
 
 __all__ = ["nominal_drives", "run_demo", "truth_table"]
@@ -137,7 +137,7 @@ def _identify(model: Robot, data: IdentData, realistic: bool) -> IdentificationR
     """The sequential method from guessed drives; with the realistic twin, friction chosen per
     joint and the electrics and standby from the logged voltages and supply."""
     if realistic:
-        return run_method(nominal_drives(model), [data], friction="auto")
+        return identify_model(nominal_drives(model), [data], friction="auto")
     return identify_sequential(nominal_drives(model), [data])
 
 

@@ -30,7 +30,6 @@ __all__ = [
     "identify_model",
     "identify_payload_model",
     "measured_electrics",
-    "run_method",
 ]
 
 #: identification methods by the name ``--method`` takes
@@ -49,27 +48,7 @@ def _header(what: str, logs: Sequence[str | os.PathLike[str]]) -> str:
 def identify_model(
     robot: Robot,
     datas: Sequence[IdentData],
-    out: str | os.PathLike[str],
-    *,
-    method: str = "sequential",
-    friction: str | None = None,
-    target: str = "auto",
-    solver: str = "ols",
-    ridge: float = 0.0,
-) -> IdentificationResult:
-    """Identify ``robot`` from prepared logs by ``method`` (:func:`run_method`) and write the
-    model to ``out``."""
-    result = run_method(
-        robot, datas, method=method, friction=friction, target=target, solver=solver, ridge=ridge
-    )
-    what = f"{robot.name} identified ({result.method} method)"
-    save_robot(result.robot, out, header=_header(what, [d.path for d in datas]))
-    return result
-
-
-def run_method(
-    robot: Robot,
-    datas: Sequence[IdentData],
+    out: str | os.PathLike[str] | None = None,
     *,
     method: str = "sequential",
     friction: str | None = None,
@@ -78,7 +57,8 @@ def run_method(
     ridge: float = 0.0,
 ) -> IdentificationResult:
     """Identify ``robot`` from prepared logs by ``method``, then the motor electrics and the
-    standby power where the logs have voltages and the supply (:func:`measured_electrics`).
+    standby power where the logs have voltages and the supply (:func:`measured_electrics`);
+    write the identified model to ``out`` when given.
 
     Raises
     ------
@@ -102,7 +82,11 @@ def run_method(
         result = identify_full(
             robot, list(datas), target=target, solver=solver, ridge=ridge, friction=friction
         )
-    return measured_electrics(result, datas)
+    result = measured_electrics(result, datas)
+    if out is not None:
+        what = f"{robot.name} identified ({result.method} method)"
+        save_robot(result.robot, out, header=_header(what, [d.path for d in datas]))
+    return result
 
 
 def _motion(

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from kinergy.errors import KinergyError
+from kinergy.files import all_or_none
 from kinergy.io.task import Task, load_task
 from kinergy.io.urscript import movej_program, write_script
 from kinergy.model.robot import Robot
@@ -142,16 +143,11 @@ def _write(
     result, front = timing
     script = None if urscript is None else timing_script(robot, task, result)
     figure = None if plot is None else timing_pareto(result, front)
-    written: list[Path] = []
-    try:
+    with all_or_none() as written:
         if figure is not None and plot is not None:
             written.append(save(figure, plot))
         if script is not None and urscript is not None:
             written.append(write_script(urscript, script))
-    except BaseException:
-        for path in written:
-            path.unlink(missing_ok=True)
-        raise
     return written
 
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from kinergy.files import atomic_folder, check_outputs
+from kinergy.files import all_or_none, atomic_folder, check_outputs
 from kinergy.io.rtde import write_log
 from kinergy.io.urscript import program_script, write_script
 from kinergy.io.urscript_reader import parse_program, read_program
@@ -89,8 +89,7 @@ def _write(
 ) -> list[Path]:
     """Write the URScript and the motions folder where asked: all or none."""
     result, script = run
-    written: list[Path] = []
-    try:
+    with all_or_none() as written:
         if urscript is not None:
             written.append(write_script(urscript, script))
         if motions is not None:
@@ -98,10 +97,6 @@ def _write(
                 for name, run_ in (("program", result.program), ("optimized", result.optimized)):
                     write_log(folder / f"{name}.csv", run_.motion.t, _motion_signals(run_.motion))
             written += [Path(motions) / "program.csv", Path(motions) / "optimized.csv"]
-    except BaseException:
-        for path in written:
-            path.unlink(missing_ok=True)
-        raise
     return written
 
 
