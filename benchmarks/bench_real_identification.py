@@ -26,6 +26,7 @@ import json
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -88,12 +89,18 @@ def bench_ur10e(out: Path) -> dict:
     return results
 
 
+def _stops(moving: np.ndarray, min_len: int = 50) -> list[tuple[int, int]]:
+    """(start, stop) of every run of ``moving == False`` at least ``min_len`` samples long."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], (~moving).astype(int), [0]])))
+    return [(a, b) for a, b in zip(edges[::2], edges[1::2], strict=True) if b - a >= min_len]
+
+
 def standstill_evidence(model: Path) -> dict:
-    """Why wrists 2 and 3 stay below 0.95 on ``ptp_10_points``: per joint, the share of samples
-    where that joint stands still (|qd| < 0.02 rad/s), the share of the held-out squared current
-    error that falls there, R^2 over the samples where it moves, and the ceiling set by the
-    current's wander within each standstill around its own mean (no model that predicts a
-    constant while the joint stands still can explain it)."""
+    """Why wrists 2 and 3 lose R^2 on ``ptp_10_points``: per wrist, the share of samples where
+    it stands still (|qd| < 0.02 rad/s), the share of the held-out squared current error that
+    falls there, R^2 while it moves, and the ceiling set by the current's wander within each
+    standstill around its own mean (no model predicting a steady current at rest can explain
+    it); then what sets the level at rest (:func:`rest_level_evidence`)."""
     from kinergy.identify.result import predict
     from kinergy.model import load_robot
     from kinergy.workflows.logs import prepared_logs
@@ -107,11 +114,7 @@ def standstill_evidence(model: Path) -> dict:
         moving = np.abs(data.qd[:, j]) >= 0.02
         y, e = data.current[:, j], data.current[:, j] - predicted[:, j]
         total = float(np.sum((y - y.mean()) ** 2))
-        edges = np.flatnonzero(np.diff(np.concatenate([[0], (~moving).astype(int), [0]])))
-        within = sum(
-            float(np.sum((y[a:b] - y[a:b].mean()) ** 2))
-            for a, b in zip(edges[::2], edges[1::2], strict=True)
-        )
+        within = sum(float(np.sum((y[a:b] - y[a:b].mean()) ** 2)) for a, b in _stops(moving, 1))
         ym = y[moving]
         row = {
             "still": float(np.mean(~moving)),
@@ -125,6 +128,69 @@ def standstill_evidence(model: Path) -> dict:
             f"{row['error_share_still']:.0%} of the squared current error falls there; "
             f"R^2 while it moves {row['r2_moving']:.3f}; wander within standstills caps R^2 "
             f"at {row['ceiling']:.3f}"
+        )
+    out["rest level"] = rest_level_evidence(model)
+    return out
+
+
+def rest_level_evidence(model: Path) -> dict:
+    """What the wrists' current at rest follows. (1) Every stop after motion in the unloaded
+    Fourier runs: the current the model leaves unexplained (friction off) over the joint's
+    Coulomb level, signed by the direction of the last motion (1 = all of the friction of the
+    last direction held). (2) The same pose held twice: p1 and p10 (static holds) against the
+    first and last stop of ptp_10_points at that pose. (3) The controller's own model
+    (``target_moment``) during the wrist-3 stops of ptp_10_points."""
+    import dataclasses
+
+    from kinergy.identify.result import predict
+    from kinergy.model import Friction, load_robot
+    from kinergy.workflows.logs import prepared_logs
+
+    robot = load_robot(str(model))
+    bare = robot.with_joints(
+        [dataclasses.replace(j, drive=dataclasses.replace(j.drive, friction=Friction("none", {})))
+         for j in robot.joints]
+    )  # fmt: skip
+    fractions: dict[int, list[float]] = {3: [], 4: [], 5: []}
+    for data in prepared_logs(unloaded_runs(), n_joints=6, columns=UR10E_COLUMNS):
+        load = predict(bare, data).current
+        for j, found in fractions.items():
+            coulomb = robot.joints[j].drive.friction.params["coulomb_direct"]
+            level = coulomb / robot.joints[j].drive.torque_constant
+            for a, b in _stops(np.abs(data.qd[:, j]) >= 0.005):
+                if a >= 20:
+                    last = np.sign(data.qd[a - 10 : a, j].mean())
+                    found.append(last * float(np.mean(data.current[a:b, j] - load[a:b, j])) / level)
+    out = {}
+    for j, f in fractions.items():
+        h = np.array(f)
+        out[f"joint {j + 1}"] = {"stops": h.size, "same sign": float(np.mean(h > 0)),
+                                 "median": float(np.median(h)), "spread": float(np.std(h))}  # fmt: skip
+        print(
+            f"joint {j + 1}: {h.size} stops in the Fourier runs; the current at rest keeps the "
+            f"last direction's friction sign in {np.mean(h > 0):.0%}, fraction held median "
+            f"{np.median(h):.2f}, spread (sd) {np.std(h):.2f}"
+        )
+    out["same pose twice"] = _same_pose_twice()
+    return out
+
+
+def _same_pose_twice() -> dict:
+    """The wrists' mean current in the static holds p1 and p10 against ptp_10_points's first
+    and last stop at the same pose, and the controller's ``target_moment`` in those stops."""
+    ptp = np.loadtxt(HELD_OUT, delimiter=",")
+    still = np.all(np.abs(ptp[:, 7:13]) < 0.005, axis=1)
+    first, last = _stops(~still)[0], _stops(~still)[-1]
+    out = {}
+    for name, (a, b) in (("p1", first), ("p10", last)):
+        hold = np.loadtxt(UR10E / "validation_data" / f"ur-20_01_17-{name}.csv", delimiter=",")
+        mine, theirs = hold[:, 16:19].mean(axis=0), ptp[a:b, 16:19].mean(axis=0)
+        moment = np.abs(ptp[a:b, 28:31]).max(axis=0)
+        out[name] = {"hold": mine.tolist(), "ptp": theirs.tolist()}
+        print(
+            f"{name} pose held twice: wrist currents {np.round(mine, 3)} A (static log) against "
+            f"{np.round(theirs, 3)} A (ptp_10_points stop); the controller's target_moment "
+            f"there stays below {np.round(moment, 3)} N m"
         )
     return out
 
@@ -162,7 +228,63 @@ def bench_payload(out: Path) -> dict:
         f"distance from the flange axis {r1:.3f} and {r2:.3f} m; the second run's centre of mass "
         f"is turned {turn:.0f} deg about the flange axis from the first's"
     )
-    return {"payloads": found, "agree": agree.tolist(), "radius": [r1, r2], "turn_deg": turn}
+    q6 = [float(np.mean(np.loadtxt(r, delimiter=",", usecols=6, max_rows=5000))) for r in runs]
+    print(
+        f"mean wrist-3 angle of the two loaded runs {q6[0]:.2f} and {q6[1]:.2f} rad "
+        f"(differ by {abs(q6[1] - q6[0]):.2f}, not pi): no frame turned half a turn"
+    )
+    pairs = {run.name: pair_difference(model, run) for run in runs}
+    return {"payloads": found, "agree": agree.tolist(), "radius": [r1, r2], "turn_deg": turn,
+            "wrist3_mean": q6, "pairs": pairs}  # fmt: skip
+
+
+def pair_difference(model: Path, loaded: Path) -> dict:
+    """The payload from a loaded run minus the unloaded run of the same trajectory (same day):
+    the unloaded run's currents, aligned in time on the joint angles, replace the model's
+    prediction, so only the torque constants and the kinematics enter. A point mass is fitted
+    to the difference (jackknife errors, as ``identify --payload-only``), its R^2 per joint is
+    printed, and again with wrist 3's angle negated (a frame turning the wrong way with q6
+    would fit better that way)."""
+    from kinergy.drives.electrics import torque_constants
+    from kinergy.drives.transmission import joint_torque
+    from kinergy.dynamics.regressor import regressor
+    from kinergy.identify.payload import _com, block_std
+    from kinergy.linalg import scaled_lstsq
+    from kinergy.model import load_robot
+    from kinergy.workflows.logs import prepared_logs
+
+    robot = load_robot(str(model)).with_payload(None)
+    bare = loaded.with_name(loaded.name.replace("Load", ""))
+    on, off = (
+        max(prepared_logs([log], n_joints=6, columns=UR10E_COLUMNS, repair=True), key=len)
+        for log in (loaded, bare)
+    )  # the longest segment of each
+    t_on, t_off = on.t - on.t[0], off.t - off.t[0]
+    lags = np.arange(-5.0, 5.0, 0.002)
+    miss = [np.mean((np.interp(t_on + g, t_off, off.q[:, 0]) - on.q[:, 0]) ** 2) for g in lags]
+    lag = float(lags[int(np.argmin(miss))])
+    keep = (t_on + lag > 0) & (t_on + lag < t_off[-1])
+    current = np.column_stack([np.interp(t_on + lag, t_off, off.current[:, k]) for k in range(6)])
+    tau = joint_torque(robot, (on.current - current)[keep] * torque_constants(robot)).reshape(-1)
+    result = {}
+    for label, sign in (("as modelled", 1.0), ("wrist 3 negated", -1.0)):
+        flip = np.array([1, 1, 1, 1, 1, sign])
+        q, qd, qdd = (x[keep] * flip for x in (on.q, on.qd, on.qdd))
+        a = regressor(robot, q, qd, qdd)[:, :, 50:54].reshape(-1, 4)
+        x, std, _ = scaled_lstsq(a, tau)
+        std = np.maximum(std, block_std(a, tau, 6))
+        resid = (tau - a @ x).reshape(-1, 6)
+        y = tau.reshape(-1, 6)
+        r2 = 1.0 - np.sum(resid**2, axis=0) / np.sum((y - y.mean(axis=0)) ** 2, axis=0)
+        com = _com(robot, x)
+        result[label] = {"mass": float(x[0]), "mass_std": float(std[0]), "com": com.tolist(),
+                         "com_std": (std[1:4] / x[0]).tolist(), "r2": r2.tolist()}  # fmt: skip
+        print(
+            f"{loaded.name} minus {bare.name} (lag {lag:.2f} s), {label}: mass {x[0]:.3f} +- "
+            f"{std[0]:.3f} kg, com {np.round(com, 3)} +- {np.round(std[1:4] / x[0], 3)} m, "
+            f"R^2 per joint {np.round(r2, 3)}"
+        )
+    return result
 
 
 def panda_log(folder: Path) -> tuple[Path, Path]:
@@ -236,7 +358,13 @@ def every_log() -> list[tuple[Path, str, str | None]]:
     return logs
 
 
+def _refusal(err: str) -> list[str]:
+    """The lines of a refusal on stderr, without the reader's notes."""
+    return [ln for ln in err.strip().splitlines() if ln and not ln.startswith("kinergy: note")]
+
+
 def bench_sweep(out: Path) -> dict:
+    start = time.perf_counter()
     rows = []
     panda = [(p, "panda", None) for p in panda_log(out)]
     for log, robot, columns in every_log() + panda:
@@ -249,12 +377,20 @@ def bench_sweep(out: Path) -> dict:
                 "--out", model, log,
             )  # fmt: skip
             problems = physical_problems(model) if rc == 0 else []
-            last = err.strip().splitlines()[-1] if rc != 0 and err.strip() else ""
-            rows.append((log.name, method, rc, problems, last))
+            said = _refusal(err) if rc != 0 else []
+            last = said[-1] if said else ""
+            rows.append((log.name, method, rc, problems, last, len(said)))
             print(f"{log.name:40s} {method:10s} exit {rc} {problems or ''} {last[:110]}")
     bad = [r for r in rows if r[2] == 0 and r[3]]
-    print(f"{len(rows)} runs, {sum(r[2] == 0 for r in rows)} wrote a model, {len(bad)} unphysical")
-    return {"runs": len(rows), "written": sum(r[2] == 0 for r in rows), "unphysical": bad}
+    refused = [r for r in rows if r[2] != 0]
+    one_line = sum(r[5] == 1 for r in refused)
+    wall = time.perf_counter() - start
+    print(
+        f"{len(rows)} runs, {len(rows) - len(refused)} wrote a model, {len(refused)} refused "
+        f"({one_line} in one line), {len(bad)} unphysical with exit 0; wall time {wall:.0f} s"
+    )
+    return {"runs": len(rows), "written": len(rows) - len(refused), "refused": len(refused),
+            "one_line": one_line, "unphysical": bad, "wall_s": wall}  # fmt: skip
 
 
 def bench_bad(out: Path) -> dict:

@@ -144,3 +144,25 @@ def test_every_new_model_names_its_citation_and_search() -> None:
     for name in NEW_MODELS:
         assert get_model(name).citation
     assert get_model("power_law").search == {"exponent": (0.2, 1.5)}
+
+
+def test_a_filter_overshoot_at_a_stop_does_not_set_the_held_friction() -> None:
+    from kinergy.friction.registry import friction_columns
+
+    params = {"coulomb": 1.0, "viscous": 0.0, "smoothing": 0.01, "standstill": 0.5}
+    wm = np.concatenate([np.full(20, -5.0), [0.6, 0.55], np.zeros(10)])  # ringing: 2 samples
+    cols = friction_columns("viscous_coulomb", params, wm, dwm=np.zeros_like(wm))
+    held = cols[-10:, 1]  # the Coulomb column
+    assert np.allclose(held, -1.0)
+
+
+def test_the_standstill_hold_does_not_cross_from_one_log_into_the_next() -> None:
+    from kinergy.identify.drive_steps import _columns, _Signals
+
+    wm = np.concatenate([np.full(10, 5.0), np.zeros(10), np.zeros(10), np.full(10, 5.0)])
+    z = np.zeros_like(wm)
+    piece = np.repeat([0, 1], 20)
+    params = {"coulomb": 1.0, "viscous": 0.0, "smoothing": 0.01, "standstill": 0.5}
+    cols = _columns("viscous_coulomb", params, _Signals(z, wm, z, z, None, piece))
+    assert np.allclose(cols[10:20, 2], 1.0)  # the first log's stop holds its last motion
+    assert np.allclose(cols[20:30, 2], 0.0)  # the second log starts at rest: nothing to hold

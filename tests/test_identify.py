@@ -187,18 +187,20 @@ def test_cli_identify_bad_log_leaves_no_model(
 
 # --- real robots ----------------------------------------------------------------------------------
 
-UR10E_RUNS = ["ur-20_02_19_15harm50sec", "ur-20_02_19_14harm50sec", "ur-20_02_12-50sec_12harm"]
-
 
 @pytest.fixture(scope="module")
 def ur10e_model():
+    """The model of issue 12's acceptance: every unloaded Fourier run. (On three of them the
+    15harm payload mass reads -6.1 % since the standstill-hold fixes (was -4.4 %);
+    the pair of runs of the same motion with and without the load reads -4.6 % with no
+    model at all, see benchmarks/bench_real_identification.py payload.)"""
     if not UR10E.exists():
         pytest.skip("shared datasets not available")
     robot = kinergy.load_robot("ur10e")
-    datas = [
-        prepare(read_log(UR10E / "identification_data" / f"{run}.csv", columns=UR10E_SPEC), 6)
-        for run in UR10E_RUNS
-    ]
+    runs = sorted(
+        p for p in (UR10E / "identification_data").glob("*harm*.csv") if "Load" not in p.name
+    )
+    datas = [prepare(read_log(run, columns=UR10E_SPEC), 6) for run in runs]
     return identify_sequential(robot, datas).robot
 
 
@@ -208,7 +210,7 @@ def test_ur10e_predicts_the_held_out_point_to_point_program(ur10e_model) -> None
     )
     metrics = validation_metrics(ur10e_model, [val])
     r2 = [m.r2 for m in metrics.current]
-    # measured (README): 0.963 0.995 0.997 0.977 0.958 0.808 -- wrist 3 rests 64 % of this run and
+    # measured (README): 0.964 0.995 0.997 0.977 0.957 0.826 -- wrist 3 rests 64 % of this run and
     # its standstill current wanders under the position loop (see README)
     assert min(r2[:5]) >= 0.95
     assert r2[5] >= 0.78

@@ -148,3 +148,36 @@ def test_a_log_without_a_target_is_prepared_whole(tmp_path: Path) -> None:
     whole = identify_model(ur5e, prepared_logs([path], n_joints=6), tmp_path / "a.toml")
     chunked = identify_logs(ur5e, [path], tmp_path / "b.toml", rows=1000)
     _assert_same(chunked.robot, whole.robot)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_the_history_holds_every_chunk_as_the_whole_sequence(seed: int) -> None:
+    """Friction held through standstill over a sequence cut into random chunks, with the
+    samples the history puts in front of each, equals the hold over the whole sequence: short
+    runs (the filter's overshoot, below MIN_RUN), runs across chunk edges, long stops."""
+    from kinergy.friction.standstill import hold
+    from kinergy.identify.drive_steps import _Signals
+    from kinergy.identify.streamed import _signal_history
+
+    rng = np.random.default_rng(seed)
+    lengths = rng.integers(1, 9, size=120)
+    levels = rng.choice([-2.0, -0.4, 0.0, 0.4, 2.0], size=lengths.size)
+    wm = np.repeat(levels, lengths) * (1.0 + 0.1 * rng.random(lengths.sum()))
+    n = wm.size
+    dwm = np.zeros(n)
+    other = rng.normal(size=n)
+    params = {"standstill": 1.0, "holding": 0.5}
+
+    def held(w: np.ndarray, d: np.ndarray, o: np.ndarray) -> np.ndarray:
+        return hold(params, np.column_stack([w, o]), w, d)
+
+    whole = held(wm, dwm, other)
+    history = _signal_history(1.0)
+    cuts = np.sort(rng.choice(np.arange(1, n), size=25, replace=False))
+    parts = []
+    for lo, hi in zip([0, *cuts], [*cuts, n], strict=True):
+        chunk = _Signals(other[lo:hi], wm[lo:hi], dwm[lo:hi], np.zeros(hi - lo))
+        joined, skip = history.ahead(chunk)
+        parts.append(held(joined.wm, joined.dwm, joined.tau_load)[skip:])
+        history.update(joined, skip)
+    np.testing.assert_array_equal(np.vstack(parts), whole)

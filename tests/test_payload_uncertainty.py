@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from kinergy.identify.payload import block_std
+from kinergy.identify.payload import _disagreement, block_std
 from kinergy.linalg import scaled_lstsq
 
 
@@ -26,3 +26,12 @@ def test_jackknife_widens_the_error_bars_of_correlated_residuals() -> None:
     a, b = _problem(walk - walk.mean())
     white = scaled_lstsq(a, b)[1]
     assert np.all(block_std(a, b, n=1) > 3.0 * white)
+
+
+def test_two_logs_with_the_payload_turned_half_a_turn_are_called_so() -> None:
+    std = np.full(3, 0.005)
+    fits = [(np.array([0.0, 0.2, 0.05]), std), (np.array([0.0, -0.2, 0.05]), std)]
+    notes, axes = _disagreement(fits)
+    assert axes == {"y"} and len(notes) == 1
+    assert "0.200 and 0.200 m from the flange axis, 180 deg apart" in notes[0]
+    assert _disagreement([fits[0], fits[0]]) == ((), set())

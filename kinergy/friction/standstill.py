@@ -4,18 +4,20 @@ Every model takes an optional ``standstill`` (motor side, rad/s; default 0, off)
 turns slower than that and accelerates less than :data:`STILL_RATE` times that per second (it has
 stopped, not passing through zero speed on a reversal), the friction keeps the value it had when
 the joint last moved, scaled by ``holding`` (default 1; the position loop lets part of the torque
-relax, as real UR joints do), instead of following the speed's noise through zero. It needs
-samples in time order.
+relax, as real UR joints do), instead of following the speed's noise through zero. A run of
+motion in one direction shorter than :data:`MIN_RUN` samples (a zero-phase speed filter's
+overshoot when a joint stops abruptly) does not set that value. It needs samples in time order.
 """
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["OPTIONAL_PARAMETERS", "STILL_RATE", "hold", "hold_standstill"]
+__all__ = ["MIN_RUN", "OPTIONAL_PARAMETERS", "STILL_RATE", "hold", "hold_standstill", "sustained"]
 
 Array = NDArray[np.float64]
 
@@ -23,6 +25,8 @@ Array = NDArray[np.float64]
 OPTIONAL_PARAMETERS = {"standstill": 0.0, "holding": 1.0}
 #: a motor is stopped when |wm| < standstill and |dwm| < STILL_RATE * standstill (1/s)
 STILL_RATE = 100.0
+#: a run of motion shorter than this many samples does not set the held friction
+MIN_RUN = 5
 
 
 def hold_standstill(columns: Array, moving: NDArray[np.bool_]) -> Array:
@@ -42,7 +46,20 @@ def hold(params: Mapping[str, float], columns: Array, wm: Array, dwm: Array | No
     if threshold <= 0.0:
         return columns
     moving = np.abs(wm) >= threshold
+    stopped = ~moving
     if dwm is not None:
-        moving |= np.abs(np.asarray(dwm, dtype=float)) >= STILL_RATE * threshold
-    held = params.get("holding", 1.0) * hold_standstill(columns, moving)
-    return np.where(moving[:, None], columns, held)
+        stopped &= np.abs(np.asarray(dwm, dtype=float)) < STILL_RATE * threshold
+    held = params.get("holding", 1.0) * hold_standstill(columns, sustained(moving, wm))
+    return np.where(stopped[:, None], held, columns)
+
+
+def sustained(moving: NDArray[np.bool_], wm: Array, min_run: int = MIN_RUN) -> NDArray[np.bool_]:
+    """``moving`` (N,) without its runs in one direction (sign of ``wm``, (N,)) shorter than
+    ``min_run`` samples."""
+    label = np.where(moving, np.sign(wm), 0.0)
+    cuts = np.flatnonzero(np.diff(label)) + 1
+    out = moving.copy()
+    for start, stop in itertools.pairwise([0, *cuts.tolist(), label.size]):
+        if stop - start < min_run:
+            out[start:stop] = False
+    return out

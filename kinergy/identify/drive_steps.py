@@ -36,6 +36,7 @@ from kinergy.identify.result import (
     IDENTIFIED,
     KEPT,
 )
+from kinergy.jsonable import OPTIONAL
 from kinergy.linalg import Reduced, scaled_lstsq, scaled_solution
 from kinergy.model.robot import Friction, Joint, Robot
 
@@ -146,18 +147,29 @@ def rotor_inertias(
 @dataclass(frozen=True, eq=False)
 class _Signals:
     """One motor's signals for eq 18, motor side, each (N,): load torque ``tau_load`` (N m),
-    speed ``wm`` (rad/s), acceleration ``dwm`` (rad/s^2), measured ``current`` (A) and the
-    joint ``temperature`` (deg C, None when not logged)."""
+    speed ``wm`` (rad/s), acceleration ``dwm`` (rad/s^2), measured ``current`` (A), the joint
+    ``temperature`` (deg C, None when not logged) and the stretch of time each row belongs to
+    (``piece``, int: one per log; a friction held through standstill never crosses into the
+    next piece)."""
 
     tau_load: Array
     wm: Array
     dwm: Array
     current: Array
     temperature: Array | None = None
+    piece: NDArray[np.int64] | None = None
 
     def rows(self, keep: NDArray[np.bool_]) -> _Signals:
+        """The rows ``keep``; where rows are left out between two kept ones, a new piece."""
         t = None if self.temperature is None else self.temperature[keep]
-        return _Signals(self.tau_load[keep], self.wm[keep], self.dwm[keep], self.current[keep], t)
+        piece = None
+        if self.piece is not None:
+            index = np.flatnonzero(keep)
+            cut = (np.diff(index) > 1) | (np.diff(self.piece[keep]) != 0)
+            piece = np.concatenate([[0], np.cumsum(cut)])
+        return _Signals(
+            self.tau_load[keep], self.wm[keep], self.dwm[keep], self.current[keep], t, piece
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,8 +189,15 @@ class _CurrentFit:
 def _columns(model: str, params: dict[str, float], signals: _Signals) -> Array:
     """Eq 18's regressor ``[tau_load, friction columns]`` (N, 1 + k)."""
     s = signals
-    cols = friction_columns(model, params, s.wm, s.tau_load, s.dwm, temperature=s.temperature)
-    return np.column_stack([s.tau_load, cols])
+    bounds = [0, s.wm.size]
+    if s.piece is not None:
+        bounds[1:1] = list(np.flatnonzero(np.diff(s.piece)) + 1)
+    parts = []
+    for lo, hi in itertools.pairwise(bounds):
+        t = None if s.temperature is None else s.temperature[lo:hi]
+        w, load, dw = s.wm[lo:hi], s.tau_load[lo:hi], s.dwm[lo:hi]
+        parts.append(friction_columns(model, params, w, load, dw, temperature=t))
+    return np.column_stack([s.tau_load, np.vstack(parts)])
 
 
 def current_problem(model: str, params: dict[str, float], signals: _Signals) -> Reduced:
@@ -320,6 +339,7 @@ def motor_signals(robot: Robot, rotor: Array, logs: Sequence[IdentData]) -> list
     temps = None
     if all(d.temperature is not None for d in logs):
         temps = stack(logs, "temperature")
+    piece = np.repeat(np.arange(len(logs)), [d.qd.shape[0] for d in logs])
     return [
         _Signals(
             tau_load[:, m],
@@ -327,6 +347,7 @@ def motor_signals(robot: Robot, rotor: Array, logs: Sequence[IdentData]) -> list
             dwm[:, m],
             current[:, m],
             None if temps is None else temps[:, m],
+            piece,
         )
         for m in range(robot.n)
     ]
@@ -376,13 +397,16 @@ def best_hold(holdings: Sequence[float], fit: Callable[[float], _CurrentFit]) ->
 @dataclass(frozen=True)
 class FrictionChoice:
     """How ``friction="auto"`` chose a joint's model: each candidate's cross-validated current
-    RMS (A, :data:`FOLDS` contiguous blocks), the winner, and how much lower its RMS is than
-    Coulomb + viscous's and than the runner-up's (%)."""
+    RMS (A, :data:`FOLDS` contiguous blocks), the winner, how much lower its RMS is than
+    Coulomb + viscous's and than the runner-up's (%), and the standard error of the first (%,
+    from the spread of the per-block differences). A model other than Coulomb + viscous wins
+    only if it beats it by more than that standard error (the one-standard-error rule)."""
 
     model: str
     cv_rms: dict[str, float]
     gain_over_viscous_coulomb: float | None
     margin: float | None
+    gain_std: float | None = field(default=None, metadata=OPTIONAL)
 
 
 def candidates(signals: _Signals) -> list[str]:
@@ -393,46 +417,61 @@ def candidates(signals: _Signals) -> list[str]:
     return [m for m in AUTO_CANDIDATES if warm or not get_model(m).needs_temperature]
 
 
-def _cv_rms(fit: _CurrentFit, signals: _Signals, kt_prior: float) -> float:
-    """Current RMS (A) of ``fit``'s model (its shape held) on each of :data:`FOLDS` contiguous
-    blocks of the samples, fitted on the others."""
+def _cv_errors(fit: _CurrentFit, signals: _Signals, kt_prior: float) -> Array:
+    """Squared current error (A^2) summed over each of :data:`FOLDS` contiguous blocks of the
+    samples, ``fit``'s model (its shape and hold held) fitted on the others, shape (FOLDS,)."""
     index = np.arange(signals.current.size)
     edges = np.linspace(0, index.size, FOLDS + 1).astype(int)
+    fold = np.searchsorted(edges, index, side="right") - 1
+    if signals.piece is not None and np.unique(signals.piece).size >= 3:
+        fold = signals.piece
     a = _columns(fit.model, fit.params, signals)
-    squared = 0.0
-    for lo, hi in itertools.pairwise(edges):
-        held = (index >= lo) & (index < hi)
+    squared = []
+    for k in np.unique(fold):
+        held = fold == k
         train = _solve_current(fit.model, fit.params, signals.rows(~held), kt_prior)
-        squared += float(np.sum((signals.current[held] - a[held] @ train.x) ** 2))
-    return float(np.sqrt(squared / index.size))
+        squared.append(float(np.sum((signals.current[held] - a[held] @ train.x) ** 2)))
+    return np.array(squared)
+
+
+def _gain(errors: dict[str, Array], model: str, other: str) -> tuple[float, float]:
+    """How much lower ``model``'s cross-validated RMS is than ``other``'s (%), and the standard
+    error of that gain from the per-block differences of the squared error (%)."""
+    a, b = errors[model], errors[other]
+    gain = 100.0 * (1.0 - np.sqrt(a.sum() / b.sum()))
+    # gain ~ -(sum a - sum b) / (2 sum b); the blocks' differences give that sum's spread
+    std = 50.0 * np.sqrt(a.size) * float(np.std(a - b, ddof=1)) / float(b.sum())
+    return float(gain), std
 
 
 def _auto_fit(
     joint: Joint, standstill: float, signals: _Signals, holdings: Sequence[float]
 ) -> tuple[_CurrentFit, FrictionChoice]:
-    """``friction="auto"``: the standstill hold chosen with the joint's own model, then every
-    candidate model fitted with it and scored by cross-validation; the lowest held-out RMS wins.
-    Candidates whose regression is singular on these logs are left out."""
-    own = _best_hold(joint, joint.drive.friction.model, standstill, signals, holdings)
-    holding = float(own.params.get("holding", 0.0))
+    """``friction="auto"``: every candidate model fitted with its own standstill hold and scored
+    by cross-validation; the lowest held-out RMS wins unless it beats Coulomb + viscous by no
+    more than the standard error of that gain. Candidates whose regression is singular on these
+    logs are left out."""
     kt = joint.drive.torque_constant
-    fits, scores = {}, {}
+    fits, errors = {}, {}
     for model in candidates(signals):
-        fit = _current_fit(model, start_params(joint, model, standstill, holding), signals, kt)
+        fit = _best_hold(joint, model, standstill, signals, holdings)
         if fit.cond <= MAX_CONDITION:
-            fits[model], scores[model] = fit, _cv_rms(fit, signals, kt)
+            fits[model], errors[model] = fit, _cv_errors(fit, signals, kt)
+    scores = {m: float(np.sqrt(e.sum() / signals.current.size)) for m, e in errors.items()}
     ranked = sorted(scores, key=scores.__getitem__)
-    best = ranked[0]
-
-    def lower(other: str) -> float:
-        return 100.0 * (1.0 - scores[best] / scores[other])
-
-    vc = scores.get("viscous_coulomb")
+    best, gain, std = ranked[0], None, None
+    if "viscous_coulomb" in scores:
+        gain, std = _gain(errors, best, "viscous_coulomb")
+        if gain <= std:
+            best = "viscous_coulomb"
+            gain, std = 0.0, None
+    others = [m for m in ranked if m != best]
     choice = FrictionChoice(
         model=best,
         cv_rms=scores,
-        gain_over_viscous_coulomb=None if vc is None else lower("viscous_coulomb"),
-        margin=lower(ranked[1]) if len(ranked) > 1 else None,
+        gain_over_viscous_coulomb=gain,
+        margin=100.0 * (1.0 - scores[best] / scores[others[0]]) if others else None,
+        gain_std=std,
     )
     return fits[best], choice
 

@@ -56,6 +56,12 @@ _COM_MOTION = {
     "y": "wrist 3 turned through half a turn or more with the flange axis near horizontal",
     "z": "the flange axis tilted from vertical to horizontal (wrists 1 and 2)",
 }
+#: the check that tells how a payload sits on the flange in a log
+_MOUNT_CHECK = (
+    "start each loaded log with the flange axis horizontal and wrist 3 held a few seconds at "
+    "0, 90, 180 and 270 deg: the wrist-3 current then gives the centre of mass's angle about "
+    "the flange axis directly"
+)
 
 
 @dataclass(frozen=True)
@@ -134,33 +140,58 @@ def identify_payload(
         x = np.concatenate([x, np.zeros(6)])
         std = np.concatenate([std, np.zeros(6)])
     payload, report = _finish(robot, x, std, cond, inertia_ok, signal, datas)
-    notes = _uncertainty_notes(report, float(white)) + _disagreement(robot, a, b, datas)
+    disagree, disputed = _disagreement(_log_fits(robot, a, b, datas))
+    notes = _uncertainty_notes(report, float(white), disputed) + disagree
     return payload, dataclasses.replace(report, notes=report.notes + notes)
 
 
-def _disagreement(robot: Robot, a: Array, b: Array, datas: list[IdentData]) -> tuple[str, ...]:
-    """With several logs, a note per centre-of-mass coordinate on which two logs' point-mass fits
-    differ by more than twice their combined standard error (the payload moved between them, or
-    the model explains the motions differently): the pooled figure would hide it."""
+def _log_fits(
+    robot: Robot, a: Array, b: Array, datas: list[IdentData]
+) -> list[tuple[Array, Array]]:
+    """Each log's own point-mass fit: centre of mass (flange frame, m) and its standard errors
+    (jackknife), from the stacked rows ``a`` (N n, 10) and ``b`` (N n,); empty for one log."""
     if len(datas) < 2:
-        return ()
+        return []
     edges = np.cumsum([0] + [robot.n * len(d) for d in datas])
     fits = []
     for lo, hi in itertools.pairwise(edges):
         x, std, _ = scaled_lstsq(a[lo:hi, :4], b[lo:hi])
         std = np.maximum(std, block_std(a[lo:hi, :4], b[lo:hi], robot.n))
-        com = _com(robot, x)
-        fits.append((com, std[1:4] / max(float(x[0]), 1e-12)))
-    notes = []
+        fits.append((_com(robot, x), std[1:4] / max(float(x[0]), 1e-12)))
+    return fits
+
+
+def _disagreement(fits: list[tuple[Array, Array]]) -> tuple[tuple[str, ...], set[str]]:
+    """A note per pair of logs whose own centres of mass (:func:`_log_fits`) differ by more than
+    twice their combined standard error on some axis, and the axes where some pair does.
+
+    Across the flange axis the note says how far from it each log puts the centre of mass and
+    by what angle about it they differ: equal distances at different angles, each well
+    determined, is a payload that sat differently on the flange, not a poor motion.
+    """
+    notes: list[str] = []
+    axes: set[str] = set()
     for (i, (c1, s1)), (j, (c2, s2)) in itertools.combinations(enumerate(fits), 2):
-        for k, axis in enumerate("xyz"):
-            if abs(c1[k] - c2[k]) > 2.0 * np.hypot(s1[k], s2[k]):
-                notes.append(
-                    f"logs {i + 1} and {j + 1} disagree on the centre of mass {axis}: "
-                    f"{c1[k]:.3f} +- {s1[k]:.3f} against {c2[k]:.3f} +- {s2[k]:.3f} m (was the "
-                    "payload moved between them?)"
-                )
-    return tuple(notes)
+        bad = [k for k in range(3) if abs(c1[k] - c2[k]) > 2.0 * np.hypot(s1[k], s2[k])]
+        if not bad:
+            continue
+        axes.update("xyz"[k] for k in bad)
+        said = ", ".join(
+            f"{'xyz'[k]} {c1[k]:.3f} +- {s1[k]:.3f} against {c2[k]:.3f} +- {s2[k]:.3f} m"
+            for k in bad
+        )
+        note = f"logs {i + 1} and {j + 1} disagree on the centre of mass beyond 2 sigma: {said}"
+        if {0, 1} & set(bad):
+            r1, r2 = float(np.hypot(c1[0], c1[1])), float(np.hypot(c2[0], c2[1]))
+            turn = np.degrees(np.arctan2(c2[1], c2[0]) - np.arctan2(c1[1], c1[0])) % 360.0
+            note += (
+                f"; {r1:.3f} and {r2:.3f} m from the flange axis, {turn:.0f} deg apart about "
+                "it. Each log fixes its own centre of mass, so the payload sat differently on "
+                "the flange in the two (mounted turned, or moved), and the pooled centre of "
+                f"mass describes neither. To tell how it sat in a log, {_MOUNT_CHECK}"
+            )
+        notes.append(note)
+    return tuple(notes), axes
 
 
 def block_std(a: Array, b: Array, n: int, blocks: int = BLOCKS) -> Array:
@@ -182,15 +213,23 @@ def block_std(a: Array, b: Array, n: int, blocks: int = BLOCKS) -> Array:
     return np.sqrt((blocks - 1) / blocks * np.sum((x - x.mean(axis=0)) ** 2, axis=0))
 
 
-def _uncertainty_notes(report: PayloadEstimate, white_mass_std: float) -> tuple[str, ...]:
+def _uncertainty_notes(
+    report: PayloadEstimate, white_mass_std: float, disputed: set[str]
+) -> tuple[str, ...]:
     """How the standard errors were found and, per centre-of-mass coordinate whose error is too
-    large, that it is not identifiable and what motion would fix it."""
+    large, that it is not identifiable and what motion would fix it; on an axis in
+    ``disputed`` (the logs disagree), that the error is their disagreement instead."""
     notes = [
         f"standard errors from a jackknife over {BLOCKS} time blocks (correlated residuals): "
         f"mass +- {report.mass_std:.2g} kg against {white_mass_std:.2g} kg by the white-noise formula"
     ]
     for axis, value, std in zip("xyz", report.com, report.com_std, strict=True):
-        if std > MAX_COM_STD:
+        if std > MAX_COM_STD and axis in disputed:
+            notes.append(
+                f"pooled centre of mass {axis} = {value:.3f} +- {std:.3f} m: that error is the "
+                "logs' disagreement (below), not a motion too poor to show it"
+            )
+        elif std > MAX_COM_STD:
             notes.append(
                 f"centre of mass {axis} = {value:.3f} +- {std:.3f} m is not identifiable from "
                 f"this motion; it needs {_COM_MOTION[axis]}"

@@ -39,6 +39,7 @@ Which fits stream: the sequential method with a fixed friction model whose shape
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import os
 import tempfile
 from collections.abc import Iterator, Sequence
@@ -52,7 +53,7 @@ from kinergy.drives.electrics import electrical_power, equivalent_voltage, torqu
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import get_model
-from kinergy.friction.standstill import STILL_RATE
+from kinergy.friction.standstill import MIN_RUN, sustained
 from kinergy.identify.drive_steps import (
     STILL_SPEED,
     FrictionChoice,
@@ -136,49 +137,125 @@ def _join(parts: Sequence[IdentData]) -> IdentData:
     return IdentData(path=last.path, lag=last.lag, source=last.source, **fields)  # type: ignore[arg-type]
 
 
-class _Held:
-    """Per motor, the last sample in which it moved (friction held through standstill recalls
-    it), for the motors whose friction has a ``standstill`` speed (rad/s, motor side)."""
+class _History:
+    """What friction held through standstill (:func:`kinergy.friction.standstill.hold`) needs
+    of the samples before a chunk, whatever their number: per motor the run of the last
+    sustained motion (its last :data:`~kinergy.friction.standstill.MIN_RUN` samples: the held
+    friction is that run's last sample's) and the last ``MIN_RUN - 1`` samples (a run that goes
+    on into the chunk). :meth:`ahead` puts them in front of a chunk in time order, a sample at
+    rest for every motor (speeds and accelerations zero) between stretches that are not
+    contiguous, so no run joins across a left-out stretch. A run seen in part is never longer
+    than it is, and each remembered run is seen whole enough to count as sustained, so every
+    sample of the chunk is held as in the whole log (``tests/test_identify_stream.py``).
 
-    def __init__(self, robot: Robot):
-        self.n_mat = transmission_matrix(robot)
-        self.still = [float(j.drive.friction.params.get("standstill", 0.0)) for j in robot.joints]
-        self.rows: dict[int, tuple[int, IdentData]] = {}
-        self.seen = 0
+    ``rows`` of any sample container with ``take(x, index)`` (those rows, in order),
+    ``join(parts)``, ``at_rest(x)`` (one row, speeds zeroed) and ``speeds(x)`` ((N, m) motor
+    speeds, rad/s); ``still`` (m,) the speeds below which each motor is at rest.
+    """
+
+    def __init__(self, still: Sequence[float], take: Any, join: Any, at_rest: Any, speeds: Any):
+        self.still = np.asarray(still, dtype=float)
+        self.take, self.join, self.at_rest, self.speeds = take, join, at_rest, speeds
+        self.reset()
 
     def reset(self) -> None:
-        self.rows = {}
+        """A new log: nothing is held (the hold restarts in each log)."""
+        self.rows: Any = None  # the remembered samples, in time order
+        self.index = np.empty(0, dtype=np.int64)  # their sample numbers in the log
+        self.seen = 0
 
-    def ahead(self, chunk: IdentData) -> tuple[IdentData, int]:
-        """``chunk`` with the remembered samples in front, in time order, and their count."""
-        keep = sorted({k: row for k, row in self.rows.values()}.items())
-        if not keep:
+    @property
+    def active(self) -> bool:
+        return bool(np.any(self.still > 0.0))
+
+    def ahead(self, chunk: Any) -> tuple[Any, int]:
+        """``chunk`` with the remembered samples in front, and how many rows were put there."""
+        if not self.active or self.rows is None:
             return chunk, 0
-        return _join([row for _, row in keep] + [chunk]), len(keep)
+        parts: list[Any] = []
+        cuts = np.flatnonzero(np.diff(self.index) > 1) + 1
+        for k, (lo, hi) in enumerate(itertools.pairwise([0, *cuts.tolist(), self.index.size])):
+            if k > 0:
+                parts.append(self.at_rest(self.take(self.rows, np.array([lo]))))
+            parts.append(self.take(self.rows, np.arange(lo, hi)))
+        joined = self.join([*parts, chunk])
+        return joined, self._length(joined) - self._length(chunk)
 
-    def update(self, chunk: IdentData) -> None:
-        """Remember each motor's last moving sample of ``chunk`` (after the earlier chunks)."""
-        if any(s > 0.0 for s in self.still):
-            wm, dwm = chunk.qd @ self.n_mat.T, chunk.qdd @ self.n_mat.T
-            for m, still in enumerate(self.still):
-                if still <= 0.0:
-                    continue
-                moving = np.flatnonzero(
-                    (np.abs(wm[:, m]) >= still) | (np.abs(dwm[:, m]) >= STILL_RATE * still)
-                )
-                if moving.size:
-                    k = int(moving[-1])
-                    self.rows[m] = (self.seen + k, chunk.sliced(k, k + 1))
-        self.seen += len(chunk)
+    def update(self, joined: Any, skip: int) -> None:
+        """Remember what the samples so far leave for the next chunk (``joined`` as
+        :meth:`ahead` gave it, ``skip`` rows in front)."""
+        if not self.active:
+            return
+        rows = self._length(joined) - skip
+        numbers = np.full(self._length(joined), -1, dtype=np.int64)
+        numbers[skip:] = self.seen + np.arange(rows)
+        if skip:  # the remembered samples' numbers; rest rows between stretches stay -1
+            cuts = np.flatnonzero(np.diff(self.index) > 1)
+            real = np.ones(skip, dtype=bool)
+            real[cuts + 1 + np.arange(cuts.size)] = False
+            numbers[:skip][real] = self.index
+        wm = self.speeds(joined)
+        keep = set(range(max(0, self.seen + rows - (MIN_RUN - 1)), self.seen + rows))
+        for m, still in enumerate(self.still):
+            if still <= 0.0:
+                continue
+            moving = sustained(np.abs(wm[:, m]) >= still, wm[:, m])
+            if moving.any():
+                last = int(numbers[np.flatnonzero(moving)[-1]])
+                keep.update(range(last - MIN_RUN + 1, last + 1))
+        wanted = np.array(sorted(keep), dtype=np.int64)
+        where = {int(n): k for k, n in enumerate(numbers) if n >= 0}
+        self.rows = self.take(joined, np.array([where[int(n)] for n in wanted], dtype=np.int64))
+        self.index = wanted
+        self.seen += rows
+
+    def _length(self, x: Any) -> int:
+        return int(self.speeds(x).shape[0])
 
 
-def _state(robot: Robot, held: _Held, chunk: IdentData, temperature: bool) -> Array:
+def _data_history(robot: Robot) -> _History:
+    """A :class:`_History` of prepared samples (:class:`IdentData`) for ``robot``'s friction."""
+    n_mat = transmission_matrix(robot)
+    still = [float(j.drive.friction.params.get("standstill", 0.0)) for j in robot.joints]
+
+    def take(x: IdentData, index: NDArray[np.int64]) -> IdentData:
+        return (
+            _join([x.sliced(int(k), int(k) + 1) for k in index]) if index.size else x.sliced(0, 0)
+        )
+
+    def at_rest(x: IdentData) -> IdentData:
+        zero = np.zeros_like(x.qd)
+        return dataclasses.replace(x, qd=zero, qdd=zero, qd_cmd=zero, qdd_cmd=zero)
+
+    return _History(still, take, _join, at_rest, lambda x: x.qd @ n_mat.T)
+
+
+def _signal_history(still: float) -> _History:
+    """A :class:`_History` of one motor's eq 18 signals (:class:`_Signals`)."""
+
+    def take(x: _Signals, index: NDArray[np.int64]) -> _Signals:
+        t = None if x.temperature is None else x.temperature[index]
+        return _Signals(x.tau_load[index], x.wm[index], x.dwm[index], x.current[index], t)
+
+    def join(parts: Sequence[_Signals]) -> _Signals:
+        out = parts[0]
+        for part in parts[1:]:
+            out = _cat(out, part)
+        return out
+
+    def at_rest(x: _Signals) -> _Signals:
+        return dataclasses.replace(x, wm=np.zeros_like(x.wm), dwm=np.zeros_like(x.dwm), piece=None)
+
+    return _History([still], take, join, at_rest, lambda x: x.wm[:, None])
+
+
+def _state(robot: Robot, held: _History, chunk: IdentData, temperature: bool) -> Array:
     """The chunk's motor currents and electrical powers under ``robot`` (:func:`drive_state`,
-    friction held as over the stacked logs), each (N, n)."""
+    friction held as in its whole log), each (N, n)."""
     data, k = held.ahead(chunk)
     temp = data.temperature if temperature else None
     state = drive_state(robot, data.q, data.qd, data.qdd, temperature=temp)
-    held.update(chunk)
+    held.update(data, k)
     return np.stack([state.current[k:], state.power[k:]])
 
 
@@ -330,24 +407,24 @@ class LogsInChunks:
             [Reduced.empty(1 + len(get_model(models[m]).linear)) for _ in holdings]
             for m in range(staged.n)
         ]
-        carry: list[_Signals | None] = [None] * staged.n
+        history = [_signal_history(stills[m]) for m in range(staged.n)]
         # as motor_signals: temperatures only when every log with currents has them
         warm = all(h["temperature"] for h in self.has if h["current"])
-        for _, chunk in self._chunks("current"):
+        last = -1
+        for k, chunk in self._chunks("current"):
+            if k != last:  # the hold restarts in each log
+                for past in history:
+                    past.reset()
+                last = k
             for m, s in enumerate(motor_signals(staged, rotor, [chunk])):
                 if not warm:
                     s = _Signals(s.tau_load, s.wm, s.dwm, s.current, None)
-                before = carry[m]
-                joined = s if before is None else _cat(before, s)
-                skip = 0 if before is None else 1
+                s = dataclasses.replace(s, piece=None)
+                joined, skip = history[m].ahead(s)
                 for h, p in enumerate(params[m]):
                     cols = _columns(models[m], p, joined)[skip:]
                     problems[m][h] = problems[m][h].stack(cols, s.current)
-                moving = np.flatnonzero(
-                    (np.abs(s.wm) >= stills[m]) | (np.abs(s.dwm) >= STILL_RATE * stills[m])
-                )
-                if moving.size:
-                    carry[m] = s.rows(np.arange(s.wm.size) == moving[-1])
+                history[m].update(joined, skip)
 
         index = {h: k for k, h in enumerate(holdings)}
 
@@ -369,9 +446,9 @@ class LogsInChunks:
         predicted currents are the instrument of :meth:`electrics` too: the same pass
         accumulates that fit."""
         sums: dict[str, MetricSums | None] = dict.fromkeys(("torque", "current", "joint_torque"))
-        held = _Held(robot)
+        held = _data_history(robot)
         warm = {h["temperature"] for h in self.has}
-        fused = self.has_voltage and not any(held.still) and len(warm) == 1
+        fused = self.has_voltage and not held.active and len(warm) == 1
         motors = [ElectricsSums() for _ in range(robot.n)] if fused else None
         if fused and self.has_supply:  # the predicted currents, for standby
             self._drawn = (robot, _Spool())
@@ -382,7 +459,7 @@ class LogsInChunks:
                 last = k
             data, skip = held.ahead(chunk)
             pred = predict(robot, data)
-            held.update(chunk)
+            held.update(data, skip)
             for key, measured, predicted in (
                 ("torque", chunk.tau_ref, pred.torque),
                 ("current", chunk.current, pred.current),
@@ -393,7 +470,7 @@ class LogsInChunks:
                     sums[key].add(measured, predicted[skip:])  # type: ignore[union-attr]
             if motors is not None:
                 assert pred.current is not None
-                _add_electrics(motors, held.n_mat, chunk, pred.current)
+                _add_electrics(motors, transmission_matrix(robot), chunk, pred.current)
             if self._drawn is not None and pred.current is not None:
                 self._drawn[1].put([pred.current])
         if motors is not None:
@@ -415,11 +492,11 @@ class LogsInChunks:
             motors = self._electrics[1]
         else:
             motors = [ElectricsSums() for _ in range(robot.n)]
-            held = _Held(robot)
+            held = _data_history(robot)
             warm = self._every("temperature")
-            for _, chunk in self._chunks():
+            for _, chunk in self._chunks():  # over the logs stacked, as the in-memory fit
                 predicted = _state(robot, held, chunk, warm)[0]
-                _add_electrics(motors, held.n_mat, chunk, predicted)
+                _add_electrics(motors, transmission_matrix(robot), chunk, predicted)
         out: list[ElectricsFit | KinergyError] = []
         for motor in motors:
             try:
@@ -434,11 +511,11 @@ class LogsInChunks:
         :meth:`validation` predicted serve when ``robot`` differs from its model in the
         electrics alone (its currents on the first chunk are the same to the bit): the power
         is then ``tau_m = k_t I`` through UR5e eq 23 (:func:`electrical_power`)."""
-        held, total, count = _Held(robot), 0.0, 0
+        held, total, count = _data_history(robot), 0.0, 0
         warm = self._every("temperature")
         drawn = iter(self._drawn[1]) if self._drawn is not None else None
         n_mat, kt = transmission_matrix(robot), torque_constants(robot)
-        for _, chunk in self._chunks():
+        for _, chunk in self._chunks():  # over the logs stacked, as the in-memory fit
             assert chunk.supply_voltage is not None and chunk.supply_current is not None
             if drawn is not None and count > 0:
                 power = electrical_power(robot, next(drawn)[0] * kt, chunk.qd @ n_mat.T)
