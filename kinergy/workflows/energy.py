@@ -12,7 +12,7 @@ from kinergy.accounting.energy import EnergyReport, energy
 from kinergy.accounting.energy_stream import EnergyAccumulator
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.accounting.supply import measured_supply
-from kinergy.io.formats import CHUNK_ROWS, iter_log
+from kinergy.io.formats import iter_log
 from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
 from kinergy.io.motion_stream import iter_motion
@@ -22,7 +22,11 @@ from kinergy.predict import drive_state
 from kinergy.trajectory.motion import Motion
 from kinergy.workflows.logs import read_motion
 
-__all__ = ["energy_figures_of_log", "energy_of_log"]
+__all__ = ["ENERGY_ROWS", "energy_figures_of_log", "energy_of_log"]
+
+#: samples per chunk of the one-pass energy: 40 s at 500 Hz; the drive state of a chunk holds
+#: about 40 arrays of (rows, n) (60-minute log: peak 400 MB against 530 MB at 50,000 rows)
+ENERGY_ROWS = 20_000
 
 Array = NDArray[np.float64]
 
@@ -95,7 +99,7 @@ def energy_figures_of_log(
     columns: str | None = None,
     source: str = "auto",
     recovery: bool = True,
-    rows: int = CHUNK_ROWS,
+    rows: int = ENERGY_ROWS,
 ) -> EnergyFigures:
     """The figures of :func:`energy_of_log` (what ``kinergy energy`` prints), a log read in one
     pass: chunks of ``rows`` samples (:func:`kinergy.io.formats.iter_log`), their motion as the
