@@ -36,6 +36,7 @@ __all__ = [
     "link_inertials",
     "make_chain",
     "output_array",
+    "z_first",
 ]
 
 Array = NDArray[np.float64]
@@ -130,6 +131,26 @@ def kernel_geometry(chain: Chain) -> tuple[Array, Array, Array, Array, Array, Ar
     pcc = pp + np.einsum("nij,nj->ni", rp, (_E3 @ pc.T).T)
     axis_v = np.cross(chain.point, chain.axis)
     return tuple(np.ascontiguousarray(x) for x in (a, b, c, pa, pb, pcc, chain.axis, axis_v))  # type: ignore[return-value]
+
+
+def z_first(geo: tuple[Array, ...]) -> bool:
+    """Whether every link pose of :func:`kernel_geometry`'s ``geo`` is ``Rz(q)`` first, then a
+    constant transform (standard DH: ``pre`` is the identity): exactly, ``B = E2 A``, ``A`` and
+    ``B`` without a third row, ``C`` with only its third, and the same for ``pa, pb, pc``. The
+    kernels then form each pose from four products per column (``_kernels._link_pose``)."""
+    a, b, c, pa, pb, pc = geo[:6]
+    return bool(
+        not np.any(a[:, 2])
+        and not np.any(b[:, 2])
+        and not np.any(c[:, :2])
+        and np.array_equal(b[:, 0], -a[:, 1])
+        and np.array_equal(b[:, 1], a[:, 0])
+        and not np.any(pa[:, 2])
+        and not np.any(pb[:, 2])
+        and not np.any(pc[:, :2])
+        and np.array_equal(pb[:, 0], -pa[:, 1])
+        and np.array_equal(pb[:, 1], pa[:, 0])
+    )
 
 
 @dataclass(frozen=True)
@@ -274,6 +295,8 @@ class KernelData:
     body : tuple of 3 ndarray
         ``(mass, first, inertia)``: (n,) kg, (n, 3) ``m c`` kg m, (n, 3, 3) about the link
         origins kg m^2; the payload merged into the last link.
+    z_first : bool
+        :func:`z_first` of ``geo``.
     """
 
     chain: Chain
@@ -281,6 +304,7 @@ class KernelData:
     geo: tuple[Array, Array, Array, Array, Array, Array, Array, Array]
     ends: tuple[Array, Array, Array]
     body: tuple[Array, Array, Array]
+    z_first: bool = False
 
 
 #: one KernelData per robot; a robot is immutable, and dropping it drops its entry
@@ -294,10 +318,11 @@ def kernel_data(robot: Robot) -> KernelData:
     if data is None:
         chain = make_chain(robot)
         body = link_inertials(robot)
+        geo = kernel_geometry(chain)
         data = KernelData(
             chain,
             body,
-            kernel_geometry(chain),
+            geo,
             tuple(  # type: ignore[arg-type]
                 np.ascontiguousarray(x, dtype=float)
                 for x in (chain.base[:3, :3], chain.flange[:3, 3], chain.gravity0)
@@ -306,6 +331,7 @@ def kernel_data(robot: Robot) -> KernelData:
                 np.ascontiguousarray(x, dtype=float)
                 for x in (body.mass, body.first_moment, body.inertia_origin)
             ),
+            z_first(geo),
         )
         _KERNEL_DATA[robot] = data
     return data

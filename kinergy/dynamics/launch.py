@@ -55,7 +55,8 @@ def _with_notice(compile_all: Callable[[], None]) -> None:
 def compile_kernels(data: KernelData, *, gradient: bool = False) -> None:
     """Compile (or load from numba's cache) the dynamics kernels once per process (with
     ``gradient``, the regressor gradient's too), with a notice if that takes a while."""
-    if "dynamics" in _compiled and (not gradient or "gradient" in _compiled):
+    zf = data.z_first
+    if f"dynamics{zf}" in _compiled and (not gradient or f"gradient{zf}" in _compiled):
         return
     n = data.geo[0].shape[0]
     z = np.zeros((1, n))
@@ -63,22 +64,39 @@ def compile_kernels(data: KernelData, *, gradient: bool = False) -> None:
 
     def dynamics() -> None:
         args = (data.geo, data.ends, data.body, state, np.empty((0, 6)), np.empty((1, n)))
-        _kernels.rnea_kernel(*args)
-        _kernels.rnea_rows(0, 1, *args)
+        serial, parallel = _rnea(data)
+        parallel(*args)
+        serial(0, 1, *args)
         y = np.empty((1, n, 10 * n))
-        _kernels.regressor_kernel(data.geo, data.ends[2], state, y, True)
-        _kernels.regressor_rows(0, 1, data.geo, data.ends[2], state, y, True)
+        serial, parallel = _regressor(data)
+        parallel(data.geo, data.ends[2], state, y, True)
+        serial(0, 1, data.geo, data.ends[2], state, y, True)
 
     def gradients() -> None:
-        args = (data.geo, data.ends[2], state, np.zeros((1, n, 10 * n)), 1e-5, np.empty((3, 1, n)))
+        w = np.zeros((1, n, 10 * n))
+        args = (data.geo, data.ends[2], state, w, 1e-5, np.empty((3, 1, n)))
         _kernels.regressor_gradient_kernel(*args)
         _kernels.regressor_gradient_rows(0, 1, *args)
 
     with _lock:
         for key, fn in (("dynamics", dynamics), ("gradient", gradients if gradient else None)):
-            if fn is not None and key not in _compiled:
+            if fn is not None and f"{key}{zf}" not in _compiled:
                 _with_notice(fn)
-                _compiled.add(key)
+                _compiled.add(f"{key}{zf}")
+
+
+def _rnea(data: KernelData) -> tuple[Callable[..., None], Callable[..., None]]:
+    """The serial and the parallel RNEA kernel for ``data``'s chain."""
+    if data.z_first:
+        return _kernels.rnea_rows_dh, _kernels.rnea_kernel_dh
+    return _kernels.rnea_rows, _kernels.rnea_kernel
+
+
+def _regressor(data: KernelData) -> tuple[Callable[..., None], Callable[..., None]]:
+    """The serial and the parallel regressor kernel for ``data``'s chain."""
+    if data.z_first:
+        return _kernels.regressor_rows_dh, _kernels.regressor_kernel_dh
+    return _kernels.regressor_rows, _kernels.regressor_kernel
 
 
 def _launch(
@@ -114,7 +132,7 @@ def rnea_into(
     compile_kernels(data)
     ends = data.ends if g0 is None else (data.ends[0], data.ends[1], g0)
     args = (data.geo, ends, data.body, state, wrench, tau)
-    _launch(_kernels.rnea_rows, _kernels.rnea_kernel, tau.shape[0], args, threads)
+    _launch(*_rnea(data), tau.shape[0], args, threads)
 
 
 def regressor_into(
@@ -131,7 +149,7 @@ def regressor_into(
     entries alone: for a ``y`` that holds zeros there (fresh ``np.zeros``, or a regressor)."""
     compile_kernels(data)
     args = (data.geo, data.ends[2] if g0 is None else g0, state, y, clear)
-    _launch(_kernels.regressor_rows, _kernels.regressor_kernel, y.shape[0], args, threads)
+    _launch(*_regressor(data), y.shape[0], args, threads)
 
 
 def regressor_gradient_into(
