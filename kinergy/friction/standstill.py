@@ -11,7 +11,6 @@ overshoot when a joint stops abruptly) does not set that value. It needs samples
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Mapping
 
 import numpy as np
@@ -57,9 +56,6 @@ def sustained(moving: NDArray[np.bool_], wm: Array, min_run: int = MIN_RUN) -> N
     """``moving`` (N,) without its runs in one direction (sign of ``wm``, (N,)) shorter than
     ``min_run`` samples."""
     label = np.where(moving, np.sign(wm), 0.0)
-    cuts = np.flatnonzero(np.diff(label)) + 1
-    out = moving.copy()
-    for start, stop in itertools.pairwise([0, *cuts.tolist(), label.size]):
-        if stop - start < min_run:
-            out[start:stop] = False
-    return out
+    edges = np.concatenate([[0], np.flatnonzero(np.diff(label)) + 1, [label.size]])
+    lengths = np.diff(edges)  # of each run of one label
+    return moving & np.repeat(lengths >= min_run, lengths)
