@@ -19,6 +19,7 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 
 __all__ = [
@@ -32,8 +33,6 @@ __all__ = [
     "scaled_solution",
     "solve_reduced",
 ]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -20,8 +20,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.drives.electrics import (
     back_emf_constants,
     electrical_power,
@@ -35,8 +36,6 @@ from kinergy.dynamics.rnea import gravity_torque, rnea
 from kinergy.model.robot import Robot
 
 __all__ = ["DriveState", "drive_state"]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -37,9 +37,9 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
+from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
 from kinergy.drives.electrics import controller_voltage, winding_resistances
 from kinergy.drives.thermal import joint_losses, joint_temperatures
@@ -53,7 +53,6 @@ from kinergy.trajectory.motion import Motion
 
 __all__ = ["MISMATCHES", "TwinSettings", "realistic_truth", "simulate"]
 
-Array = NDArray[np.float64]
 
 #: what ``--mismatch`` takes: the model itself is the truth, or a realistic true robot
 MISMATCHES = ("none", "realistic")

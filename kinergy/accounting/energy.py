@@ -33,11 +33,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.integrate import trapezoid
 
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy, supply_energy
+from kinergy.arrays import Array
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.io.segments import segment_bounds
 from kinergy.model.robot import Robot
@@ -46,7 +46,6 @@ from kinergy.trajectory.motion import Motion
 
 __all__ = ["EnergyReport", "energy", "part_powers"]
 
-Array = NDArray[np.float64]
 
 BREAKDOWN = ("inertial", "gravity", "friction", "copper")
 

@@ -14,20 +14,18 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.integrate import trapezoid
 
 from kinergy.accounting.energy import BREAKDOWN, part_powers
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy
+from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 from kinergy.predict import DriveState
 
 __all__ = ["EnergyAccumulator"]
-
-Array = NDArray[np.float64]
 
 
 class EnergyAccumulator:

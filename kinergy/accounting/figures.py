@@ -11,14 +11,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy
+from kinergy.arrays import Array
 from kinergy.jsonable import to_jsonable
 
 __all__ = ["EnergyFigures"]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

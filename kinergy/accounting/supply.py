@@ -13,9 +13,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from scipy.integrate import trapezoid
 
+from kinergy.arrays import Array
 from kinergy.drives.bus import SupplyPower, supply_power
 from kinergy.io.segments import segment_bounds
 
@@ -28,7 +29,6 @@ __all__ = [
     "supply_energy",
 ]
 
-Array = NDArray[np.float64]
 
 #: what the predicted supply energy includes, as ``energy`` prints it
 PREDICTED_INCLUDES = (

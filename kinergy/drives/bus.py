@@ -19,11 +19,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
+
+from kinergy.arrays import Array
 
 __all__ = ["SupplyPower", "supply_power"]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

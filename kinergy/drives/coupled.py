@@ -37,6 +37,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.drives.electrics import friction_torques, torque_constants
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.errors import KinergyError
@@ -55,8 +56,6 @@ __all__ = [
     "motor_share",
     "torque_from_current",
 ]
-
-Array = NDArray[np.float64]
 
 
 def coupled_joint_dynamics(

@@ -31,8 +31,9 @@ catalogue conversion: 0.89). docs/FRICTION.md has the whole reconciliation.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.friction.registry import friction_torque
 from kinergy.model.robot import Robot
 
@@ -48,7 +49,6 @@ __all__ = [
     "winding_resistances",
 ]
 
-Array = NDArray[np.float64]
 
 #: equivalent DC motor voltage per volt of the controller's dq voltage (module docstring)
 DQ_VOLTAGE_FACTOR = 1.5

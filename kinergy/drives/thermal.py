@@ -22,15 +22,14 @@ al. 2021), lowers its friction: the framework doc's "thermal effects" (section 5
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.drives.electrics import winding_resistances
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot, Thermal
 
 __all__ = ["joint_losses", "joint_temperatures", "thermal_models"]
-
-Array = NDArray[np.float64]
 
 
 def thermal_models(robot: Robot) -> list[Thermal]:

@@ -21,8 +21,9 @@ side) is in :mod:`kinergy.drives.coupled`.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.model.robot import Robot
 
 __all__ = [
@@ -33,8 +34,6 @@ __all__ = [
     "rotor_inertia",
     "transmission_matrix",
 ]
-
-Array = NDArray[np.float64]
 
 
 def transmission_matrix(robot: Robot) -> Array:

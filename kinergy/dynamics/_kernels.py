@@ -32,9 +32,8 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
-from numpy.typing import NDArray
 
-Array = NDArray[np.float64]
+from kinergy.arrays import Array
 
 __all__ = [
     "GRADIENT_CHUNK",

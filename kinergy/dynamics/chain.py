@@ -19,8 +19,9 @@ from dataclasses import dataclass
 from typing import TypeGuard
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot, inertia_matrix
 
@@ -38,8 +39,6 @@ __all__ = [
     "output_array",
     "z_first",
 ]
-
-Array = NDArray[np.float64]
 
 
 def _rot_x(angle: float) -> Array:

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 
@@ -46,7 +47,6 @@ __all__ = [
     "wrap_near",
 ]
 
-Array = NDArray[np.float64]
 
 #: number of closed-form branches of a UR arm (shoulder x wrist x elbow)
 BRANCHES = 8

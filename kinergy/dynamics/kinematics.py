@@ -7,14 +7,13 @@ same leading rank. Poses are 4x4 homogeneous transforms in the robot's base fram
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.dynamics.chain import Chain, check_state, kernel_data
 from kinergy.model.robot import Robot
 
 __all__ = ["flange_pose", "jacobian", "joint_axes", "link_poses", "rot_z_batch"]
-
-Array = NDArray[np.float64]
 
 
 def rot_z_batch(q: Array) -> Array:

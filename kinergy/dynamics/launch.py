@@ -15,8 +15,8 @@ from collections.abc import Callable
 
 import numba
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.dynamics import _kernels
 from kinergy.dynamics.chain import KernelData
 from kinergy.dynamics.threads import kernel_threads
@@ -29,7 +29,6 @@ __all__ = [
     "rnea_into",
 ]
 
-Array = NDArray[np.float64]
 
 #: batches up to this many samples run serially
 SERIAL_ROWS = 256

@@ -11,9 +11,10 @@ its geometric Jacobian.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
+from kinergy.arrays import Array
 from kinergy.dynamics.kinematics import flange_pose, jacobian
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
@@ -25,8 +26,6 @@ __all__ = [
     "tcp_jacobian",
     "tcp_pose",
 ]
-
-Array = NDArray[np.float64]
 
 
 def pose_matrix(pose: ArrayLike) -> Array:

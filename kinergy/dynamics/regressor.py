@@ -24,6 +24,7 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.dynamics.chain import (
     check_state,
     contiguous_state,
@@ -49,7 +50,6 @@ __all__ = [
     "regressor_gradient",
 ]
 
-Array = NDArray[np.float64]
 
 #: Names of the 10 standard parameters of one link, in order.
 PARAMETER_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")

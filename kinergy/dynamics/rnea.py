@@ -15,8 +15,9 @@ the joints only.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.dynamics.chain import (
     check_state,
     contiguous_state,
@@ -30,8 +31,6 @@ from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 
 __all__ = ["forward_dynamics", "gravity_torque", "mass_matrix", "rnea"]
-
-Array = NDArray[np.float64]
 
 
 def _check_wrench(wrench: ArrayLike | None, rows: int, single: bool) -> Array | None:

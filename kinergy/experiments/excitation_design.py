@@ -26,8 +26,8 @@ from typing import Any
 
 import numpy as np
 import scipy.optimize
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.experiments.excitation_problem import ExcitationProblem
 from kinergy.experiments.excitation_regression import scaled_condition
@@ -37,7 +37,6 @@ from kinergy.trajectory.motion import Motion
 
 __all__ = ["Excitation", "Progress", "design_excitation", "random_feasible"]
 
-Array = NDArray[np.float64]
 
 #: progress callback: (start number from 1, SLSQP iteration (0 = the start point), condition number)
 Progress = Callable[[int, int, float], None]

@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.dynamics.chain import kernel_data
 from kinergy.dynamics.kinematics import joint_axes
 from kinergy.errors import KinergyError
@@ -42,7 +43,6 @@ __all__ = [
     "frame_heights",
 ]
 
-Array = NDArray[np.float64]
 
 #: frames kept above the floor: the flange only, or the flange and every link frame from the second
 FLOOR_FRAMES = ("flange", "links")

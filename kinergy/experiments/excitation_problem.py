@@ -39,8 +39,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.experiments.excitation_limits import (
     ExcitationLimits,
@@ -66,8 +67,6 @@ from kinergy.trajectory.fourier import fourier_motion
 from kinergy.trajectory.motion import Motion
 
 __all__ = ["ExcitationProblem", "excitation_problem"]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

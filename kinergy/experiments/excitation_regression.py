@@ -38,6 +38,7 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.drives.transmission import motor_speed, transmission_matrix
 from kinergy.dynamics.regressor import (
     BaseParameters,
@@ -58,7 +59,6 @@ __all__ = [
     "scaled_condition",
 ]
 
-Array = NDArray[np.float64]
 
 #: optimisation criteria: condition number, D-optimality
 CRITERIA = ("cond", "dopt")

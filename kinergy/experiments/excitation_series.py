@@ -23,13 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.trajectory.fourier import fourier_basis
 
 __all__ = ["FourierParametrisation", "SeriesGrid", "sample_times"]
-
-Array = NDArray[np.float64]
 
 
 def _null_basis(harmonics: int) -> Array:

@@ -21,6 +21,7 @@ import numpy as np
 import scipy.optimize
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.dynamics.chain import make_chain
 from kinergy.dynamics.kinematics import joint_axes
 from kinergy.errors import KinergyError
@@ -29,7 +30,6 @@ from kinergy.trajectory.motion import Motion
 
 __all__ = ["FrictionRun", "back_and_forth_motion", "default_speeds", "vertical_axis_pose"]
 
-Array = NDArray[np.float64]
 #: ``x -> z_j(x) x g_hat``: the moving joint's axis crossed with gravity's direction, shape (3,)
 _TiltFunction = Callable[[Array], Array]
 

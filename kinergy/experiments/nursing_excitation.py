@@ -9,8 +9,8 @@ a robot's limits.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.experiments.nursing_doc import BASE_FREQUENCY, DOC_TABLE6
 from kinergy.model.robot import Robot
@@ -18,8 +18,6 @@ from kinergy.trajectory.fourier import fourier_motion
 from kinergy.trajectory.motion import Motion
 
 __all__ = ["table6_motion"]
-
-Array = NDArray[np.float64]
 
 
 def _limit_scales(robot: Robot, q0: Array, one: Motion) -> tuple[Array, list[str]]:

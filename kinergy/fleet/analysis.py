@@ -30,10 +30,10 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.integrate import cumulative_trapezoid
 
 from kinergy.accounting.energy import energy
+from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
 from kinergy.drives.electrics import torque_constants
 from kinergy.drives.transmission import transmission_matrix
@@ -50,7 +50,6 @@ from kinergy.model.robot import Robot
 
 __all__ = ["CycleRecord", "LogResult", "analyse_log"]
 
-Array = NDArray[np.float64]
 
 PARTS = ("inertial", "gravity", "friction", "copper")
 

@@ -30,7 +30,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
+
+from kinergy.arrays import Array
 
 __all__ = [
     "DRIFT_SIGMAS",
@@ -43,7 +44,6 @@ __all__ = [
     "trend",
 ]
 
-Array = NDArray[np.float64]
 
 STEP_SIGMAS = 6.0
 DRIFT_SIGMAS = 4.0

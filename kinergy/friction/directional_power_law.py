@@ -15,15 +15,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.friction.model import FrictionModel
 from kinergy.friction.power_law import speed_power
 from kinergy.friction.viscous_coulomb import sign
 
 __all__ = ["MODEL"]
 
-Array = NDArray[np.float64]
 
 _LINEAR = ("coulomb_positive", "coulomb_negative", "viscous_positive", "viscous_negative")
 

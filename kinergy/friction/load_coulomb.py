@@ -16,14 +16,12 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.friction.model import FrictionModel, needed
 from kinergy.friction.viscous_coulomb import sign
 
 __all__ = ["MODEL"]
-
-Array = NDArray[np.float64]
 
 
 def _torque(

@@ -19,16 +19,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.friction.model import FrictionModel, needed
 from kinergy.friction.power_law import speed_power
 from kinergy.friction.thermal_viscous import REFERENCE_TEMPERATURE, warming
 from kinergy.friction.viscous_coulomb import sign
 
 __all__ = ["MODEL"]
-
-Array = NDArray[np.float64]
 
 
 def _columns(

@@ -10,11 +10,10 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.friction.model import FrictionModel
-
-Array = NDArray[np.float64]
 
 __all__ = ["MODEL", "PARAMETERS", "makkar", "makkar_columns"]
 

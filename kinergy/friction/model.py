@@ -11,13 +11,12 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 
 __all__ = ["Columns", "FrictionModel", "Torque", "needed"]
 
-Array = NDArray[np.float64]
 
 #: ``torque(params, wm, tau_load, temperature) -> (N,)``: friction torque, motor side, N m.
 #: ``tau_load`` (N m, motor side) and ``temperature`` (deg C, the joint's) may be None when the

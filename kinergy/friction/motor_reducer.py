@@ -11,12 +11,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.friction.model import FrictionModel
 from kinergy.friction.viscous_coulomb import columns, sign
-
-Array = NDArray[np.float64]
 
 
 def _torque(

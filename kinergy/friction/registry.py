@@ -9,8 +9,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction import (
     directional_power_law,
@@ -39,7 +39,6 @@ __all__ = [
     "with_linear_parameters",
 ]
 
-Array = NDArray[np.float64]
 
 #: every friction model, by the name robot files use
 MODELS: dict[str, FrictionModel] = {

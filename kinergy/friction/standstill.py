@@ -16,9 +16,10 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
+
 __all__ = ["MIN_RUN", "OPTIONAL_PARAMETERS", "STILL_RATE", "hold", "hold_standstill", "sustained"]
 
-Array = NDArray[np.float64]
 
 #: optional parameters of every model and their defaults
 OPTIONAL_PARAMETERS = {"standstill": 0.0, "holding": 1.0}

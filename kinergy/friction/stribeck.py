@@ -7,12 +7,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.friction.model import FrictionModel
 from kinergy.friction.viscous_coulomb import sign
-
-Array = NDArray[np.float64]
 
 
 def _bump(p: Mapping[str, float], wm: Array) -> Array:

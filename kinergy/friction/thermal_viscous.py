@@ -18,14 +18,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.friction.model import FrictionModel
 from kinergy.friction.viscous_coulomb import sign
 
 __all__ = ["MODEL", "REFERENCE_TEMPERATURE", "warming"]
 
-Array = NDArray[np.float64]
 
 #: the reference temperature fits start from, deg C (a UR joint a few degrees above room)
 REFERENCE_TEMPERATURE = 25.0

@@ -6,11 +6,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.friction.model import FrictionModel
-
-Array = NDArray[np.float64]
 
 
 def sign(wm: Array, smoothing: float) -> Array:

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.dynamics.regressor import BaseParameters, inertial_parameters, regressor
 from kinergy.friction.registry import (
@@ -48,7 +49,6 @@ __all__ = [
     "stack",
 ]
 
-Array = NDArray[np.float64]
 
 #: friction models whose columns depend on the load torque (the direction of power flow)
 LOAD_DEPENDENT = ("power_flow",)

@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import cvxpy as cp
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.dynamics.regressor import BaseParameters
 from kinergy.friction.registry import get_model
 from kinergy.identify.columns import Columns
@@ -47,7 +47,6 @@ from kinergy.identify.regression import Solved
 
 __all__ = ["MARGIN", "ConstrainedFit", "bounds", "physical_fit"]
 
-Array = NDArray[np.float64]
 
 #: smallest eigenvalue of each link's scaled pseudo-inertia (kg and LENGTH_SCALE as units)
 MARGIN = 1e-5

@@ -14,13 +14,12 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 
 __all__ = ["cycle_average", "find_period"]
-
-Array = NDArray[np.float64]
 
 
 def cycle_average(

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.dynamics.rnea import rnea
 from kinergy.errors import KinergyError
@@ -64,7 +65,6 @@ __all__ = [
     "with_rotor_inertias",
 ]
 
-Array = NDArray[np.float64]
 
 #: joint speed below which a joint counts as still, rad/s
 STILL_SPEED = 0.005

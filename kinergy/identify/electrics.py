@@ -19,8 +19,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
 from kinergy.errors import KinergyError
 from kinergy.linalg import Reduced, scaled_lstsq, scaled_solution
@@ -35,8 +36,6 @@ __all__ = [
     "fit_standby",
     "with_electrics",
 ]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import (
     friction_columns,
@@ -32,7 +33,6 @@ from kinergy.linalg import scaled_lstsq
 
 __all__ = ["CurveFit", "FrictionPoints", "choose_model", "fit_curve", "points_from", "search_shape"]
 
-Array = NDArray[np.float64]
 
 #: trial values of a searched shape parameter before the bounded refinement
 SEARCH_GRID = 15

@@ -22,11 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 
 __all__ = ["FrictionPoints", "constant_speed_runs", "friction_points", "odd_even_friction"]
-
-Array = NDArray[np.float64]
 
 
 def odd_even_friction(

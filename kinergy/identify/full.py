@@ -71,8 +71,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.dynamics.regressor import BaseParameters, base_parameters, inertial_parameters
 from kinergy.errors import KinergyError
@@ -115,7 +115,6 @@ __all__ = [
     "rescaled",
 ]
 
-Array = NDArray[np.float64]
 
 #: signals the regression can be made against; "auto" picks torque, else moment, else current
 TARGETS = ("auto", "moment", "torque", "current")

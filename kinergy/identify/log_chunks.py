@@ -43,9 +43,9 @@ from dataclasses import dataclass
 from typing import BinaryIO
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.identify.preprocess import (
     JOINT_SIGNALS,
@@ -79,7 +79,6 @@ __all__ = [
     "streamable",
 ]
 
-Array = NDArray[np.float64]
 
 #: the signals identification takes from a log (those it has are spilled)
 SIGNALS = (*JOINT_SIGNALS, "actual_robot_voltage", "actual_robot_current")

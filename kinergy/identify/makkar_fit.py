@@ -19,9 +19,10 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.optimize
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from scipy.ndimage import minimum_filter
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction.makkar import PARAMETERS as _MAKKAR
 from kinergy.friction.makkar import makkar, makkar_columns
@@ -31,7 +32,6 @@ from kinergy.identify.pso import SwarmResult, particle_swarm
 
 __all__ = ["MakkarFit", "fit_makkar_lsq", "fit_makkar_pso"]
 
-Array = NDArray[np.float64]
 Seed = np.random.Generator | int | None
 
 #: gamma1, gamma4, gamma6: the parameters the model is linear in

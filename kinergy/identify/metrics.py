@@ -5,11 +5,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
+
+from kinergy.arrays import Array
 
 __all__ = ["JointMetrics", "MetricSums", "fit_metrics", "r_squared", "rmse"]
-
-Array = NDArray[np.float64]
 
 
 def r_squared(measured: ArrayLike, predicted: ArrayLike) -> Array:

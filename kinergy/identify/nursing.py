@@ -32,8 +32,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.drives.coupled import (
     joint_friction,
     joint_kind,
@@ -78,7 +79,6 @@ __all__ = [
     "identify_nursing",
 ]
 
-Array = NDArray[np.float64]
 #: a Makkar fit of joint-side friction points: ``(speeds, friction) -> MakkarFit``
 Fitter = Callable[[Array, Array], MakkarFit]
 

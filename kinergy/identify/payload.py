@@ -28,8 +28,8 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.drives.electrics import torque_constants
 from kinergy.drives.transmission import joint_torque
 from kinergy.dynamics.regressor import regressor
@@ -42,7 +42,6 @@ from kinergy.predict import drive_state
 
 __all__ = ["BLOCKS", "MAX_COM_STD", "PayloadEstimate", "block_std", "identify_payload"]
 
-Array = NDArray[np.float64]
 
 #: inertia terms are reported only when their relative standard deviation is below this
 MAX_INERTIA_SPREAD = 0.2

@@ -14,8 +14,9 @@ checks that a link is a real body:
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.dynamics.regressor import BaseParameters
 from kinergy.model.robot import Robot
 
@@ -31,7 +32,6 @@ __all__ = [
     "standard_from_base",
 ]
 
-Array = NDArray[np.float64]
 
 #: length (m) that puts masses, first moments and inertias on one scale when "closest" is measured
 LENGTH_SCALE = 0.1

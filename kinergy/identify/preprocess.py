@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 
@@ -50,7 +51,6 @@ __all__ = [
     "uniform_grid",
 ]
 
-Array = NDArray[np.float64]
 
 #: runtime_state PLAYING and robot_mode RUNNING in RTDE
 _PLAYING = 2

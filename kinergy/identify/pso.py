@@ -28,13 +28,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 
 __all__ = ["SwarmResult", "constriction", "particle_swarm"]
-
-Array = NDArray[np.float64]
 
 
 def constriction(c1: float = 2.05, c2: float = 2.05) -> float:

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction import get_model
 from kinergy.identify.columns import (
@@ -51,7 +52,6 @@ __all__ = [
     "solve",
 ]
 
-Array = NDArray[np.float64]
 Index = NDArray[np.intp]
 
 #: the column-scaled stacked regressor, after merged columns are dropped, is singular beyond this

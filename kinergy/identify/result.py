@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.drives.transmission import joint_torque
 from kinergy.identify.metrics import JointMetrics, fit_metrics
 from kinergy.identify.preprocess import IdentData
@@ -44,7 +44,6 @@ __all__ = [
     "validation_metrics",
 ]
 
-Array = NDArray[np.float64]
 
 #: a per-joint metrics field: one entry per joint, or None when no log has the signal
 Metrics = tuple[JointMetrics, ...] | None

@@ -13,8 +13,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.dynamics.regressor import BaseParameters, base_parameters
 from kinergy.dynamics.regressor import regressor as full_regressor
 from kinergy.errors import KinergyError
@@ -23,8 +24,6 @@ from kinergy.linalg import Reduced, reduce, solve_reduced
 from kinergy.model.robot import Robot
 
 __all__ = ["RidgeFit", "gcv_scores", "ridge_minimal"]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

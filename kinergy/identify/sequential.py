@@ -28,6 +28,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import (
     get_model,
@@ -78,8 +79,6 @@ __all__ = [
     "rotor_inertias",
     "sequential_from",
 ]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -48,6 +48,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
 from kinergy.drives.electrics import electrical_power, equivalent_voltage, torque_constants
 from kinergy.drives.transmission import transmission_matrix
@@ -81,7 +82,6 @@ from kinergy.predict import drive_state
 
 __all__ = ["LogsInChunks", "Segment", "WholeSegment", "streams"]
 
-Array = NDArray[np.float64]
 
 #: IdentData fields that hold samples, (N, ...) each
 _FIELDS = tuple(

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.identify.metrics import JointMetrics, fit_metrics
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import Validation, predict
@@ -36,7 +37,6 @@ __all__ = [
     "validation_report",
 ]
 
-Array = NDArray[np.float64]
 
 #: rad/s: a sample where every joint is slower than this belongs to a static hold
 HOLD_SPEED = 0.02

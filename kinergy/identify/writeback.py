@@ -22,9 +22,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-import numpy as np
-from numpy.typing import NDArray
-
+from kinergy.arrays import Array
 from kinergy.dynamics.regressor import BaseParameters, inertial_parameters, parameter_names
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import get_model, with_linear_parameters
@@ -43,7 +41,6 @@ from kinergy.model.robot import Drive, Friction, Joint, Link, Robot, Source
 
 __all__ = ["CLOSEST", "CONSTRAINED", "WriteBack", "write_back"]
 
-Array = NDArray[np.float64]
 
 #: how the links were written: the closest standard parameters, or the constrained fit
 CLOSEST = "closest"

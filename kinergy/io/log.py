@@ -12,11 +12,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 
 __all__ = ["TIME_UNITS", "Log", "gaps", "sample_period", "time_unit"]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

@@ -11,13 +11,12 @@ from __future__ import annotations
 from collections.abc import Iterator, Sequence
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.io.log_layout import LogLayout
 
 __all__ = ["NotPlain", "arrow_chunks"]
 
-Array = NDArray[np.float64]
 
 #: the name given to the empty field after a trailing delimiter
 _TRAILING = "\x00trailing"

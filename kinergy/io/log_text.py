@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.io.columns import printable
 from kinergy.io.log_layout import LogLayout
@@ -20,8 +21,6 @@ if TYPE_CHECKING:
     import pandas as pd
 
 __all__ = ["read_text_table"]
-
-Array = NDArray[np.float64]
 
 
 def read_text_table(layout: LogLayout, *, repair: bool = False) -> tuple[Array, list[str]]:

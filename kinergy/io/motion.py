@@ -8,17 +8,15 @@ computed from a cubic spline through the samples of each segment (:mod:`kinergy.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 from kinergy.io.segments import segment_bounds
 from kinergy.trajectory.motion import Motion
 
 __all__ = ["motion_from_log"]
-
-Array = NDArray[np.float64]
 
 
 def _derivatives(t: Array, x: Array, order: int, bounds: list[tuple[int, int]]) -> Array:

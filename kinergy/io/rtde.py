@@ -21,8 +21,8 @@ from pathlib import Path
 from typing import IO
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
 from kinergy.io.columns import group_columns, parse_columns
@@ -33,8 +33,6 @@ from kinergy.io.log_layout import LogLayout, log_layout
 from kinergy.io.log_text import read_text_table
 
 __all__ = ["RTDE", "iter_log", "parse_columns", "read_log", "write_log"]
-
-Array = NDArray[np.float64]
 
 
 def _selection(layout: LogLayout, select: Sequence[str] | None) -> dict[str, list[int]]:

@@ -37,8 +37,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import read_toml
 from kinergy.model.robot import Robot
@@ -46,7 +46,6 @@ from kinergy.trajectory.programs import paper_speed, paper_waypoints
 
 __all__ = ["BUILTIN_TASKS", "Task", "load_task", "task_from_dict"]
 
-Array = NDArray[np.float64]
 
 #: built-in task name -> seed of :func:`kinergy.trajectory.programs.paper_waypoints`
 BUILTIN_TASKS = {"test-a": 1, "test-b": 2}

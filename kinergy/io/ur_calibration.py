@@ -29,14 +29,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import read_text
 
 __all__ = ["Calibration", "JointCalibration", "read_ur_calibration"]
 
-Array = NDArray[np.float64]
 
 _SUMMARY = ("K_tau", "tau_avg", "Stiction-", "Stiction+", "TauMax-", "TauMax+", "Avg. temp.")
 _POINTS = ("Ang. vel.", "U", "I", "Temp", "Tau", "Km")

@@ -20,8 +20,9 @@ from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
 from kinergy.trajectory.movej import check_waypoints, per_move
@@ -35,8 +36,6 @@ __all__ = [
     "servoj_program",
     "write_script",
 ]
-
-Array = NDArray[np.float64]
 
 
 def _num(x: float) -> str:

@@ -25,17 +25,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.integrate import trapezoid
 
 from kinergy.accounting.energy import energy
+from kinergy.arrays import Array
 from kinergy.identify.cycles import find_period
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion
 
 __all__ = ["MONITOR_FIELDS", "CycleEnergy", "CycleTracker"]
 
-Array = NDArray[np.float64]
 
 #: what the monitor subscribes to
 MONITOR_FIELDS = (

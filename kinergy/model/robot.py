@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import check_friction
 
@@ -41,7 +41,6 @@ __all__ = [
     "inertia_matrix",
 ]
 
-Array = NDArray[np.float64]
 
 #: ``dh``: frame i = frame i-1 · Rz(q_i + offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i).
 #: ``mdh`` (Craig): frame i = frame i-1 · Rx(alpha_{i-1}) · Tx(a_{i-1}) · Rz(q_i + offset_i) · Tz(d_i),

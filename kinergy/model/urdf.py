@@ -37,8 +37,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.model.robot import (
     SOURCE_CATEGORIES,
@@ -53,7 +53,6 @@ from kinergy.model.robot import (
 
 __all__ = ["mdh_frames", "mdh_parameters", "mdh_transform", "robot_from_urdf"]
 
-Array = NDArray[np.float64]
 
 #: Consecutive axes closer than this to parallel (|sin| of the angle between them) are treated as
 #: parallel. URDF files often write pi/2 as 1.5708 (3.7e-6 rad off); taking such axes as skew would

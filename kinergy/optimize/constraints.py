@@ -13,8 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.drives.transmission import joint_torque
 from kinergy.model.robot import Robot
 from kinergy.optimize.program import ProgramSamples
@@ -23,7 +23,6 @@ from kinergy.trajectory.motion import Motion
 
 __all__ = ["LIMIT_TOL", "LimitCheck", "limit_violations", "torque_ratio"]
 
-Array = NDArray[np.float64]
 
 #: a sample is within a limit when ``|x| / limit <= 1 + LIMIT_TOL``
 LIMIT_TOL = 1e-9

@@ -31,14 +31,12 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
 from kinergy.optimize.program import ProgramSamples
 
 __all__ = ["PROGRAM_OBJECTIVE", "ElectricalEnergy", "Objective", "SupplyEnergy", "bus_power"]
-
-Array = NDArray[np.float64]
 
 
 class Objective(Protocol):

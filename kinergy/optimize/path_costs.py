@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.dynamics.ik import ik_branches, joint_limits, wrap_choices, wrap_near
 from kinergy.dynamics.poses import rotation_about_z, tcp_pose
 from kinergy.errors import KinergyError
@@ -39,7 +40,6 @@ from kinergy.trajectory.program_path import ProgramPath
 
 __all__ = ["TargetStates", "move_costs", "refined_turns", "symmetry_angles", "target_states"]
 
-Array = NDArray[np.float64]
 
 #: Gauss-Legendre nodes per phase (ramp up, cruise, braking) of the estimate
 _NODES = 4

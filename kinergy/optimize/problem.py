@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import torque_ratio
@@ -37,7 +38,6 @@ __all__ = [
     "uniform_scaling",
 ]
 
-Array = NDArray[np.float64]
 
 #: ``(t, f) -> (objective, torque_ratio)`` of B programs, see :class:`TimingProblem`
 Evaluator = Callable[[Array, Array], tuple[Array, Array]]

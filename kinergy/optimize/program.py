@@ -25,6 +25,7 @@ from typing import Any, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.dynamics.threads import kernel_threads
 from kinergy.model.robot import Robot
 from kinergy.predict import DriveState, drive_state
@@ -42,7 +43,6 @@ __all__ = [
     "settings",
 ]
 
-Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]
 
 #: Gauss-Legendre quadrature: sub-intervals per piece and nodes per sub-interval

@@ -26,9 +26,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from kinergy.accounting.energy import part_powers
+from kinergy.arrays import Array
 from kinergy.drives.electrics import friction_torques
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.model.robot import Robot
@@ -38,7 +38,6 @@ from kinergy.trajectory.program_motion import payload_index
 
 __all__ = ["EnergyFloor", "energy_floor"]
 
-Array = NDArray[np.float64]
 
 #: load torque (motor side, N m) that sets the power-flow direction of the friction floor
 _FLOW = 1e-9

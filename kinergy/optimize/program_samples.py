@@ -19,6 +19,7 @@ from dataclasses import fields
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.model.robot import Payload, Robot
 from kinergy.optimize.program import (
     ProgramSamples,
@@ -39,7 +40,6 @@ from kinergy.trajectory.program_path import ProgramPath
 
 __all__ = ["drive_by_payload", "grid_path_samples", "path_schedule", "sample_path_programs"]
 
-Array = NDArray[np.float64]
 
 #: Gauss-Legendre sub-intervals per piece (the 500 Hz re-simulation makes the final figures)
 _SUB = 2

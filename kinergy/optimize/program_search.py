@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.dynamics.ik import joint_limits, wrap_near
 from kinergy.dynamics.poses import pose_vector
 from kinergy.model.robot import Robot
@@ -27,8 +28,6 @@ from kinergy.trajectory.program_path import ProgramPath
 from kinergy.trajectory.robot_program import Move
 
 __all__ = ["cheapest_cycle", "chosen_moves", "lever_mask", "masked", "wrapped_moves"]
-
-Array = NDArray[np.float64]
 
 
 def cheapest_cycle(costs: list[Array]) -> tuple[NDArray[np.intp], float]:

@@ -24,8 +24,8 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import torque_ratio
@@ -38,8 +38,6 @@ from kinergy.optimize.verify import ProgramResult
 from kinergy.trajectory.program_path import ProgramPath, line_joints
 
 __all__ = ["PathChecks", "path_caps", "path_problem", "retime", "scaled_to"]
-
-Array = NDArray[np.float64]
 
 
 def path_caps(

@@ -21,9 +21,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from kinergy.accounting.energy import energy
+from kinergy.arrays import Array
 from kinergy.dynamics.poses import tcp_pose
 from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import limit_violations
@@ -37,7 +37,6 @@ from kinergy.trajectory.program_path import ProgramPath
 
 __all__ = ["SYMMETRIES", "PathRun", "TargetCheck", "simulate_path", "target_errors"]
 
-Array = NDArray[np.float64]
 
 #: tool symmetries about the tool z axis: name -> number of equivalent turns (0: any angle)
 SYMMETRIES = {"none": 1, "z2": 2, "z4": 4, "z": 0}

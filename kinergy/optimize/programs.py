@@ -63,7 +63,6 @@ from kinergy.trajectory.robot_program import Move, RobotProgram
 
 __all__ = ["Lever", "ProgramOptimization", "optimize_program", "supply", "via_blends"]
 
-Array = NDArray[np.float64]
 
 #: a via point's blend radius: this share of the shorter tool distance of its two moves, ...
 _BLEND_SHARE = 0.4

@@ -26,12 +26,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize
 
+from kinergy.arrays import Array
 from kinergy.optimize.problem import TimingProblem
 from kinergy.optimize.program import durations, settings
 
 __all__ = ["Solution", "solve_timing"]
 
-Array = NDArray[np.float64]
 
 #: relative forward-difference step in the decision variables
 _FD_STEP = 1e-6

@@ -63,8 +63,9 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import LIMIT_TOL
@@ -88,8 +89,6 @@ __all__ = [
     "pareto_front",
     "uniform_wins",
 ]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

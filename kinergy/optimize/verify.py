@@ -14,10 +14,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from scipy.integrate import cumulative_trapezoid
 
 from kinergy.accounting.energy import energy
+from kinergy.arrays import Array
 from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import LimitCheck, limit_violations
 from kinergy.optimize.objectives import Objective
@@ -26,7 +27,6 @@ from kinergy.trajectory.movej import movej, plan_movej
 
 __all__ = ["VERIFY_DT", "ProgramResult", "program_energy", "simulate_program"]
 
-Array = NDArray[np.float64]
 
 #: sample period of every verification: the UR controller's 500 Hz
 VERIFY_DT = 0.002

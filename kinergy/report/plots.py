@@ -32,6 +32,7 @@ from matplotlib.figure import Figure
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import cumulative_trapezoid
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
 from kinergy.identify.metrics import r_squared
@@ -47,7 +48,6 @@ __all__ = [
     "timing_pareto",
 ]
 
-Array = NDArray[np.float64]
 
 DPI = 110
 """Resolution :func:`save` writes at, dots per inch: a 11 x 8 in figure is 1210 x 880 px."""

@@ -14,9 +14,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from kinergy.accounting.energy import EnergyReport
+from kinergy.arrays import Array
 from kinergy.identify.metrics import JointMetrics
 from kinergy.identify.result import IdentificationResult
 from kinergy.model.robot import Robot
@@ -39,8 +39,6 @@ from kinergy.report.tables import (
 )
 
 __all__ = ["Comparison", "Study", "Timing", "study_sections"]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

@@ -12,14 +12,13 @@ them, which :func:`fourier_series` evaluates and the excitation design optimises
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.trajectory.motion import Motion
 
 __all__ = ["fourier_basis", "fourier_motion", "fourier_series"]
-
-Array = NDArray[np.float64]
 
 
 def fourier_basis(

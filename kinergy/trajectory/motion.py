@@ -5,13 +5,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 
 __all__ = ["Motion"]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

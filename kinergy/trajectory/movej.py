@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.trajectory.motion import Motion
 
@@ -43,8 +44,6 @@ __all__ = [
     "trapezoid",
     "trapezoid_timing",
 ]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -25,9 +25,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from kinergy.arrays import Array
 from kinergy.dynamics.ik import URGeometry, ik_branches
 from kinergy.dynamics.poses import tcp_jacobian
 from kinergy.errors import KinergyError
@@ -35,7 +35,6 @@ from kinergy.model.robot import Robot
 
 __all__ = ["ToolSegment", "joints_on_path", "tool_motion", "tool_segment"]
 
-Array = NDArray[np.float64]
 
 #: step of the central difference of the Jacobian along qd, s
 _JDOT_STEP = 1e-5

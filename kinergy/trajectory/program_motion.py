@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.movej import blend_starts, trapezoid, trapezoid_timing
@@ -35,7 +36,6 @@ __all__ = [
     "tool_runs",
 ]
 
-Array = NDArray[np.float64]
 
 #: the controller's sample period, s
 CONTROLLER_DT = 0.002

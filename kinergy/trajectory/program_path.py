@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy.arrays import Array
 from kinergy.dynamics.ik import (
     URGeometry,
     branch_of,
@@ -55,7 +56,6 @@ __all__ = [
     "tool_blend_radius",
 ]
 
-Array = NDArray[np.float64]
 
 #: points a straight tool line is followed at to find its end joints
 _LINE_POINTS = 64

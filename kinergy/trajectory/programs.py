@@ -9,8 +9,8 @@ until the flange and the elbow stay above the table plane over the whole motion.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.dynamics.kinematics import link_poses
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
@@ -26,7 +26,6 @@ __all__ = [
     "paper_waypoints",
 ]
 
-Array = NDArray[np.float64]
 
 #: name -> seed of the UR5e doc's test programs
 TEST_TRAJECTORIES = {"test-a": 1, "test-b": 2}

@@ -17,8 +17,8 @@ import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Payload
 
@@ -30,7 +30,6 @@ __all__ = [
     "Step",
 ]
 
-Array = NDArray[np.float64]
 
 #: URScript's default ``(a, v)`` of each move (rad/s^2, rad/s for movej; m/s^2, m/s otherwise)
 MOVE_DEFAULTS = {"movej": (1.4, 1.05), "movel": (1.2, 0.25), "movep": (1.2, 0.25)}

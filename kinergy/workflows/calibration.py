@@ -23,7 +23,6 @@ import os
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
 from kinergy.drives.electrics import controller_voltage, equivalent_voltage
 from kinergy.errors import KinergyError
@@ -47,7 +46,6 @@ __all__ = [
     "import_calibration",
 ]
 
-Array = NDArray[np.float64]
 
 #: models ``--friction auto`` chooses from: those a calibration's points (no load torque, a few
 #: kelvin of temperature spread) can fit

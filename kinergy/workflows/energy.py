@@ -6,12 +6,12 @@ import dataclasses
 import os
 
 import numpy as np
-from numpy.typing import NDArray
 
 from kinergy.accounting.energy import EnergyReport, energy
 from kinergy.accounting.energy_stream import EnergyAccumulator
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.accounting.supply import measured_supply
+from kinergy.arrays import Array
 from kinergy.io.formats import iter_log
 from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
@@ -27,8 +27,6 @@ __all__ = ["ENERGY_ROWS", "energy_figures_of_log", "energy_of_log"]
 #: samples per chunk of the one-pass energy: 40 s at 500 Hz; the drive state of a chunk holds
 #: about 40 arrays of (rows, n) (60-minute log: peak 400 MB against 530 MB at 50,000 rows)
 ENERGY_ROWS = 20_000
-
-Array = NDArray[np.float64]
 
 
 def _temperature(log: Log, motion: Motion) -> Array | None:

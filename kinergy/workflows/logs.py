@@ -12,9 +12,7 @@ import itertools
 import os
 from collections.abc import Callable, Iterator, Sequence
 
-import numpy as np
-from numpy.typing import NDArray
-
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.identify.log_chunks import prepare_segment, spill_log, streamable
 from kinergy.identify.preprocess import IdentData, prepare
@@ -31,8 +29,6 @@ from kinergy.trajectory.program_motion import program_motion
 from kinergy.trajectory.program_path import program_path
 
 __all__ = ["MIN_SEGMENT", "chunked_logs", "prepared_logs", "read_motion"]
-
-Array = NDArray[np.float64]
 
 
 MIN_SEGMENT = 1.0
