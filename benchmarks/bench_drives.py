@@ -139,23 +139,45 @@ def _current_rms(robot: Robot, data: IdentData) -> np.ndarray:
     return np.sqrt(np.mean((pred - data.current) ** 2, axis=0))
 
 
+#: a joint counts as moving on the held-out log where its speed exceeds this, rad/s
+MOVING = 0.01
+
+
 def ur10e() -> None:
-    """--friction auto against Coulomb + viscous on the held-out UR10e log."""
+    """--friction auto against Coulomb + viscous on the held-out UR10e log, and every candidate
+    model fitted alone; each RMS over the whole log, and split where the joint moves and where
+    it is at rest (a friction-versus-speed model sets the first; the standstill hold the second)."""
     model = kinergy.load_robot("ur10e")
     logs = _ur10e_logs(UR10E / "identification_data" / "*harm*.csv")
     held = _ur10e_logs(UR10E / "validation_data" / "ur-20_01_17-ptp_10_points.csv")[0]
-    rms = {}
-    for friction in ("viscous_coulomb", "auto"):
+    assert held.current is not None
+    moving = np.abs(held.qd) > MOVING
+    runs = ("viscous_coulomb", "auto", "power_law", "stribeck", "load_coulomb", "power_flow")
+    err = {}
+    for friction in runs:
         t0 = time.perf_counter()
         result = identify_model(model, logs, friction=friction)
-        rms[friction] = _current_rms(result.robot, held)
+        err[friction] = predict(result.robot, held).current - held.current
         print(f"{friction}: identified from {len(logs)} logs in {time.perf_counter() - t0:.1f} s")
         if friction == "auto":
             chosen = [c.model if c else "-" for c in result.fit.friction_choice or ()]
-    print("| joint | chosen | RMS C+V [A] | RMS auto [A] | lower by [%] |")
-    for j, name in enumerate(model.joint_names):
-        vc, auto = rms["viscous_coulomb"][j], rms["auto"][j]
-        print(f"| {name} | {chosen[j]} | {vc:.4f} | {auto:.4f} | {100 * (1 - auto / vc):.1f} |")
+
+    def rms(e: np.ndarray, where: np.ndarray) -> np.ndarray:
+        return np.sqrt(np.sum(np.where(where, e, 0.0) ** 2, axis=0) / np.sum(where, axis=0))
+
+    for label, where in (
+        ("whole log", np.ones_like(moving)),
+        ("moving", moving),
+        ("at rest", ~moving),
+    ):
+        share = 100 * np.mean(where, axis=0)
+        print(f"\n{label}: current RMS [A] (share of samples per joint: {share.round(0)} %)")
+        print("| joint | chosen | " + " | ".join(runs) + " | auto vs C+V [%] |")
+        table = {f: rms(err[f], where) for f in runs}
+        for j, name in enumerate(model.joint_names):
+            cells = " | ".join(f"{table[f][j]:.4f}" for f in runs)
+            gain = 100 * (1 - table["auto"][j] / table["viscous_coulomb"][j])
+            print(f"| {name} | {chosen[j]} | {cells} | {-gain:+.1f} |")
 
 
 def excitation(robot: Robot, seconds: float = 60.0, rate: float = 500.0, seed: int = 0) -> Motion:
