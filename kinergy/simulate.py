@@ -44,6 +44,7 @@ from kinergy.drives.bus import supply_power
 from kinergy.drives.electrics import controller_voltage, winding_resistances
 from kinergy.drives.thermal import joint_losses, joint_temperatures
 from kinergy.errors import KinergyError
+from kinergy.friction.model import SMOOTHING
 from kinergy.friction.power_law import speed_power
 from kinergy.friction.registry import friction_torque
 from kinergy.io.log import Log
@@ -278,7 +279,7 @@ def _true_friction(joint: Joint, rng: np.random.Generator, scale: float) -> Fric
             "viscous_temperature": float(-_THERMAL_DROP * viscous * rng.uniform(0.9, 1.1)),
             "exponent": exponent,
             "reference_temperature": 25.0,
-            "smoothing": 1e-3,
+            "smoothing": SMOOTHING,
         },
     )
 

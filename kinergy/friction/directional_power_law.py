@@ -18,7 +18,7 @@ import numpy as np
 
 from kinergy.arrays import Array
 from kinergy.friction.model import FrictionModel
-from kinergy.friction.power_law import speed_power
+from kinergy.friction.power_law import EXPONENT, EXPONENT_SEARCH, speed_power
 from kinergy.friction.viscous_coulomb import sign
 
 __all__ = ["MODEL"]
@@ -49,9 +49,8 @@ MODEL = FrictionModel(
     torque=_torque,
     linear=_LINEAR,
     columns=_columns,
-    positive=frozenset({"smoothing", "exponent"}),
-    bounds={name: (0.0, np.inf) for name in _LINEAR},
-    shape_defaults={"smoothing": 1e-3, "exponent": 0.6},
-    search={"exponent": (0.2, 1.5)},
+    positive=frozenset({"exponent"}),
+    shape_defaults={"exponent": EXPONENT},
+    search={"exponent": EXPONENT_SEARCH},
     citation="power_law per direction of rotation (docs/FRICTION.md)",
 )

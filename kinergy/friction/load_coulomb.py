@@ -45,9 +45,6 @@ MODEL = FrictionModel(
     torque=_torque,
     linear=("coulomb", "load", "viscous"),
     columns=_columns,
-    positive=frozenset({"smoothing"}),
-    bounds={k: (0.0, np.inf) for k in ("coulomb", "load", "viscous")},
-    shape_defaults={"smoothing": 1e-3},
     needs_load=True,
     citation="AURT (INTO-CPS Association); Bittencourt and Gunnarsson 2012",
 )

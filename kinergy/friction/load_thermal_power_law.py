@@ -22,7 +22,7 @@ import numpy as np
 
 from kinergy.arrays import Array
 from kinergy.friction.model import FrictionModel, needed
-from kinergy.friction.power_law import speed_power
+from kinergy.friction.power_law import EXPONENT, EXPONENT_SEARCH, speed_power
 from kinergy.friction.thermal_viscous import REFERENCE_TEMPERATURE, warming
 from kinergy.friction.viscous_coulomb import sign
 
@@ -59,19 +59,10 @@ MODEL = FrictionModel(
     torque=_torque,
     linear=("coulomb", "load", "viscous", "viscous_temperature"),
     columns=_columns,
-    positive=frozenset({"smoothing", "exponent"}),
-    bounds={
-        "coulomb": (0.0, np.inf),
-        "load": (0.0, np.inf),
-        "viscous": (0.0, np.inf),
-        "viscous_temperature": (-np.inf, np.inf),
-    },
-    shape_defaults={
-        "smoothing": 1e-3,
-        "exponent": 0.6,
-        "reference_temperature": REFERENCE_TEMPERATURE,
-    },
-    search={"exponent": (0.2, 1.5)},
+    positive=frozenset({"exponent"}),
+    bounds={"viscous_temperature": (-np.inf, np.inf)},
+    shape_defaults={"exponent": EXPONENT, "reference_temperature": REFERENCE_TEMPERATURE},
+    search={"exponent": EXPONENT_SEARCH},
     needs_load=True,
     needs_temperature=True,
     citation="power_law + load_coulomb + thermal_viscous (docs/FRICTION.md)",

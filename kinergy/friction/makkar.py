@@ -68,7 +68,7 @@ MODEL = FrictionModel(
     torque=_torque,
     linear=("gamma1", "gamma4", "gamma6"),
     columns=_columns,
-    bounds={"gamma1": (-np.inf, np.inf), "gamma4": (0.0, np.inf), "gamma6": (0.0, np.inf)},
+    bounds={"gamma1": (-np.inf, np.inf)},  # its sign goes with gamma2 - gamma3
     shape_defaults={"gamma2": 50.0, "gamma3": 5.0, "gamma5": 100.0},
     citation="nursing eq 13 (Makkar et al.)",
 )

@@ -15,7 +15,13 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 
-__all__ = ["Columns", "FrictionModel", "Torque", "needed"]
+__all__ = ["LEVEL_BOUNDS", "SMOOTHING", "Columns", "FrictionModel", "Torque", "needed"]
+
+#: the smoothing speed ``smoothing`` of ``tanh(wm / smoothing)``, rad/s, that models start from:
+#: far below any motion's motor speed, so the tanh is a sign but for a moment at each reversal
+SMOOTHING = 1e-3
+#: the range of a linear parameter a model gives none for: a friction level, >= 0 (motor side)
+LEVEL_BOUNDS = (0.0, np.inf)
 
 
 #: ``torque(params, wm, tau_load, temperature) -> (N,)``: friction torque, motor side, N m.
@@ -65,11 +71,13 @@ class FrictionModel:
         ``columns(params, wm, tau_load, temperature) -> ndarray (N, len(linear))`` with
         ``torque == columns @ linear_values(params)``.
     positive : frozenset of str
-        Parameters that must be > 0 (they divide).
+        Parameters that must be > 0 (they divide); ``smoothing`` always is.
     bounds : mapping of str to (float, float)
-        Physically plausible range of each linear parameter (motor side), for constrained fits.
+        Physically plausible range of each linear parameter (motor side), for constrained fits;
+        a linear parameter not named here is a level, in :data:`LEVEL_BOUNDS`.
     shape_defaults : mapping of str to float
-        Values a fit starts the non-linear parameters from when a joint switches to this model.
+        Values a fit starts the non-linear parameters from when a joint switches to this model;
+        ``smoothing`` starts from :data:`SMOOTHING` unless named here.
     needs_load : bool
         Whether ``torque`` needs the load torque (power-flow or load-dependent friction).
     needs_temperature : bool
@@ -100,3 +108,12 @@ class FrictionModel:
     with_linear: Callable[[FrictionModel, Mapping[str, float], Array], dict[str, float]] = (
         _replace_by_name
     )
+
+    def __post_init__(self) -> None:
+        bounds = {name: LEVEL_BOUNDS for name in self.linear}
+        bounds.update(self.bounds)
+        object.__setattr__(self, "bounds", bounds)
+        if "smoothing" in self.parameters:
+            object.__setattr__(self, "positive", self.positive | {"smoothing"})
+            defaults = {"smoothing": SMOOTHING, **self.shape_defaults}
+            object.__setattr__(self, "shape_defaults", defaults)

@@ -42,9 +42,6 @@ MODEL = FrictionModel(
     torque=_torque,
     linear=("viscous", "coulomb_direct", "coulomb_reverse"),
     columns=_columns,
-    positive=frozenset({"smoothing"}),
-    bounds={k: (0.0, np.inf) for k in ("viscous", "coulomb_direct", "coulomb_reverse")},
-    shape_defaults={"smoothing": 1e-3},
     needs_load=True,
     citation="UR5e eqs 11-16",
 )

@@ -21,7 +21,12 @@ from kinergy.arrays import Array
 from kinergy.friction.model import FrictionModel
 from kinergy.friction.viscous_coulomb import sign
 
-__all__ = ["MODEL", "speed_power"]
+__all__ = ["EXPONENT", "EXPONENT_SEARCH", "MODEL", "speed_power"]
+
+#: the speed exponent fits start from (a UR5e's calibration: 0.52-0.65) ...
+EXPONENT = 0.6
+#: ... and the range their 1-D search looks in, for every model with a power-law speed term
+EXPONENT_SEARCH = (0.2, 1.5)
 
 
 def speed_power(wm: Array, exponent: float) -> Array:
@@ -49,9 +54,8 @@ MODEL = FrictionModel(
     torque=_torque,
     linear=("coulomb", "viscous"),
     columns=_columns,
-    positive=frozenset({"smoothing", "exponent"}),
-    bounds={"coulomb": (0.0, np.inf), "viscous": (0.0, np.inf)},
-    shape_defaults={"smoothing": 1e-3, "exponent": 0.6},
-    search={"exponent": (0.2, 1.5)},
+    positive=frozenset({"exponent"}),
+    shape_defaults={"exponent": EXPONENT},
+    search={"exponent": EXPONENT_SEARCH},
     citation="power-law speed term (docs/FRICTION.md; fitted to a UR5e's factory calibration)",
 )

@@ -37,8 +37,7 @@ MODEL = FrictionModel(
     torque=_torque,
     linear=("coulomb", "static", "viscous"),
     columns=_columns,
-    positive=frozenset({"smoothing", "stribeck_speed"}),
-    bounds={k: (0.0, np.inf) for k in ("coulomb", "static", "viscous")},
-    shape_defaults={"smoothing": 1e-3, "stribeck_speed": 10.0},
+    positive=frozenset({"stribeck_speed"}),
+    shape_defaults={"stribeck_speed": 10.0},
     citation="Stribeck (Olsson et al. 1998, eq 8)",
 )

@@ -62,13 +62,8 @@ MODEL = FrictionModel(
     torque=_torque,
     linear=("coulomb", "viscous", "viscous_temperature"),
     columns=_columns,
-    positive=frozenset({"smoothing"}),
-    bounds={
-        "coulomb": (0.0, np.inf),
-        "viscous": (0.0, np.inf),
-        "viscous_temperature": (-np.inf, np.inf),
-    },
-    shape_defaults={"smoothing": 1e-3, "reference_temperature": REFERENCE_TEMPERATURE},
+    bounds={"viscous_temperature": (-np.inf, np.inf)},
+    shape_defaults={"reference_temperature": REFERENCE_TEMPERATURE},
     needs_temperature=True,
     citation="Raviola et al. 2021 (viscous friction of UR joints falls 17-20 % as they warm)",
 )

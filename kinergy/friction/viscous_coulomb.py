@@ -35,8 +35,5 @@ MODEL = FrictionModel(
     torque=_torque,
     linear=("viscous", "coulomb"),
     columns=columns,
-    positive=frozenset({"smoothing"}),
-    bounds={"viscous": (0.0, np.inf), "coulomb": (0.0, np.inf)},
-    shape_defaults={"smoothing": 1e-3},
     citation="framework Table 1",
 )

@@ -26,6 +26,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from kinergy.files import output_folder
+from kinergy.friction.model import SMOOTHING
 from kinergy.identify.metrics import fit_metrics
 from kinergy.identify.preprocess import IdentData, prepare
 from kinergy.identify.result import IdentificationResult, predict
@@ -63,7 +64,7 @@ def nominal_drives(robot: Robot) -> Robot:
     joints = []
     for joint in robot.joints:
         params = {name: 0.0 for name in joint.drive.friction.params}
-        params["smoothing"] = joint.drive.friction.params.get("smoothing", 1e-3)
+        params["smoothing"] = joint.drive.friction.params.get("smoothing", SMOOTHING)
         drive = dataclasses.replace(
             joint.drive,
             motor_inertia=0.0,
