@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import click
 
 from kinergy.cli.common import (
@@ -23,7 +21,7 @@ from kinergy.identify.result import FLAGS, IDENTIFIED, DriveEstimate, Identifica
 from kinergy.jsonable import dumps
 from kinergy.model import load_robot
 from kinergy.workflows.identify import METHODS, identify_logs, identify_payload_model
-from kinergy.workflows.logs import prepared_logs
+from kinergy.workflows.logs import LogReading, prepared_logs
 
 __all__ = ["identify"]
 
@@ -228,7 +226,7 @@ def identify(
     actual_current; the full method regresses the base inertial parameters too.
     """
     r = load_robot(robot_name)
-    reading: dict[str, Any] = {"columns": columns, "repair": repair, "cutoff": cutoff, "note": note}
+    reading: LogReading = {"columns": columns, "repair": repair, "cutoff": cutoff, "note": note}
     with progress() as say:
         if payload_only:
             say(f"reading {len(logs)} log(s)")

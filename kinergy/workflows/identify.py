@@ -27,7 +27,7 @@ from kinergy.io.formats import CHUNK_ROWS
 from kinergy.model import Payload, Robot, save_robot
 from kinergy.model.robot import Source
 from kinergy.predict import drive_state
-from kinergy.workflows.logs import chunked_logs, prepared_logs
+from kinergy.workflows.logs import LogReading, chunked_logs, prepared_logs
 
 __all__ = [
     "METHODS",
@@ -235,14 +235,14 @@ def identify_logs(
     paths: Sequence[str | os.PathLike[str]],
     out: str | os.PathLike[str],
     *,
-    reading: dict[str, Any] | None = None,
+    reading: LogReading | None = None,
     rows: int = CHUNK_ROWS,
     **options: Any,
 ) -> IdentificationResult:
     """Read, prepare and identify the logs at ``paths`` and write the model to ``out``.
 
-    ``reading`` holds :func:`~kinergy.workflows.logs.prepared_logs`'s options (``columns``,
-    ``repair``, ``cutoff``, ``note``), ``options`` :func:`identify_model`'s. When the method
+    ``reading`` says how to read the logs (:class:`~kinergy.workflows.logs.LogReading`),
+    ``options`` are :func:`identify_model`'s. When the method
     streams (:func:`kinergy.identify.streamed.streams`: the sequential method with a fixed
     friction model) the logs are read in chunks of ``rows`` samples and never held whole
     (:func:`~kinergy.workflows.logs.chunked_logs`); other methods prepare them in memory.

@@ -11,6 +11,7 @@ import contextlib
 import itertools
 import os
 from collections.abc import Callable, Iterator, Sequence
+from typing import TypedDict, Unpack
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
@@ -28,62 +29,87 @@ from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.program_motion import program_motion
 from kinergy.trajectory.program_path import program_path
 
-__all__ = ["MIN_SEGMENT", "chunked_logs", "prepared_logs", "read_motion"]
+__all__ = ["MIN_SEGMENT", "LogReading", "chunked_logs", "prepared_logs", "read_motion"]
 
 
 MIN_SEGMENT = 1.0
 """Shortest segment of a log (s) :func:`prepared_logs` identifies from."""
 
 
+class LogReading(TypedDict, total=False):
+    """How :func:`prepared_logs` and :func:`chunked_logs` read and prepare each log (every key
+    may be left out).
+
+    Attributes
+    ----------
+    columns : str or None
+        The layout of a headerless file (``--columns``, :mod:`kinergy.io.formats`); None: the
+        file names its columns (UR's record.py layout).
+    repair : bool
+        Drop rows that cannot be read (each drop noted) instead of failing; default False.
+    cutoff : float or None
+        Low-pass cutoff for measured speeds, Hz (:func:`kinergy.identify.preprocess.prepare`);
+        None: its default.
+    note : callable or None
+        Receives what reading changed (rows dropped by ``repair``, segments), one message each.
+    """
+
+    columns: str | None
+    repair: bool
+    cutoff: float | None
+    note: Callable[[str], None] | None
+
+
 def _segments(
-    path: str | os.PathLike[str], t: Array, bounds: list[tuple[int, int]]
-) -> tuple[list[tuple[str, tuple[int, int]]], str | None]:
-    """The segments ``bounds`` of the log at ``path`` (time stamps ``t``) identified from, each
-    with the name :func:`~kinergy.io.segments.split_segments` gives it, and what was done when
-    there are several (None for one): those shorter than :data:`MIN_SEGMENT` are left out."""
-    name = os.fspath(path)
+    path: str | os.PathLike[str],
+    t: Array,
+    segment: Array | None,
+    notes: Sequence[str],
+    note: Callable[[str], None] | None,
+) -> list[tuple[str, tuple[int, int]]]:
+    """The segments of the log at ``path`` identified from (time stamps ``t``, its ``segment``
+    signal if any: :func:`~kinergy.io.segments.segment_bounds`), each with the name
+    :func:`~kinergy.io.segments.split_segments` gives it: those shorter than :data:`MIN_SEGMENT`
+    are left out. ``note`` receives the log's reading ``notes`` and, where there are several
+    segments, what was done with them."""
+    name, bounds = os.fspath(path), segment_bounds(t, segment)
     if len(bounds) == 1:
-        return [(name, bounds[0])], None
-    parts = [(f"{name}#{k}", ab) for k, ab in enumerate(bounds)]
-    kept = [p for p in parts if t[p[1][1] - 1] - t[p[1][0]] >= MIN_SEGMENT] or [
-        max(parts, key=lambda p: p[1][1] - p[1][0])
-    ]
-    gaps = [t[b[0]] - t[a[1] - 1] for a, b in itertools.pairwise(bounds)]
-    message = (
-        f"{path}: {len(parts)} segments (gaps up to {max(gaps):.3f} s), each prepared on "
-        f"its own; {len(parts) - len(kept)} shorter than {MIN_SEGMENT:g} s left out"
-    )
-    return kept, message
+        kept = [(name, bounds[0])]
+    else:
+        parts = [(f"{name}#{k}", ab) for k, ab in enumerate(bounds)]
+        kept = [p for p in parts if t[p[1][1] - 1] - t[p[1][0]] >= MIN_SEGMENT] or [
+            max(parts, key=lambda p: p[1][1] - p[1][0])
+        ]
+        gaps = [t[b[0]] - t[a[1] - 1] for a, b in itertools.pairwise(bounds)]
+        notes = [
+            *notes,
+            f"{path}: {len(parts)} segments (gaps up to {max(gaps):.3f} s), each prepared on "
+            f"its own; {len(parts) - len(kept)} shorter than {MIN_SEGMENT:g} s left out",
+        ]
+    if note is not None:
+        for text in notes:
+            note(text)
+    return kept
 
 
 def prepared_logs(
-    paths: Sequence[str | os.PathLike[str]],
-    *,
-    n_joints: int,
-    columns: str | None = None,
-    repair: bool = False,
-    cutoff: float | None = None,
-    note: Callable[[str], None] | None = None,
+    paths: Sequence[str | os.PathLike[str]], *, n_joints: int, **reading: Unpack[LogReading]
 ) -> list[IdentData]:
     """Read and prepare every log (:func:`kinergy.identify.preprocess.prepare`), each segment of
     a log on its own (:func:`kinergy.io.segments.segment_bounds`: nothing is filtered or
-    differentiated across a gap or a reconnection).
+    differentiated across a gap or a reconnection), as ``reading`` says (:class:`LogReading`).
 
-    ``note`` receives what reading changed (rows dropped by ``repair``, segments), one message
-    each. Segments shorter than :data:`MIN_SEGMENT` seconds are left out and counted.
+    Segments shorter than :data:`MIN_SEGMENT` seconds are left out and counted in a note.
     """
     datas: list[IdentData] = []
     for path in paths:
-        log = read_log(path, columns=columns, repair=repair)
-        kept, message = _segments(path, log.t, segment_bounds(log.t, log.signals.get("segment")))
-        for text in [*log.notes, *([message] if message else [])]:
-            if note is not None:
-                note(text)
-        for name, (a, b) in kept:
+        log = read_log(path, columns=reading.get("columns"), repair=reading.get("repair", False))
+        segment = log.signals.get("segment")
+        for name, (a, b) in _segments(path, log.t, segment, log.notes, reading.get("note")):
             part = Log(
                 name, log.t[a:b], {k: v[a:b] for k, v in log.signals.items()}, list(log.notes)
             )
-            datas.append(prepare(part, n_joints, cutoff=cutoff))
+            datas.append(prepare(part, n_joints, cutoff=reading.get("cutoff")))
     return datas
 
 
@@ -92,29 +118,23 @@ def chunked_logs(
     paths: Sequence[str | os.PathLike[str]],
     *,
     n_joints: int,
-    columns: str | None = None,
-    repair: bool = False,
-    cutoff: float | None = None,
-    note: Callable[[str], None] | None = None,
     rows: int = CHUNK_ROWS,
+    **reading: Unpack[LogReading],
 ) -> Iterator[list[Segment]]:
     """:func:`prepared_logs` as segments that yield their samples in chunks of ``rows``
     (:mod:`kinergy.identify.log_chunks`: each log read once into a temporary spill, removed on
     leaving the context). A log without the commanded motion is prepared whole
     (:class:`~kinergy.identify.streamed.WholeSegment`)."""
+    cutoff = reading.get("cutoff")
     with contextlib.ExitStack() as stack:
         segments: list[Segment] = []
         for path in paths:
-            spill = spill_log(path, columns=columns, repair=repair, rows=rows)
-            stack.callback(spill.close)
-            t = spill.state.t
-            kept, message = _segments(
-                path, t, segment_bounds(t, spill.state.signals.get("segment"))
+            spill = spill_log(
+                path, columns=reading.get("columns"), repair=reading.get("repair", False), rows=rows
             )
-            for text in [*spill.notes, *([message] if message else [])]:
-                if note is not None:
-                    note(text)
-            for name, ab in kept:
+            stack.callback(spill.close)
+            t, segment = spill.state.t, spill.state.signals.get("segment")
+            for name, ab in _segments(path, t, segment, spill.notes, reading.get("note")):
                 if streamable(spill):
                     segments.append(prepare_segment(spill, ab, name, n_joints, cutoff))
                 else:

@@ -19,7 +19,7 @@ from kinergy.model.robot import Robot
 from kinergy.report.html import Section, Table, write_report
 from kinergy.report.study import Comparison, Study, Timing, study_sections
 from kinergy.trajectory.motion import Motion
-from kinergy.workflows.logs import prepared_logs, read_motion
+from kinergy.workflows.logs import LogReading, prepared_logs, read_motion
 from kinergy.workflows.optimize import optimize_task
 
 __all__ = ["optimal_timing", "run_study", "study_report", "write_study"]
@@ -134,20 +134,18 @@ def study_report(
     system's temporary folder. Returns the path of ``report.html`` and the tables.
     """
     say = progress or (lambda _msg: None)
+    reading: LogReading = {"columns": columns, "repair": repair, "note": note}
     result = None
     if identify_logs:
         say("identifying")
-        datas = prepared_logs(
-            identify_logs, n_joints=robot.n, columns=columns, repair=repair, note=note
+        result = identify_sequential(
+            robot, prepared_logs(identify_logs, n_joints=robot.n, **reading)
         )
-        result = identify_sequential(robot, datas)
         robot = result.robot
     validation = dict(
         zip(
             (Path(p).name for p in validate_logs),
-            prepared_logs(
-                validate_logs, n_joints=robot.n, columns=columns, repair=repair, note=note
-            ),
+            prepared_logs(validate_logs, n_joints=robot.n, **reading),
             strict=True,
         )
     )
