@@ -21,6 +21,7 @@ from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
     "columns_option",
+    "cutoff_option",
     "fmt",
     "fmt_vector",
     "load",
@@ -105,6 +106,12 @@ columns_option = click.option(
     "--columns",
     metavar="SPEC",
     help='Layout of a headerless log, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6".',
+)
+cutoff_option = click.option(
+    "--cutoff",
+    type=click.FloatRange(0.0, 1e6, min_open=True),
+    default=None,
+    help="Low-pass cutoff for measured speeds, Hz [min(10, fs/5)].",
 )
 repair_option = click.option(
     "--repair",

@@ -6,6 +6,7 @@ import click
 
 from kinergy.cli.common import (
     columns_option,
+    cutoff_option,
     note,
     output_file_option,
     progress,
@@ -196,12 +197,7 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     is_flag=True,
     help="Identify only the payload from logs taken with it; ROBOT is the model identified without it.",
 )
-@click.option(
-    "--cutoff",
-    type=click.FloatRange(0.0, 1e6, min_open=True),
-    default=None,
-    help="Low-pass cutoff for measured speeds, Hz [min(10, fs/5)].",
-)
+@cutoff_option
 @repair_option
 @writes(files=("out",), inputs=("logs", "robot_name"))
 def identify(

@@ -10,6 +10,7 @@ import numpy as np
 
 from kinergy.cli.common import (
     columns_option,
+    cutoff_option,
     load,
     note,
     payload_option,
@@ -122,11 +123,7 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
     default=None,
     help="Write plots (measured vs predicted, error box plots) to this folder.",
 )
-@click.option(
-    "--cutoff",
-    type=click.FloatRange(0.0, 1e6, min_open=True),
-    help="Low-pass cutoff for measured speeds, Hz.",
-)
+@cutoff_option
 @payload_option
 @repair_option
 @writes(into=("plots",), inputs=("model", "logs"))
