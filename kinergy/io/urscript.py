@@ -68,11 +68,15 @@ def _vector(q: ArrayLike) -> str:
     return "[" + ", ".join(_decimal(x) for x in np.asarray(q, dtype=float)) + "]"
 
 
+def _comments(header: Sequence[str], indent: str) -> list[str]:
+    """The header as comment lines after ``indent``: one per line of each entry."""
+    return [f"{indent}# {line}" for text in header for line in str(text).splitlines()]
+
+
 def _program(name: str, header: Sequence[str], body: Sequence[str]) -> str:
-    """``def name():``, the header as comments (one per line of each entry), the body lines
-    (indented), ``end``; newline-terminated."""
-    lines = [f"def {_name(name)}():"]
-    lines.extend(f"  # {line}" for text in header for line in str(text).splitlines())
+    """``def name():``, the header as comments (:func:`_comments`), the body lines (indented),
+    ``end``; newline-terminated."""
+    lines = [f"def {_name(name)}():", *_comments(header, "  ")]
     lines.extend(f"  {line}" for line in body)
     lines.append("end")
     return "\n".join(lines) + "\n"
@@ -205,8 +209,7 @@ def program_script(program: RobotProgram, header: Sequence[str] = ()) -> str:
         comment = old[old.index("#") :] if "#" in old and "#" not in move.text else ""
         lines[move.line - 1] = indent + move_statement(move) + (f"  {comment}" if comment else "")
     at = next((i + 1 for i, line in enumerate(lines) if line.lstrip().startswith("def ")), 0)
-    indent = "  " if at else ""
-    lines[at:at] = [f"{indent}# {line}" for text in header for line in str(text).splitlines()]
+    lines[at:at] = _comments(header, "  " if at else "")
     return "\n".join(lines) + "\n"
 
 
