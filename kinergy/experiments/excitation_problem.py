@@ -64,7 +64,7 @@ from kinergy.experiments.excitation_series import (
 )
 from kinergy.model.robot import Robot
 from kinergy.trajectory.fourier import fourier_motion
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import CONTROLLER_DT, Motion
 
 __all__ = ["ExcitationProblem", "excitation_problem"]
 
@@ -249,7 +249,7 @@ def excitation_problem(
     criterion: str = "cond",
     include_drives: bool = True,
     samples: int = 200,
-    dt: float = 0.002,
+    dt: float = CONTROLLER_DT,
 ) -> ExcitationProblem:
     """Build an excitation design problem (module docstring).
 

@@ -26,7 +26,7 @@ from kinergy.dynamics.chain import make_chain
 from kinergy.dynamics.kinematics import joint_axes
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import CONTROLLER_DT, Motion
 
 __all__ = ["FrictionRun", "back_and_forth_motion", "default_speeds", "vertical_axis_pose"]
 
@@ -243,7 +243,7 @@ def back_and_forth_motion(
     max_time: float = 2.0,
     acceleration: float = 2.0,
     dwell: float = 0.2,
-    dt: float = 0.002,
+    dt: float = CONTROLLER_DT,
     pose: ArrayLike | None = None,
 ) -> FrictionRun:
     """The doc's friction experiment (section 4.1, Figure 6) for one joint.

@@ -15,7 +15,7 @@ from kinergy.errors import KinergyError
 from kinergy.experiments.nursing_doc import BASE_FREQUENCY, DOC_TABLE6
 from kinergy.model.robot import Robot
 from kinergy.trajectory.fourier import fourier_motion
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import CONTROLLER_DT, Motion
 
 __all__ = ["table6_motion"]
 
@@ -48,7 +48,7 @@ def _limit_scales(robot: Robot, q0: Array, one: Motion) -> tuple[Array, list[str
 
 
 def table6_motion(
-    robot: Robot, *, periods: int = 10, dt: float = 0.002
+    robot: Robot, *, periods: int = 10, dt: float = CONTROLLER_DT
 ) -> tuple[Motion, Array, list[str]]:
     """The doc's excitation (eq 22 with Table 6, ``w_f = 0.2 pi``, N = 3), inside the limits.
 

@@ -28,7 +28,7 @@ from kinergy.io.rtde import write_log
 from kinergy.model.library import load_robot
 from kinergy.model.robot import Friction, Payload, Robot
 from kinergy.simulate import TwinSettings, simulate
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import CONTROLLER_DT, Motion
 from kinergy.trajectory.movej import movej
 from kinergy.trajectory.programs import UR_HOME, pad_rest, paper_trajectory
 
@@ -74,7 +74,7 @@ def _program(name: str) -> Motion:
         return paper_trajectory(robot, name)
     moves = np.array([[0.8, 0.3, -0.5, 0.2, 0.6, 0.0], [-0.5, 0.2, 0.4, 0.0, 0.0, 1.0]])
     way = np.vstack([UR_HOME, UR_HOME + moves[0], UR_HOME + moves[1], UR_HOME])
-    return pad_rest(movej(way, speed=2.0, acceleration=5.0, dt=0.002), 0.1, 0.002)
+    return pad_rest(movej(way, speed=2.0, acceleration=5.0, dt=CONTROLLER_DT), 0.1, CONTROLLER_DT)
 
 
 def plan(
@@ -130,7 +130,7 @@ def write_twin_log(item: TwinLog) -> str:
     samples = round(item.seconds * 500)
     rng = np.random.default_rng(item.seed)
     index = (np.arange(samples) + int(rng.integers(period))) % period
-    t = item.clock + 0.002 * np.arange(samples, dtype=float)
+    t = item.clock + CONTROLLER_DT * np.arange(samples, dtype=float)
     motion = Motion(t, cycle.q[index], cycle.qd[index], cycle.qdd[index])
     log = simulate(robot, motion, TwinSettings(seed=item.seed), name=item.path)
     Path(item.path).parent.mkdir(parents=True, exist_ok=True)

@@ -27,6 +27,7 @@ from kinergy.errors import KinergyError
 from kinergy.linalg import Reduced, scaled_lstsq, scaled_solution
 from kinergy.model.robot import Robot
 from kinergy.predict import drive_state
+from kinergy.trajectory.motion import CONTROLLER_DT
 
 __all__ = [
     "ElectricsFit",
@@ -184,7 +185,7 @@ def fit_standby(
     supply: Array,
     *,
     temperature: Array | None = None,
-    dt: float = 0.002,
+    dt: float = CONTROLLER_DT,
 ) -> StandbyFit:
     """The standby power: measured supply power minus the motors' predicted draw, averaged.
 

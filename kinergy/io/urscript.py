@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
+from kinergy.trajectory.motion import CONTROLLER_DT
 from kinergy.trajectory.movej import check_waypoints, per_move
 from kinergy.trajectory.robot_program import Move, RobotProgram
 
@@ -232,7 +233,7 @@ def write_script(path: str | os.PathLike[str], text: str) -> Path:
 # servoj: a sampled trajectory streamed at the controller's rate
 
 #: the controller's cycle, s (e-Series: 500 Hz)
-SERVO_PERIOD = 0.002
+SERVO_PERIOD = CONTROLLER_DT
 
 
 def _servo_steps(t: ArrayLike, q: ArrayLike) -> tuple[Array, Array, float]:

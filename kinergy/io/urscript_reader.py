@@ -36,6 +36,7 @@ import numpy as np
 from kinergy.errors import KinergyError
 from kinergy.files import read_text
 from kinergy.model.robot import Payload
+from kinergy.trajectory.motion import CONTROLLER_DT
 from kinergy.trajectory.robot_program import MOVE_DEFAULTS, Event, Move, RobotProgram, Step
 
 __all__ = ["IO_CALLS", "parse_program", "read_program"]
@@ -55,7 +56,7 @@ IO_CALLS = frozenset(
 )
 
 #: the controller's cycle, s: what ``sync()`` waits
-_SYNC = 0.002
+_SYNC = CONTROLLER_DT
 
 _CONTROL = re.compile(
     r"^(if|elif|else|while|for|thread|return|halt|break|continue|run|join|kill)\b"

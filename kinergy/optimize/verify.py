@@ -23,13 +23,14 @@ from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import LimitCheck, limit_violations
 from kinergy.optimize.objectives import Objective
 from kinergy.optimize.program import motion_samples, serial
+from kinergy.trajectory.motion import CONTROLLER_DT
 from kinergy.trajectory.movej import movej, plan_movej
 
 __all__ = ["VERIFY_DT", "ProgramResult", "program_energy", "simulate_program"]
 
 
 #: sample period of every verification: the UR controller's 500 Hz
-VERIFY_DT = 0.002
+VERIFY_DT = CONTROLLER_DT
 
 
 @serial

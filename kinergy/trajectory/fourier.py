@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import CONTROLLER_DT, Motion
 
 __all__ = ["fourier_basis", "fourier_motion", "fourier_series"]
 
@@ -100,7 +100,7 @@ def fourier_motion(
     *,
     base_frequency: float,
     periods: int = 1,
-    dt: float = 0.002,
+    dt: float = CONTROLLER_DT,
 ) -> Motion:
     """A Fourier-series motion over ``periods`` whole periods, sampled every ``dt`` s.
 

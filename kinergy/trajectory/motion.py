@@ -10,7 +10,10 @@ from numpy.typing import ArrayLike
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 
-__all__ = ["Motion"]
+__all__ = ["CONTROLLER_DT", "Motion"]
+
+#: the UR controller's cycle, s (e-Series: 500 Hz): the period it logs, plans and servos at
+CONTROLLER_DT = 0.002
 
 
 @dataclass(frozen=True, eq=False)

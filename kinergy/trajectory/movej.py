@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import CONTROLLER_DT, Motion
 
 __all__ = [
     "MovejPlan",
@@ -350,7 +350,7 @@ def movej(
     *,
     speed: ArrayLike,
     acceleration: ArrayLike,
-    dt: float = 0.002,
+    dt: float = CONTROLLER_DT,
     blend: ArrayLike = 0.0,
 ) -> Motion:
     """A movej program sampled every ``dt`` seconds (UR's controller runs at 500 Hz: 0.002 s).

@@ -20,13 +20,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from kinergy.arrays import Array
 from kinergy.model.robot import Robot
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import CONTROLLER_DT, Motion
 from kinergy.trajectory.movej import blend_starts, trapezoid, trapezoid_timing
 from kinergy.trajectory.movel import ToolSegment, joints_on_path, tool_motion
 from kinergy.trajectory.program_path import ProgramPath
 
 __all__ = [
-    "CONTROLLER_DT",
     "Schedule",
     "payload_index",
     "program_motion",
@@ -35,10 +34,6 @@ __all__ = [
     "schedule_profiles",
     "tool_runs",
 ]
-
-
-#: the controller's sample period, s
-CONTROLLER_DT = 0.002
 
 
 @dataclass(frozen=True, eq=False)

@@ -14,7 +14,7 @@ from kinergy.arrays import Array
 from kinergy.dynamics.kinematics import link_poses
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import CONTROLLER_DT, Motion
 from kinergy.trajectory.movej import movej
 
 __all__ = [
@@ -95,7 +95,9 @@ def paper_waypoints(robot: Robot, seed: int, *, points: int = 6, floor: float = 
     return np.vstack(way)
 
 
-def paper_trajectory(robot: Robot, name: str, *, dt: float = 0.002, rest: float = 0.2) -> Motion:
+def paper_trajectory(
+    robot: Robot, name: str, *, dt: float = CONTROLLER_DT, rest: float = 0.2
+) -> Motion:
     """``test-a`` or ``test-b`` as a target motion at ``dt`` (with ``rest`` s still at each end)."""
     if name not in TEST_TRAJECTORIES:
         raise KinergyError(
