@@ -16,6 +16,7 @@ import os
 import shutil
 import signal
 import stat
+import sys
 import tempfile
 import tomllib
 from collections.abc import Callable, Iterator, Sequence
@@ -36,6 +37,7 @@ __all__ = [
     "check_output",
     "check_outputs",
     "output_folder",
+    "raise_pending",
     "read_text",
     "read_toml",
     "terminate_on_signals",
@@ -53,23 +55,57 @@ class Terminated(BaseException):
     """SIGTERM arrived: raised in the main thread so that every cleanup runs on the way out."""
 
 
+#: signals that arrived inside :func:`terminate_on_signals`. A handler's exception raised while
+#: C code is calling back into Python (numba compiling through llvmlite's ctypes callbacks) is
+#: printed and dropped by that callback, so the signal is kept here and raised again before the
+#: next output is put in place (:func:`raise_pending`) and at the end of the block.
+_PENDING: list[int] = []
+
+
+def _interruption(signum: int) -> BaseException:
+    return KeyboardInterrupt() if signum == signal.SIGINT else Terminated(signum)
+
+
+def raise_pending() -> None:
+    """Raise the interruption of a signal that arrived (and may have been dropped) inside
+    :func:`terminate_on_signals`: :class:`Terminated` for SIGTERM, KeyboardInterrupt for SIGINT."""
+    if _PENDING:
+        raise _interruption(_PENDING[0])
+
+
 @contextlib.contextmanager
 def terminate_on_signals() -> Iterator[None]:
-    """Inside the block SIGTERM raises :class:`Terminated` (SIGINT raises KeyboardInterrupt as
-    always), so temporaries are removed and no half-written output stays behind."""
+    """Inside the block SIGTERM raises :class:`Terminated` and SIGINT KeyboardInterrupt, so
+    temporaries are removed and no half-written output stays behind; a signal whose exception a
+    C callback dropped is raised again before the next output is renamed into place and at the
+    end of the block (:data:`_PENDING`), and the dropped exception is not printed."""
 
-    def raise_terminated(signum: int, frame: FrameType | None) -> None:
-        raise Terminated(signum)
+    def interrupt(signum: int, frame: FrameType | None) -> None:
+        _PENDING.append(signum)
+        raise _interruption(signum)
 
+    def unraisable(info: Any) -> None:
+        if not isinstance(info.exc_value, Terminated | KeyboardInterrupt):
+            hook(info)
+
+    # SIGINT only where it interrupts already (a shell's background job starts with it ignored)
+    kinds = [signal.SIGTERM]
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        kinds.append(signal.SIGINT)
     try:
-        previous = signal.signal(signal.SIGTERM, raise_terminated)
+        previous = {s: signal.signal(s, interrupt) for s in kinds}
     except ValueError:  # not the main thread: leave signals alone
         yield
         return
+    hook, sys.unraisablehook = sys.unraisablehook, unraisable
     try:
         yield
+        raise_pending()
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        sys.unraisablehook = hook
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        _PENDING.clear()
 
 
 def check_output(path: PathLike) -> Path:
@@ -181,6 +217,7 @@ def atomic_write(
                 handle.flush()
                 os.fsync(handle.fileno())
             os.chmod(tmp, 0o644)  # mkstemp makes it private; outputs are for reading
+            raise_pending()
             os.replace(tmp, target)
         except OSError as exc:
             raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
@@ -238,6 +275,7 @@ def atomic_folder(path: PathLike) -> Iterator[Path]:
         (building / MARKER).write_text("written by kinergy; it may replace this folder\n")
         yield building
         os.chmod(building, 0o755)
+        raise_pending()
         old = None
         if target.exists():
             old = target.with_name(f".{target.name}.old-{os.getpid()}")

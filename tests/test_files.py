@@ -149,3 +149,56 @@ def test_a_signal_mid_write_leaves_the_old_file_and_no_temporary(tmp_path: Path,
     assert proc.returncode != 0
     assert target.read_text() == "before"
     assert _leftovers(tmp_path) == []
+
+
+_SWALLOWED = textwrap.dedent(
+    """
+    import ctypes, signal, sys, time
+    from kinergy.files import Terminated, atomic_write, terminate_on_signals
+
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    libc = ctypes.CDLL(None)
+    compare = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p)
+
+    def slow(a, b):  # C calls back into Python, as llvmlite does while numba compiles
+        print("in callback", flush=True)
+        time.sleep(30)
+        return 0
+
+    values = (ctypes.c_int * 2)(1, 2)
+    try:
+        with terminate_on_signals():
+            libc.qsort(values, 2, ctypes.sizeof(ctypes.c_int), compare(slow))
+            print("after callback", flush=True)
+            atomic_write(sys.argv[1], lambda fh: fh.write("new"))
+    except (Terminated, KeyboardInterrupt) as exc:
+        print(type(exc).__name__, flush=True)
+        sys.exit(143)
+    """
+)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_a_signal_dropped_by_a_c_callback_still_stops_the_write(tmp_path: Path, sig: int) -> None:
+    """A signal's exception raised inside a ctypes callback is printed and dropped by ctypes (a
+    SIGTERM during numba's compile once let a killed command finish and print a traceback): the
+    signal is raised again before the output is renamed into place."""
+    target = tmp_path / "out.csv"
+    target.write_text("before")
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _SWALLOWED, str(target)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)},
+    )
+    assert proc.stdout is not None
+    assert proc.stdout.readline().strip() == "in callback"
+    proc.send_signal(sig)
+    out, err = proc.communicate(timeout=60)
+    assert "after callback" in out  # ctypes dropped the exception: the path under test ran
+    assert proc.returncode == 143, (out, err)
+    assert out.split()[-1] == ("Terminated" if sig == signal.SIGTERM else "KeyboardInterrupt")
+    assert "Traceback" not in err, err
+    assert target.read_text() == "before"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv"]
