@@ -96,6 +96,8 @@ class RtdeServer:
 
     def __enter__(self) -> RtdeServer:
         self._start = time.monotonic()
+        # set here, not in the thread: a server left at once closes the listener before it runs
+        self.listener.settimeout(0.05)
         accept = threading.Thread(target=self._accept, daemon=True)
         accept.start()
         self._threads.append(accept)
@@ -112,7 +114,6 @@ class RtdeServer:
         return int((time.monotonic() - self._start) * self.rate)
 
     def _accept(self) -> None:
-        self.listener.settimeout(0.05)
         while not self._stop.is_set():
             try:
                 sock, _ = self.listener.accept()
