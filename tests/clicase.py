@@ -21,6 +21,7 @@ import io
 import json
 import os
 import time
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -85,7 +86,12 @@ def run_case(
     start = time.perf_counter()
     try:
         os.chdir(folder)
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        with (
+            contextlib.redirect_stdout(out),
+            contextlib.redirect_stderr(err),
+            warnings.catch_warnings(record=True) as caught,
+        ):
+            warnings.simplefilter("always")
             status = main(list(args))
     finally:
         os.chdir(cwd)
@@ -98,6 +104,9 @@ def run_case(
         assert (status != 0) == refuse, f"{where}: exit {status}; {outcome.err or outcome.out:.500}"
     after = snapshot(folder)
     if status != 0:
+        # a warning prints on the user's stderr (two lines) before the one line of the refusal
+        shown = [f"{w.category.__name__}: {w.message} ({w.filename}:{w.lineno})" for w in caught]
+        assert not shown, f"{where}: warnings before the refusal: {shown}"
         lines = outcome.err.splitlines()
         assert len(lines) == 1 and lines[0].startswith("kinergy: error: "), f"{where}: {lines}"
         assert after == before, f"{where}: files changed on a refusal: {_diff(before, after)}"

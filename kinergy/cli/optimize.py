@@ -25,7 +25,9 @@ __all__ = ["optimize", "optimize_text", "program_text"]
 _PARTS = ("friction", "copper", "inertial", "gravity")
 #: the longest cycle time optimised, s (each is re-simulated at 500 Hz, Pareto points and all)
 MAX_CYCLE_TIME = 600.0
-#: the largest speed (rad/s) and acceleration (rad/s^2) caps taken
+#: the smallest and largest speed (rad/s) and acceleration (rad/s^2) caps taken (below 1e-3,
+#: 0.06 deg/s, a move takes longer than any cycle-time budget and its profile underflows)
+_MIN_CAP = 1e-3
 _MAX_CAP = {"--v-max": 100.0, "--a-max": 1e4}
 
 
@@ -45,8 +47,10 @@ def _cycle_time(text: str) -> float | None:
 
 
 def _cap(name: str, value: float | None) -> None:
-    if value is not None and not (math.isfinite(value) and 0.0 < value <= _MAX_CAP[name]):
-        raise KinergyError(f"{name}: must be > 0 and at most {_MAX_CAP[name]:g}, got {value:g}")
+    if value is not None and not (math.isfinite(value) and _MIN_CAP <= value <= _MAX_CAP[name]):
+        raise KinergyError(
+            f"{name}: must be at least {_MIN_CAP:g} and at most {_MAX_CAP[name]:g}, got {value:g}"
+        )
 
 
 def _moves_table(prog: ProgramResult, opt: ProgramResult) -> str:

@@ -117,14 +117,15 @@ def limit_violations(
     if acceleration_cap is not None:
         acc = np.minimum(acc, acceleration_cap)
     torque = np.array([lim.torque for lim in limits])
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore"):  # a zero cap: 0/0 where nothing moves
         acc_ratio = np.where(np.isfinite(acc), np.abs(motion.qdd) / acc, np.nan)
+        speed_ratio = np.abs(motion.qd) / speed
     return LimitCheck(
         joints=robot.joint_names,
         t=motion.t,
         ratios={
             "position": np.abs(motion.q - 0.5 * (lo + hi)) / (0.5 * (hi - lo)),
-            "speed": np.abs(motion.qd) / speed,
+            "speed": speed_ratio,
             "acceleration": acc_ratio,
             "torque": np.abs(joint_torque(robot, state.tau_m)) / torque,
         },

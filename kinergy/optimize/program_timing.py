@@ -66,7 +66,7 @@ def path_caps(
             q = line_joints(robot, path, k)
             step = path.travel[k] / (q.shape[0] - 1)
             gain = np.max(np.abs(np.diff(q, axis=0)), axis=0) / max(step, 1e-300)
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):  # a joint that does not move
             v_joint = np.where(gain > 0.0, speed / gain, np.inf)
             a_joint = np.where(gain > 0.0, acc / gain, np.inf)
         jv, ja = int(np.argmin(v_joint)), int(np.argmin(a_joint))

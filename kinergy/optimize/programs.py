@@ -398,6 +398,11 @@ def optimize_program(
     standby = robot.standby_power if standby is None else standby
     objective = PROGRAM_OBJECTIVE(standby)
     path = program_path(robot, program)
+    if not np.any(path.travel > 0.0):
+        raise KinergyError(
+            f"{program.path or program.name}: no move changes the arm's position; nothing to "
+            "optimise"
+        )
     say(f"{program.name}: simulating the program at 500 Hz")
     own, caps = _as_written(robot, path, objective, v_max, a_max)
     budget = own.result.cycle_time if cycle_time is None else cycle_time

@@ -220,8 +220,9 @@ def _check_limits(robot: Robot, q: Array) -> None:
     bad = np.flatnonzero((q < lo - 1e-9) | (q > hi + 1e-9))
     if bad.size:
         j = int(bad[0])
+        at = f"{np.degrees(q[j]):.2f} deg" if abs(q[j]) < 1e300 else f"{q[j]:g} rad"
         raise KinergyError(
-            f"the target puts {robot.joints[j].name} at {np.degrees(q[j]):.2f} deg, outside its "
+            f"the target puts {robot.joints[j].name} at {at}, outside its "
             f"limits [{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg"
         )
 
