@@ -129,18 +129,26 @@ _SLOW_WRITER = textwrap.dedent(
 )
 
 
-@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
-def test_a_signal_mid_write_leaves_the_old_file_and_no_temporary(tmp_path: Path, sig: int) -> None:
-    target = tmp_path / "out.csv"
+def _writer(script: str, folder: Path, first_line: str) -> tuple[subprocess.Popen[str], Path]:
+    """Start ``script`` on ``folder/out.csv`` (which holds "before") and wait for its first line
+    of output, ``first_line``: the moment to send it a signal."""
+    target = folder / "out.csv"
     target.write_text("before")
     proc = subprocess.Popen(
-        [sys.executable, "-c", _SLOW_WRITER, str(target)],
+        [sys.executable, "-c", script, str(target)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)},
     )
     assert proc.stdout is not None
-    assert proc.stdout.readline().strip() == "writing"
+    assert proc.stdout.readline().strip() == first_line
+    return proc, target
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_a_signal_mid_write_leaves_the_old_file_and_no_temporary(tmp_path: Path, sig: int) -> None:
+    proc, target = _writer(_SLOW_WRITER, tmp_path, "writing")
     assert _leftovers(tmp_path)  # the temporary exists while it writes
     proc.send_signal(sig)
     start = time.monotonic()
@@ -183,17 +191,7 @@ def test_a_signal_dropped_by_a_c_callback_still_stops_the_write(tmp_path: Path, 
     """A signal's exception raised inside a ctypes callback is printed and dropped by ctypes (a
     SIGTERM during numba's compile once let a killed command finish and print a traceback): the
     signal is raised again before the output is renamed into place."""
-    target = tmp_path / "out.csv"
-    target.write_text("before")
-    proc = subprocess.Popen(
-        [sys.executable, "-c", _SWALLOWED, str(target)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)},
-    )
-    assert proc.stdout is not None
-    assert proc.stdout.readline().strip() == "in callback"
+    proc, target = _writer(_SWALLOWED, tmp_path, "in callback")
     proc.send_signal(sig)
     out, err = proc.communicate(timeout=60)
     assert "after callback" in out  # ctypes dropped the exception: the path under test ran
