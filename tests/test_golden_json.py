@@ -52,6 +52,16 @@ def _key(where: str) -> str:
     return re.sub(r"(\[\d+\])+$", "", where.rsplit(".", 1)[-1])
 
 
+def _rule(where: str, tol: dict[str, Tolerance]) -> Tolerance:
+    """The tolerance of the value at ``where``: its own key's, else the nearest enclosing key's
+    (``physical_fit`` covers everything under it), else :data:`RTOL`."""
+    names = [re.sub(r"(\[\d+\])+$", "", part) for part in where.split(".")]
+    for name in reversed(names):
+        if name in tol:
+            return tol[name]
+    return RTOL
+
+
 def _same_text(got: str, want: str) -> bool:
     """Equal, or equal but for numbers that agree to a relative 1e-5."""
     if got == want:
@@ -117,7 +127,7 @@ def _compare(got: Any, want: Any, where: str, tol: dict[str, Tolerance]) -> list
     if isinstance(want, int | float):
         if isinstance(got, bool) or not isinstance(got, int | float):
             return [f"{where}: expected a number, got {got!r}"]
-        rule = tol.get(_key(where), RTOL)
+        rule = _rule(where, tol)
         rtol, atol = rule if isinstance(rule, tuple) else (float(rule), ATOL)
         if math.isnan(want):
             return [] if math.isnan(got) else [f"{where}: {got!r} != nan"]
@@ -226,7 +236,9 @@ def test_identify_and_validate(
             ],
             capsys,
         ),
-        tol=NOISE_FREE,
+        # a conic solver's optimum: its last digits (about 1e-4 of the flattest parameters)
+        # follow the arithmetic, e.g. the dynamics' sines and cosines (issue 16, one ulp)
+        tol={**NOISE_FREE, "physical_fit": 1e-3, "standard_parameters": 1e-3},
     )
 
 
@@ -278,6 +290,7 @@ def test_optimize(capsys: pytest.CaptureFixture[str]) -> None:
             "t": 1e-3,
             "energy": 1e-4,
             "saving": 1e-3,
+            "optimized": 1e-4,
             # parts that net to zero over the cycle: J of round-off on a ~1000 J total
             "inertial": (1e-3, 1e-3),
             "gravity": (1e-3, 1e-3),

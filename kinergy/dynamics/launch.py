@@ -1,10 +1,12 @@
-"""Calling the compiled dynamics kernels: serially for small batches or one thread, split over
-numba's threads otherwise; compiled at first use, with a one-line notice on stderr when that
-takes a while (a fresh install, no on-disk cache yet).
+"""Calling the compiled dynamics kernels: serially for small batches or one thread, else split
+over a pool of Python threads (the kernels release the GIL); compiled at first use, with a
+one-line notice on stderr when that takes a while (a fresh install, no on-disk cache yet).
 
-A parallel launch costs tens of microseconds (far more on a busy machine) and one sample costs
-about one, so batches up to :data:`SERIAL_ROWS` samples, and any batch inside
-``kernel_threads(1)``, run on the calling thread.
+How many threads a call uses is numba's thread count of the calling thread
+(:func:`kinergy.dynamics.threads.kernel_threads`, or the ``threads`` argument). Each of those
+threads takes blocks of :data:`CHUNK` samples from a shared counter until none are left, so a
+thread that the machine slows down takes fewer. Batches up to :data:`SERIAL_ROWS` samples run on
+the calling thread: handing work to the pool costs tens of microseconds.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from __future__ import annotations
 import sys
 import threading
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 
 import numba
 import numpy as np
@@ -22,6 +25,7 @@ from kinergy.dynamics.chain import KernelData
 from kinergy.dynamics.threads import kernel_threads
 
 __all__ = [
+    "CHUNK",
     "SERIAL_ROWS",
     "compile_kernels",
     "regressor_gradient_into",
@@ -32,12 +36,15 @@ __all__ = [
 
 #: batches up to this many samples run serially
 SERIAL_ROWS = 256
+#: samples a thread takes at a time (a whole number of the kernels' lanes)
+CHUNK = 8 * _kernels.LANES
 #: the notice is printed when compiling takes longer than this, s
 _NOTICE_AFTER = 1.0
-_NOTICE = "kinergy: compiling the dynamics kernels (once, about 20 s)"
+_NOTICE = "kinergy: compiling the dynamics kernels (once, about 40 s)"
 
 _compiled: set[str] = set()
 _lock = threading.Lock()
+_pool: ThreadPoolExecutor | None = None
 
 
 def _with_notice(compile_all: Callable[[], None]) -> None:
@@ -62,19 +69,12 @@ def compile_kernels(data: KernelData, *, gradient: bool = False) -> None:
     state = (z, z, z)
 
     def dynamics() -> None:
-        args = (data.geo, data.ends, data.body, state, np.empty((0, 6)), np.empty((1, n)))
-        serial, parallel = _rnea(data)
-        parallel(*args)
-        serial(0, 1, *args)
-        y = np.empty((1, n, 10 * n))
-        serial, parallel = _regressor(data)
-        parallel(data.geo, data.ends[2], state, y, True)
-        serial(0, 1, data.geo, data.ends[2], state, y, True)
+        _rnea(data)(0, 1, data.geo, data.ends[2], data.body, state, np.empty((1, n)))
+        _regressor(data)(0, 1, data.geo, data.ends[2], state, np.empty((1, n, 10 * n)), True)
 
     def gradients() -> None:
         w = np.zeros((1, n, 10 * n))
         args = (data.geo, data.ends[2], state, w, 1e-5, np.empty((3, 1, n)))
-        _kernels.regressor_gradient_kernel(*args)
         _kernels.regressor_gradient_rows(0, 1, *args)
 
     with _lock:
@@ -84,54 +84,71 @@ def compile_kernels(data: KernelData, *, gradient: bool = False) -> None:
                 _compiled.add(f"{key}{zf}")
 
 
-def _rnea(data: KernelData) -> tuple[Callable[..., None], Callable[..., None]]:
-    """The serial and the parallel RNEA kernel for ``data``'s chain."""
-    if data.z_first:
-        return _kernels.rnea_rows_dh, _kernels.rnea_kernel_dh
-    return _kernels.rnea_rows, _kernels.rnea_kernel
+def _rnea(data: KernelData) -> Callable[..., None]:
+    """The RNEA kernel for ``data``'s chain."""
+    return _kernels.rnea_rows_dh if data.z_first else _kernels.rnea_rows
 
 
-def _regressor(data: KernelData) -> tuple[Callable[..., None], Callable[..., None]]:
-    """The serial and the parallel regressor kernel for ``data``'s chain."""
-    if data.z_first:
-        return _kernels.regressor_rows_dh, _kernels.regressor_kernel_dh
-    return _kernels.regressor_rows, _kernels.regressor_kernel
+def _regressor(data: KernelData) -> Callable[..., None]:
+    """The regressor kernel for ``data``'s chain."""
+    return _kernels.regressor_rows_dh if data.z_first else _kernels.regressor_rows
+
+
+def _shared_pool() -> ThreadPoolExecutor:
+    """The process's worker threads, started at first use (as many as numba may use)."""
+    global _pool
+    with _lock:
+        if _pool is None:
+            most = int(getattr(numba.config, "NUMBA_NUM_THREADS", 1))
+            _pool = ThreadPoolExecutor(max_workers=most, thread_name_prefix="kinergy-dynamics")
+        return _pool
 
 
 def _launch(
-    serial: Callable[..., None],
-    parallel: Callable[..., None],
+    kernel: Callable[..., None],
     rows: int,
     args: tuple[object, ...],
     threads: int | None,
-    serial_rows: int = SERIAL_ROWS,
 ) -> None:
-    """``serial(0, rows, *args)`` for batches up to ``serial_rows`` or one thread, else
-    ``parallel(*args)``."""
+    """``kernel(lo, hi, *args)`` over rows 0:rows: on the calling thread for batches up to
+    :data:`SERIAL_ROWS` or one thread, else in blocks of :data:`CHUNK` rows on as many pool
+    threads as numba's thread count (or ``threads``) says."""
     if threads is not None:
         with kernel_threads(threads):
-            _launch(serial, parallel, rows, args, None, serial_rows)
-    elif rows <= serial_rows or numba.get_num_threads() == 1:
-        serial(0, rows, *args)
-    else:
-        parallel(*args)
+            _launch(kernel, rows, args, None)
+        return
+    workers = min(numba.get_num_threads(), -(-rows // CHUNK))
+    if rows <= SERIAL_ROWS or workers <= 1:
+        kernel(0, rows, *args)
+        return
+    starts = iter(range(0, rows, CHUNK))
+    taken = threading.Lock()
+
+    def work() -> None:
+        while True:
+            with taken:
+                lo = next(starts, None)
+            if lo is None:
+                return
+            kernel(lo, min(rows, lo + CHUNK), *args)
+
+    futures = [_shared_pool().submit(work) for _ in range(workers)]
+    for future in futures:
+        future.result()
 
 
 def rnea_into(
     data: KernelData,
     state: tuple[Array, Array, Array],
-    wrench: Array,
     tau: Array,
     g0: Array | None = None,
     threads: int | None = None,
 ) -> None:
     """Fill ``tau`` (N, n) with the RNEA torques of ``state`` (contiguous (N, n) each) on
-    ``threads`` threads (None: as set); ``wrench`` (N, 6) or (0, 6); ``g0`` overrides the
-    gravity in frame 0."""
+    ``threads`` threads (None: as set); ``g0`` overrides the gravity in frame 0."""
     compile_kernels(data)
-    ends = data.ends if g0 is None else (data.ends[0], data.ends[1], g0)
-    args = (data.geo, ends, data.body, state, wrench, tau)
-    _launch(*_rnea(data), tau.shape[0], args, threads)
+    args = (data.geo, data.ends[2] if g0 is None else g0, data.body, state, tau)
+    _launch(_rnea(data), tau.shape[0], args, threads)
 
 
 def regressor_into(
@@ -148,7 +165,7 @@ def regressor_into(
     entries alone: for a ``y`` that holds zeros there (fresh ``np.zeros``, or a regressor)."""
     compile_kernels(data)
     args = (data.geo, data.ends[2] if g0 is None else g0, state, y, clear)
-    _launch(*_regressor(data), y.shape[0], args, threads)
+    _launch(_regressor(data), y.shape[0], args, threads)
 
 
 def regressor_gradient_into(
@@ -163,11 +180,4 @@ def regressor_gradient_into(
     ``q``, ``qd``, ``qdd`` (:func:`kinergy.dynamics._kernels.regressor_gradient_rows`)."""
     compile_kernels(data, gradient=True)
     args = (data.geo, data.ends[2], state, weights, step_q, sens)
-    _launch(
-        _kernels.regressor_gradient_rows,
-        _kernels.regressor_gradient_kernel,
-        weights.shape[0],
-        args,
-        threads,
-        _kernels.GRADIENT_CHUNK,
-    )
+    _launch(_kernels.regressor_gradient_rows, weights.shape[0], args, threads)

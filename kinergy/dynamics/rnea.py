@@ -25,7 +25,7 @@ from kinergy.dynamics.chain import (
     kernel_data,
     output_array,
 )
-from kinergy.dynamics.kinematics import joint_axes
+from kinergy.dynamics.kinematics import jacobian, joint_axes
 from kinergy.dynamics.launch import rnea_into
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
@@ -96,8 +96,9 @@ def rnea(
     w = _check_wrench(wrench, rows, single)
     tau = output_array(out, (rows, robot.n), single)
     state = contiguous_state(s)
-    wrench_rows = np.empty((0, 6)) if w is None else np.ascontiguousarray(w)
-    rnea_into(data, state, wrench_rows, tau, g0, threads)
+    rnea_into(data, state, tau, g0, threads)
+    if w is not None:  # the flange's wrench through the flange Jacobian, tau += J^T h
+        tau += np.einsum("kji,kj->ki", jacobian(robot, state[0]), w)
     if out is not None:
         return out
     return tau[0] if single else tau
