@@ -1,6 +1,7 @@
 """How many threads the compiled dynamics kernels use, for the length of a ``with`` block.
 
-The kernels (:mod:`kinergy.dynamics._kernels`) split samples over numba's threads. Callers that
+The kernels (:mod:`kinergy.dynamics._kernels`) split samples over as many threads as numba's
+thread count of the calling thread (:mod:`kinergy.dynamics.launch`). Callers that
 evaluate small batches many times (the optimiser: a few thousand samples, thousands of times)
 run faster on one thread, because a parallel launch costs more than the work and, on a busy
 machine, far more (measured: 1.3 ms serial against 33 ms on two busy threads for one drive-model
