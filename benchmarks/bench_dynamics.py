@@ -32,7 +32,8 @@ the benchmark states before any timing is trusted. The regressor *columns* of th
 coincide when link frames equal joint frames, so the regressor is checked through its product with
 the inertial parameters, ``Y @ inertial_parameters(robot)``, against Pinocchio's RNEA.
 
-kinergy parallelises over samples with numba threads; ``--threads 1`` gives a single-thread figure
+kinergy splits the samples over as many threads as numba's thread count (a pool of threads running
+the GIL-free kernel); ``--threads 1`` gives a single-thread figure
 for a like-for-like comparison with the (single-threaded) Pinocchio loop.
 """
 

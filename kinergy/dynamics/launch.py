@@ -141,13 +141,13 @@ def rnea_into(
     data: KernelData,
     state: tuple[Array, Array, Array],
     tau: Array,
-    g0: Array | None = None,
+    g0: Array,
     threads: int | None = None,
 ) -> None:
-    """Fill ``tau`` (N, n) with the RNEA torques of ``state`` (contiguous (N, n) each) on
-    ``threads`` threads (None: as set); ``g0`` overrides the gravity in frame 0."""
+    """Fill ``tau`` (N, n) with the RNEA torques of ``state`` (contiguous (N, n) each) under
+    gravity ``g0`` (3,) in frame 0, on ``threads`` threads (None: as set)."""
     compile_kernels(data)
-    args = (data.geo, data.ends[2] if g0 is None else g0, data.body, state, tau)
+    args = (data.geo, g0, data.body, state, tau)
     _launch(_rnea(data), tau.shape[0], args, threads)
 
 

@@ -96,7 +96,7 @@ def rnea(
     w = _check_wrench(wrench, rows, single)
     tau = output_array(out, (rows, robot.n), single)
     state = contiguous_state(s)
-    rnea_into(data, state, tau, g0, threads)
+    rnea_into(data, state, tau, data.ends[2] if g0 is None else g0, threads)
     if w is not None:  # the flange's wrench through the flange Jacobian, tau += J^T h
         tau += np.einsum("kji,kj->ki", jacobian(robot, state[0]), w)
     if out is not None:
