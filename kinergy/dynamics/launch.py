@@ -109,32 +109,37 @@ def _launch(
     rows: int,
     args: tuple[object, ...],
     threads: int | None,
+    chunk: int = CHUNK,
 ) -> None:
     """``kernel(lo, hi, *args)`` over rows 0:rows: on the calling thread for batches up to
-    :data:`SERIAL_ROWS` or one thread, else in blocks of :data:`CHUNK` rows on as many pool
-    threads as numba's thread count (or ``threads``) says."""
+    :data:`SERIAL_ROWS` (or one ``chunk``, if smaller) or one thread, else in blocks of ``chunk``
+    rows on as many pool threads as numba's thread count (or ``threads``) says. If the calling
+    thread is interrupted, the pool threads stop after the block they are on."""
     if threads is not None:
         with kernel_threads(threads):
-            _launch(kernel, rows, args, None)
+            _launch(kernel, rows, args, None, chunk)
         return
-    workers = min(numba.get_num_threads(), -(-rows // CHUNK))
-    if rows <= SERIAL_ROWS or workers <= 1:
+    workers = min(numba.get_num_threads(), -(-rows // chunk))
+    if rows <= min(SERIAL_ROWS, chunk) or workers <= 1:
         kernel(0, rows, *args)
         return
-    starts = iter(range(0, rows, CHUNK))
-    taken = threading.Lock()
+    starts = iter(range(0, rows, chunk))
+    taken, stop = threading.Lock(), threading.Event()
 
     def work() -> None:
-        while True:
+        while not stop.is_set():
             with taken:
                 lo = next(starts, None)
             if lo is None:
                 return
-            kernel(lo, min(rows, lo + CHUNK), *args)
+            kernel(lo, min(rows, lo + chunk), *args)
 
     futures = [_shared_pool().submit(work) for _ in range(workers)]
-    for future in futures:
-        future.result()
+    try:
+        for future in futures:
+            future.result()
+    finally:
+        stop.set()
 
 
 def rnea_into(
@@ -180,4 +185,5 @@ def regressor_gradient_into(
     ``q``, ``qd``, ``qdd`` (:func:`kinergy.dynamics._kernels.regressor_gradient_rows`)."""
     compile_kernels(data, gradient=True)
     args = (data.geo, data.ends[2], state, weights, step_q, sens)
-    _launch(_kernels.regressor_gradient_rows, weights.shape[0], args, threads)
+    # a sample costs 5 n + 1 regressors: the threads take one block of lanes at a time
+    _launch(_kernels.regressor_gradient_rows, weights.shape[0], args, threads, _kernels.LANES)
