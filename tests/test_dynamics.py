@@ -14,7 +14,8 @@ import pytest
 from conftest import random_state
 
 import kinergy
-from kinergy.dynamics.kinematics import flange_pose, jacobian, link_poses
+from kinergy.dynamics.kinematics import axes_jacobian_rate, flange_pose, jacobian, link_poses
+from kinergy.dynamics.poses import tcp_axes, tcp_jacobian, tcp_pose
 
 pin = pytest.importorskip("pinocchio")
 from kinergy.dynamics.pinocchio import to_pinocchio  # noqa: E402
@@ -106,6 +107,34 @@ def test_jacobian_matches_finite_differences(name: str) -> None:
         skew = dr @ flange_pose(robot, q[k])[:3, :3].T
         w = np.array([skew[2, 1], skew[0, 2], skew[1, 0]])
         np.testing.assert_allclose(jac[k] @ qd[k], np.concatenate([v, w]), atol=1e-7)
+
+
+@pytest.mark.parametrize("name", [*ORACLE_ROBOTS, "panda"])
+def test_jacobian_rate_matches_differences_of_the_pose(name: str) -> None:
+    """``Jdot qd`` in closed form against the TCP's acceleration on ``q(t) = q + t qd`` (where
+    ``qdd = 0``): the second difference of its position, and the difference of its angular
+    velocity."""
+    robot = _robot(name, payload=False)
+    q, qd, _ = random_state(robot, 6, seed=9)
+    tcp = np.eye(4)
+    tcp[:3, 3] = [0.02, -0.01, 0.12]
+    rate = axes_jacobian_rate(*tcp_axes(robot, q, tcp), qd)
+    h = 1e-4
+    position = [tcp_pose(robot, q + k * h * qd, tcp)[:, :3, 3] for k in (-1, 0, 1)]
+    accel = (position[2] - 2.0 * position[1] + position[0]) / h**2
+    omega = [
+        np.einsum("sij,sj->si", tcp_jacobian(robot, q + k * h * qd, tcp)[:, 3:], qd)
+        for k in (-1, 1)
+    ]
+    alpha = (omega[1] - omega[0]) / (2.0 * h)
+    np.testing.assert_allclose(rate[:, :3], accel, atol=1e-5 * max(1.0, np.abs(accel).max()))
+    np.testing.assert_allclose(rate[:, 3:], alpha, atol=1e-7)
+    # the TCP Jacobian is the flange's with its linear rows moved by r: v_tcp = v + w x r
+    flange_jac = jacobian(robot, q)
+    r = flange_pose(robot, q)[:, :3, :3] @ tcp[:3, 3]  # (N, 3)
+    moved = flange_jac.copy()
+    moved[:, :3] += np.cross(flange_jac[:, 3:], r[:, :, None], axis=1)
+    np.testing.assert_allclose(tcp_jacobian(robot, q, tcp), moved, atol=1e-12)
 
 
 @pytest.mark.parametrize("name", ORACLE_ROBOTS)

@@ -40,6 +40,20 @@ def test_every_branch_reaches_the_pose(name: str) -> None:
     assert found >= 8 * q.shape[0] * 0.5
 
 
+def test_chosen_branches_are_the_columns_of_all_eight() -> None:
+    robot = load_robot("ur10e")
+    g = ur_geometry(robot)
+    q = np.random.default_rng(5).uniform(-np.pi, np.pi, size=(30, 6))
+    poses = flange_pose(robot, q)
+    every = ik_branches(g, poses, hint6=q[:, 5])
+    for pick in ([3], [7, 0, 5], list(range(8))):
+        np.testing.assert_array_equal(
+            ik_branches(g, poses, hint6=q[:, 5], branches=pick), every[:, pick]
+        )
+    with pytest.raises(KinergyError, match="branches are 0-7"):
+        ik_branches(g, poses, branches=[8])
+
+
 def test_nearest_solution_is_the_controllers_choice() -> None:
     robot = load_robot("ur5e")
     g = ur_geometry(robot)

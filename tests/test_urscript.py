@@ -7,11 +7,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from kinergy.dynamics.ik import branch_of, ur_geometry
+from kinergy.dynamics.poses import tcp_pose
 from kinergy.errors import KinergyError
 from kinergy.io.urscript import program_script
 from kinergy.io.urscript_reader import parse_program, read_program
 from kinergy.model.library import load_robot
-from kinergy.trajectory.program_motion import program_motion
+from kinergy.trajectory.movel import joints_on_path
+from kinergy.trajectory.program_motion import program_motion, sample_path
 from kinergy.trajectory.program_path import program_path
 from kinergy.trajectory.robot_program import Event, Move
 
@@ -78,8 +81,6 @@ def test_movej_profile_and_movel_straight_line() -> None:
     path = program_path(robot, parse_program(SMALL))
     motion, sched = program_motion(robot, path)
     # the movel down keeps the tool on a straight vertical line
-    from kinergy.dynamics.poses import tcp_pose
-
     k = 2
     t0, t1 = sched.start[0, k], sched.start[0, k] + sched.duration[0, k]
     inside = (motion.t > t0) & (motion.t < t1)
@@ -100,3 +101,37 @@ def test_benchmark_programs_resolve(path: Path) -> None:
     assert any(isinstance(s, Event) and s.kind == "io" for s in program.steps)
     assert any(isinstance(s, Move) and s.pose for s in program.steps)
     program_path(load_robot(path.stem.split("_")[0]), program)
+
+
+def test_movel_speeds_and_accelerations_are_the_derivatives_of_the_angles() -> None:
+    """The joints' speeds (``J^-1 V``) and accelerations (``J^-1 (A - Jdot qd)``) on the movel
+    down against central differences (step 10 us) of the angles and speeds sampled around
+    every 500 Hz sample of the move."""
+    robot = load_robot("ur5e")
+    path = program_path(robot, parse_program(SMALL))
+    motion, sched = program_motion(robot, path)
+    k = 2
+    t0, t1 = sched.start[0, k], sched.start[0, k] + sched.duration[0, k]
+    t = motion.t[(motion.t > t0 + 1e-3) & (motion.t < t1 - 1e-3)]
+    h = 1e-5
+    q_, qd_, _ = sample_path(robot, path, sched, np.stack([t - h, t + h]))
+    _, qd, qdd = sample_path(robot, path, sched, t[None])
+    np.testing.assert_allclose(qd[0], (q_[1] - q_[0]) / (2 * h), atol=1e-7)
+    np.testing.assert_allclose(qdd[0], (qd_[1] - qd_[0]) / (2 * h), atol=1e-5)
+
+
+def test_a_line_through_the_wrist_singularity_is_refused() -> None:
+    robot = load_robot("ur5e")
+    g = ur_geometry(robot)
+    s = np.linspace(-1.0, 1.0, 41)[:, None]
+    q = np.array([0.3, -1.4, 1.5, -1.6, 0.0, 0.4]) + s * [0.1, 0.05, -0.05, 0.1, 0.3, 0.1]
+    pose = tcp_pose(robot, q)  # wrist 2 passes 0 at the middle sample
+    still = np.zeros((len(q), 6))
+    branch = branch_of(g, q[0], pose[0])
+    with pytest.raises(KinergyError, match="singularity"):
+        joints_on_path(robot, g, np.eye(4), branch, pose, still, still, q)
+    moved = q + np.array([0.0, 0.0, 0.0, 0.0, 1.0, 0.0])  # the same line, away from it
+    pose = tcp_pose(robot, moved)
+    branch = branch_of(g, moved[0], pose[0])
+    q_back, _, _ = joints_on_path(robot, g, np.eye(4), branch, pose, still, still, moved)
+    np.testing.assert_allclose(q_back, moved, atol=1e-9)

@@ -171,8 +171,14 @@ def _arm(
     return np.asarray(q2, dtype=float), q3, np.asarray(q234 - q2 - q3, dtype=float), ok
 
 
-def ik_branches(g: URGeometry, flange: ArrayLike, *, hint6: ArrayLike | None = None) -> Array:
-    """All eight joint solutions of flange poses.
+def ik_branches(
+    g: URGeometry,
+    flange: ArrayLike,
+    *,
+    hint6: ArrayLike | None = None,
+    branches: ArrayLike | None = None,
+) -> Array:
+    """Joint solutions of flange poses, all eight branches or the ones asked for.
 
     Parameters
     ----------
@@ -181,16 +187,21 @@ def ik_branches(g: URGeometry, flange: ArrayLike, *, hint6: ArrayLike | None = N
         Flange poses in the robot's base frame.
     hint6 : array_like, shape (N,) or scalar, optional
         q6 where the wrist is singular (``sin q5 = 0``: only q4 + q6 is fixed), rad; default 0.
+    branches : array_like of int, shape (B,), optional
+        The branches to solve (0-7); default all eight. A sampled straight line needs one.
 
     Returns
     -------
-    ndarray, shape (N, 8, 6) or (8, 6)
-        Joint angles (rad, each in (-pi, pi]), branch ``4 shoulder + 2 wrist + elbow``; NaN rows
-        where the branch cannot reach the pose.
+    ndarray, shape (N, B, 6) or (B, 6)
+        Joint angles (rad, each in (-pi, pi]), in the order of ``branches`` (branch
+        ``4 shoulder + 2 wrist + elbow``); NaN rows where a branch cannot reach the pose.
     """
     f = np.asarray(flange, dtype=float)
     single = f.ndim == 2
     f = f.reshape(-1, 4, 4)
+    wanted = np.arange(BRANCHES) if branches is None else np.asarray(branches, dtype=int)
+    if np.any((wanted < 0) | (wanted >= BRANCHES)):
+        raise KinergyError(f"inverse kinematics: branches are 0-7, got {wanted.tolist()}")
     t = _inverse(g.base) @ f @ _inverse(g.flange)  # frame 6 in frame 0
     big_n = t.shape[0]
     hint = np.broadcast_to(np.asarray(0.0 if hint6 is None else hint6, dtype=float), (big_n,))
@@ -201,16 +212,15 @@ def ik_branches(g: URGeometry, flange: ArrayLike, *, hint6: ArrayLike | None = N
     ratio = g.d4 / np.maximum(r, 1e-300)
     reach1 = np.abs(ratio) <= 1.0 + 1e-9
     beta = np.arcsin(np.clip(ratio, -1.0, 1.0))
-    out = np.full((big_n, BRANCHES, 6), np.nan)
-    for shoulder, q1 in enumerate((phi + beta, phi + np.pi - beta)):
-        for wrist, sign5 in enumerate((1.0, -1.0)):
-            q5, q6, ok5 = _wrist(g, t, q1, sign5, hint)
-            for elbow, sign3 in enumerate((1.0, -1.0)):
-                q2, q3, q4, ok3 = _arm(g, t, q1, q5, q6, sign3)
-                theta = np.stack([q1, q2, q3, q4, q5, q6], axis=1)
-                ok = reach1 & ok5 & ok3
-                b = 4 * shoulder + 2 * wrist + elbow
-                out[:, b] = np.where(ok[:, None], _wrap(theta - g.offset), np.nan)
+    out = np.full((big_n, wanted.size, 6), np.nan)
+    for column, b in enumerate(wanted):
+        shoulder, wrist, elbow = int(b) // 4, (int(b) // 2) % 2, int(b) % 2
+        q1 = phi + beta if shoulder == 0 else phi + np.pi - beta
+        q5, q6, ok5 = _wrist(g, t, q1, 1.0 - 2.0 * wrist, hint)
+        q2, q3, q4, ok3 = _arm(g, t, q1, q5, q6, 1.0 - 2.0 * elbow)
+        theta = np.stack([q1, q2, q3, q4, q5, q6], axis=1)
+        ok = reach1 & ok5 & ok3
+        out[:, column] = np.where(ok[:, None], _wrap(theta - g.offset), np.nan)
     return out[0] if single else out
 
 

@@ -13,7 +13,15 @@ from kinergy.arrays import Array
 from kinergy.dynamics.chain import Chain, check_state, kernel_data
 from kinergy.model.robot import Robot
 
-__all__ = ["flange_pose", "jacobian", "joint_axes", "link_poses", "rot_z_batch"]
+__all__ = [
+    "axes_jacobian",
+    "axes_jacobian_rate",
+    "flange_pose",
+    "jacobian",
+    "joint_axes",
+    "link_poses",
+    "rot_z_batch",
+]
 
 
 def rot_z_batch(q: Array) -> Array:
@@ -80,6 +88,57 @@ def joint_axes(chain: Chain, q: Array) -> tuple[Array, Array, Array]:
     return joint[..., :3, 2], joint[..., :3, 3], link
 
 
+def axes_jacobian(z: Array, o: Array, tip: Array) -> Array:
+    """Geometric Jacobian of a point from the joint axes: column i is ``[z_i x (tip - o_i); z_i]``.
+
+    Parameters
+    ----------
+    z, o : ndarray, shape (N, n, 3)
+        Axis directions and axis points (:func:`joint_axes`), base frame.
+    tip : ndarray, shape (N, 3)
+        The point, base frame, m.
+
+    Returns
+    -------
+    ndarray, shape (N, 6, n)
+    """
+    jv = np.cross(z, tip[:, None, :] - o)
+    return np.concatenate([np.swapaxes(jv, 1, 2), np.swapaxes(z, 1, 2)], axis=1)
+
+
+def axes_jacobian_rate(z: Array, o: Array, tip: Array, qd: Array) -> Array:
+    """``Jdot qd``, the velocity-product part of the point's acceleration
+    (``[a; alpha] = J qdd + Jdot qd``), in closed form from the joint axes.
+
+    Axis ``z_i`` and its point ``o_i`` are fixed in link ``i - 1``, so ``dz_i/dt = w_{i-1} x z_i``
+    and ``do_i/dt`` is link ``i - 1``'s velocity at ``o_i``, with ``w_{i-1} = sum_{j<i} z_j qd_j``;
+    differentiating the columns of :func:`axes_jacobian` gives
+    ``Jdot qd = sum_i qd_i [dz_i/dt x (tip - o_i) + z_i x (v_tip - do_i/dt); dz_i/dt]``.
+
+    Parameters
+    ----------
+    z, o : ndarray, shape (N, n, 3)
+    tip : ndarray, shape (N, 3)
+    qd : ndarray, shape (N, n)
+        Joint speeds, rad/s.
+
+    Returns
+    -------
+    ndarray, shape (N, 6)
+        m/s^2 and rad/s^2.
+    """
+    spin = z * qd[..., None]  # (N, n, 3): each joint's share of the angular velocity
+    w_before = np.cumsum(spin, axis=1) - spin  # w_{i-1}
+    moment = np.cross(spin, o)  # qd_j z_j x o_j
+    o_rate = np.cross(w_before, o) - (np.cumsum(moment, axis=1) - moment)
+    tip_rate = np.cross(spin.sum(axis=1), tip) - moment.sum(axis=1)
+    z_rate = np.cross(w_before, z)
+    lin = np.cross(z_rate, tip[:, None, :] - o) + np.cross(z, tip_rate[:, None, :] - o_rate)
+    return np.concatenate(
+        [np.einsum("nij,ni->nj", lin, qd), np.einsum("nij,ni->nj", z_rate, qd)], axis=1
+    )
+
+
 def jacobian(robot: Robot, q: ArrayLike) -> Array:
     """Geometric Jacobian of the flange in the base frame.
 
@@ -99,7 +158,5 @@ def jacobian(robot: Robot, q: ArrayLike) -> Array:
     single, s = check_state(robot, q=q)
     chain = kernel_data(robot).chain
     z, o, link = joint_axes(chain, s["q"])
-    tip = (link[:, -1] @ chain.flange)[:, :3, 3]
-    jv = np.cross(z, tip[:, None, :] - o)
-    out = np.concatenate([np.swapaxes(jv, 1, 2), np.swapaxes(z, 1, 2)], axis=1)
+    out = axes_jacobian(z, o, (link[:, -1] @ chain.flange)[:, :3, 3])
     return out[0] if single else out

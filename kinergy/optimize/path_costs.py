@@ -216,7 +216,9 @@ def _tool_moves(
         sd.reshape(-1, 1),
         sdd.reshape(-1, 1),
     )
-    q_b = ik_branches(path.geometry, pose_b @ np.linalg.inv(tcp), hint6=q_a[:, 5])[:, branch]
+    q_b = ik_branches(
+        path.geometry, pose_b @ np.linalg.inv(tcp), hint6=q_a[:, 5], branches=[branch]
+    )[:, 0]
     q_b = q_a + _wrap(q_b - q_a)
     frac = (s / np.maximum(length, 1e-300)[:, None]).reshape(-1, 1)
     ref = q_a[rep] + frac * (q_b - q_a)[rep]

@@ -17,7 +17,7 @@ The joints follow from the analytic inverse kinematics (:mod:`kinergy.dynamics.i
 the move starts in, every sample shifted by ``2 pi`` to the value nearest a reference (the
 straight joint-space interpolation of the segments' end joints); their speeds and accelerations
 from the tool's twist through the TCP Jacobian: ``qd = J^-1 V``, ``qdd = J^-1 (A - Jdot qd)``
-with ``Jdot qd`` a central difference of ``J`` along ``qd``.
+with ``Jdot qd`` in closed form (:func:`kinergy.dynamics.kinematics.axes_jacobian_rate`).
 """
 
 from __future__ import annotations
@@ -29,15 +29,17 @@ from scipy.spatial.transform import Rotation
 
 from kinergy.arrays import Array
 from kinergy.dynamics.ik import URGeometry, ik_branches
-from kinergy.dynamics.poses import tcp_jacobian
+from kinergy.dynamics.kinematics import axes_jacobian, axes_jacobian_rate
+from kinergy.dynamics.poses import tcp_axes
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 
 __all__ = ["ToolSegment", "joints_on_path", "tool_motion", "tool_segment"]
 
 
-#: step of the central difference of the Jacobian along qd, s
-_JDOT_STEP = 1e-5
+#: the largest 1-norm condition number of the TCP Jacobian on a straight line; above it the line
+#: passes (too near) a singularity
+_MAX_COND = 1e8
 
 
 @dataclass(frozen=True, eq=False)
@@ -169,19 +171,24 @@ def joints_on_path(
         A sample out of the branch's reach or at a singularity (the caller names the line).
     """
     flange = pose @ np.linalg.inv(tcp)
-    q = ik_branches(geometry, flange, hint6=ref[:, 5])[:, branch]
+    q = ik_branches(geometry, flange, hint6=ref[:, 5], branches=[branch])[:, 0]
     if np.any(np.isnan(q)):
         raise KinergyError("the straight line leaves the arm's reach in its configuration")
     q = _nearest_shift(q, ref)
-    jac = tcp_jacobian(robot, q, tcp)
-    cond = np.linalg.cond(jac)
-    if np.any(cond > 1e8):
+    z, o, tip = tcp_axes(robot, q, tcp)
+    jac = axes_jacobian(z, o, tip)
+    try:
+        inv: Array = np.asarray(np.linalg.inv(jac), dtype=float)
+    except np.linalg.LinAlgError:
+        inv = np.full_like(jac, np.inf)
+    cond = _norm1(jac) * _norm1(inv)
+    if not np.all(cond <= _MAX_COND):
         raise KinergyError("the straight line passes a singularity of the arm")
-    qd = np.linalg.solve(jac, twist[..., None])[..., 0]
-    h = _JDOT_STEP
-    jdot_qd = (
-        np.einsum("sij,sj->si", tcp_jacobian(robot, q + h * qd, tcp), qd)
-        - np.einsum("sij,sj->si", tcp_jacobian(robot, q - h * qd, tcp), qd)
-    ) / (2.0 * h)
-    qdd = np.linalg.solve(jac, (accel - jdot_qd)[..., None])[..., 0]
-    return q, np.asarray(qd, dtype=float), np.asarray(qdd, dtype=float)
+    qd = np.einsum("sij,sj->si", inv, twist)
+    qdd = np.einsum("sij,sj->si", inv, accel - axes_jacobian_rate(z, o, tip, qd))
+    return q, qd, qdd
+
+
+def _norm1(m: Array) -> Array:
+    """1-norms (largest column sum of magnitudes) of matrices (S, 6, 6) -> (S,)."""
+    return np.asarray(np.abs(m).sum(axis=-2).max(axis=-1))

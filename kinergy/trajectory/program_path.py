@@ -194,7 +194,7 @@ def follow_line(
         zero,
     )
     flange = pose @ np.linalg.inv(tcp)
-    q = ik_branches(g, flange, hint6=np.full(_LINE_POINTS, q_a[5]))[:, branch]
+    q = ik_branches(g, flange, hint6=np.full(_LINE_POINTS, q_a[5]), branches=[branch])[:, 0]
     if np.any(np.isnan(q)):
         raise KinergyError("the straight line leaves the arm's reach")
     q = np.unwrap(q, axis=0)
