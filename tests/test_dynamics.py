@@ -14,8 +14,14 @@ import pytest
 from conftest import random_state
 
 import kinergy
-from kinergy.dynamics.kinematics import axes_jacobian_rate, flange_pose, jacobian, link_poses
-from kinergy.dynamics.poses import tcp_axes, tcp_jacobian, tcp_pose
+from kinergy.dynamics.kinematics import (
+    axes_jacobian_rate,
+    flange_pose,
+    jacobian,
+    link_poses,
+    tool_axes,
+)
+from kinergy.dynamics.poses import tcp_jacobian, tcp_pose
 
 pin = pytest.importorskip("pinocchio")
 from kinergy.dynamics.pinocchio import to_pinocchio  # noqa: E402
@@ -118,7 +124,7 @@ def test_jacobian_rate_matches_differences_of_the_pose(name: str) -> None:
     q, qd, _ = random_state(robot, 6, seed=9)
     tcp = np.eye(4)
     tcp[:3, 3] = [0.02, -0.01, 0.12]
-    rate = axes_jacobian_rate(*tcp_axes(robot, q, tcp), qd)
+    rate = axes_jacobian_rate(*tool_axes(robot, q, tcp), qd)
     h = 1e-4
     position = [tcp_pose(robot, q + k * h * qd, tcp)[:, :3, 3] for k in (-1, 0, 1)]
     accel = (position[2] - 2.0 * position[1] + position[0]) / h**2

@@ -21,6 +21,7 @@ __all__ = [
     "joint_axes",
     "link_poses",
     "rot_z_batch",
+    "tool_axes",
 ]
 
 
@@ -139,8 +140,36 @@ def axes_jacobian_rate(z: Array, o: Array, tip: Array, qd: Array) -> Array:
     )
 
 
-def jacobian(robot: Robot, q: ArrayLike) -> Array:
-    """Geometric Jacobian of the flange in the base frame.
+def tool_axes(
+    robot: Robot, q: ArrayLike, tool: ArrayLike | None = None
+) -> tuple[Array, Array, Array]:
+    """The joint axes and a tool point of joint angles, base frame: what :func:`axes_jacobian`
+    and :func:`axes_jacobian_rate` are made of.
+
+    Parameters
+    ----------
+    robot : Robot
+    q : array_like, shape (n,) or (N, n)
+        Joint angles, rad.
+    tool : array_like, shape (4, 4), optional
+        The tool frame in the flange frame (URScript's ``set_tcp``); default the flange itself.
+
+    Returns
+    -------
+    z, o : ndarray, shape (N, n, 3)
+        Axis directions and axis points (:func:`joint_axes`).
+    tip : ndarray, shape (N, 3)
+        The tool point, m.
+    """
+    _, s = check_state(robot, q=q)
+    chain = kernel_data(robot).chain
+    z, o, link = joint_axes(chain, s["q"])
+    end = chain.flange if tool is None else chain.flange @ np.asarray(tool, dtype=float)
+    return z, o, (link[:, -1] @ end)[:, :3, 3]
+
+
+def jacobian(robot: Robot, q: ArrayLike, tool: ArrayLike | None = None) -> Array:
+    """Geometric Jacobian of the flange (or of a tool point) in the base frame.
 
     ``[v; w] = J qd`` with ``v`` the linear velocity of the flange origin (m/s) and ``w`` the
     angular velocity (rad/s), both in base-frame coordinates.
@@ -150,13 +179,13 @@ def jacobian(robot: Robot, q: ArrayLike) -> Array:
     robot : Robot
     q : array_like, shape (n,) or (N, n)
         Joint angles, rad.
+    tool : array_like, shape (4, 4), optional
+        A tool frame in the flange frame whose origin ``v`` is the velocity of; default the
+        flange.
 
     Returns
     -------
     ndarray, shape (6, n) or (N, 6, n)
     """
-    single, s = check_state(robot, q=q)
-    chain = kernel_data(robot).chain
-    z, o, link = joint_axes(chain, s["q"])
-    out = axes_jacobian(z, o, (link[:, -1] @ chain.flange)[:, :3, 3])
-    return out[0] if single else out
+    out = axes_jacobian(*tool_axes(robot, q, tool))
+    return out[0] if np.ndim(q) == 1 else out

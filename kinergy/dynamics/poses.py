@@ -4,8 +4,8 @@ A URScript pose is a position (m) and a rotation vector (axis times angle, rad) 
 base frame; :func:`pose_matrix` and :func:`pose_vector` convert between it and the homogeneous
 transform that :mod:`kinergy.dynamics.kinematics` uses (rotation vectors through
 :class:`scipy.spatial.transform.Rotation`). :func:`tcp_pose` is the tool centre point of joint
-angles (the flange pose times the TCP offset that ``set_tcp`` sets), :func:`tcp_jacobian`
-its geometric Jacobian and :func:`tcp_axes` the joint axes both it and its rate are made of.
+angles (the flange pose times the TCP offset that ``set_tcp`` sets) and :func:`tcp_jacobian`
+its geometric Jacobian.
 """
 
 from __future__ import annotations
@@ -15,8 +15,7 @@ from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from kinergy.arrays import Array
-from kinergy.dynamics.chain import check_state, kernel_data
-from kinergy.dynamics.kinematics import axes_jacobian, flange_pose, joint_axes
+from kinergy.dynamics.kinematics import flange_pose, jacobian
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 
@@ -24,7 +23,6 @@ __all__ = [
     "pose_matrix",
     "pose_vector",
     "rotation_about_z",
-    "tcp_axes",
     "tcp_jacobian",
     "tcp_pose",
 ]
@@ -94,34 +92,6 @@ def tcp_pose(robot: Robot, q: ArrayLike, tcp: ArrayLike | None = None) -> Array:
     return flange if tcp is None else np.asarray(flange @ np.asarray(tcp, dtype=float))
 
 
-def tcp_axes(
-    robot: Robot, q: ArrayLike, tcp: ArrayLike | None = None
-) -> tuple[Array, Array, Array]:
-    """The joint axes and the tool centre point of joint angles, base frame.
-
-    Parameters
-    ----------
-    robot : Robot
-    q : array_like, shape (N, n)
-        Joint angles, rad.
-    tcp : array_like, shape (4, 4), optional
-        The TCP in the flange frame; default the flange itself.
-
-    Returns
-    -------
-    z, o : ndarray, shape (N, n, 3)
-        Axis directions and axis points (:func:`kinergy.dynamics.kinematics.joint_axes`).
-    tip : ndarray, shape (N, 3)
-        The TCP's position, m: with them, :func:`kinergy.dynamics.kinematics.axes_jacobian`
-        and :func:`kinergy.dynamics.kinematics.axes_jacobian_rate`.
-    """
-    _, s = check_state(robot, q=q)
-    chain = kernel_data(robot).chain
-    z, o, link = joint_axes(chain, s["q"])
-    tool = chain.flange if tcp is None else chain.flange @ np.asarray(tcp, dtype=float)
-    return z, o, (link[:, -1] @ tool)[:, :3, 3]
-
-
 def tcp_jacobian(robot: Robot, q: ArrayLike, tcp: ArrayLike | None = None) -> Array:
     """Geometric Jacobian of the tool centre point: ``[v; w] = J qd`` with ``v`` the TCP's
     velocity (m/s) and ``w`` the angular velocity (rad/s), base frame.
@@ -132,6 +102,4 @@ def tcp_jacobian(robot: Robot, q: ArrayLike, tcp: ArrayLike | None = None) -> Ar
         Column i is ``[z_i x (p - o_i); z_i]``, ``p`` the TCP (the flange Jacobian with its
         linear rows moved to the TCP: ``v_tcp = v + w x r``).
     """
-    single = np.ndim(q) == 1
-    out = axes_jacobian(*tcp_axes(robot, np.atleast_2d(np.asarray(q, dtype=float)), tcp))
-    return out[0] if single else out
+    return jacobian(robot, q, tcp)

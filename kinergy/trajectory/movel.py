@@ -29,8 +29,7 @@ from scipy.spatial.transform import Rotation
 
 from kinergy.arrays import Array
 from kinergy.dynamics.ik import URGeometry, ik_branches
-from kinergy.dynamics.kinematics import axes_jacobian, axes_jacobian_rate
-from kinergy.dynamics.poses import tcp_axes
+from kinergy.dynamics.kinematics import axes_jacobian, axes_jacobian_rate, tool_axes
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 
@@ -175,7 +174,7 @@ def joints_on_path(
     if np.any(np.isnan(q)):
         raise KinergyError("the straight line leaves the arm's reach in its configuration")
     q = _nearest_shift(q, ref)
-    z, o, tip = tcp_axes(robot, q, tcp)
+    z, o, tip = tool_axes(robot, q, tcp)
     jac = axes_jacobian(z, o, tip)
     try:
         inv: Array = np.asarray(np.linalg.inv(jac), dtype=float)
