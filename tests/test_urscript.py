@@ -135,3 +135,11 @@ def test_a_line_through_the_wrist_singularity_is_refused() -> None:
     branch = branch_of(g, moved[0], pose[0])
     q_back, _, _ = joints_on_path(robot, g, np.eye(4), branch, pose, still, still, moved)
     np.testing.assert_allclose(q_back, moved, atol=1e-9)
+
+
+def test_a_program_without_moves_names_its_file_once(tmp_path: Path) -> None:
+    script = tmp_path / "idle.script"
+    script.write_text("def idle():\n  set_payload(1.0)\nend\n")
+    with pytest.raises(KinergyError) as err:
+        read_program(script)
+    assert str(err.value) == f"{script}: the program has no move"

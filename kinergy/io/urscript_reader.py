@@ -345,16 +345,13 @@ def parse_program(text: str, *, path: str = "", name: str = "program") -> RobotP
             raise exc.prefixed(where) from None
     if reader.depth:
         raise KinergyError(f"{path or name}: 'def' without 'end'")
-    try:
-        return RobotProgram(
-            name=reader.name or name,
-            steps=tuple(reader.steps),
-            path=path,
-            lines=tuple(lines),
-            notes=tuple(reader.notes),
-        )
-    except KinergyError as exc:
-        raise exc.prefixed(path) if path else exc from None
+    return RobotProgram(  # names its path itself when it refuses (no move)
+        name=reader.name or name,
+        steps=tuple(reader.steps),
+        path=path,
+        lines=tuple(lines),
+        notes=tuple(reader.notes),
+    )
 
 
 def read_program(path: str | os.PathLike[str]) -> RobotProgram:
