@@ -346,11 +346,40 @@ def read_text(path: PathLike, what: str, *, max_bytes: int | None = None) -> str
                 f"{path}: {size / 1e6:.1f} MB is too large for a {what} "
                 f"(at most {max_bytes // (1024 * 1024)} MiB)"
             )
-        return path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8-sig")  # a byte-order mark is not text
     except OSError as exc:
         raise KinergyError(f"{path}: cannot read {what} ({exc.strerror})") from None
     except UnicodeDecodeError:
-        raise KinergyError(f"{path}: not a text (UTF-8) file") from None
+        raise KinergyError(f"{path}: not a text (UTF-8) file{_encoding_hint(path)}") from None
+
+
+def _encoding_hint(path: Path) -> str:
+    """What a file that is not UTF-8 most likely is, for the message."""
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(4096)
+    except OSError:
+        return ""
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")) or (head[1::2].count(0) > len(head) // 4):
+        return ": it is UTF-16; save it as UTF-8"
+    return ""
+
+
+def _huge_integer(data: Any, where: str = "") -> str | None:
+    """The key path of the first integer in parsed TOML ``data`` that no float holds."""
+    if isinstance(data, dict):
+        for key, value in data.items():
+            found = _huge_integer(value, f"{where}.{key}" if where else str(key))
+            if found:
+                return found
+    elif isinstance(data, list):
+        for k, value in enumerate(data):
+            found = _huge_integer(value, f"{where}[{k}]")
+            if found:
+                return found
+    elif isinstance(data, int) and not isinstance(data, bool) and abs(data) > 1e300:
+        return where
+    return None
 
 
 def read_toml(path: PathLike, what: str) -> dict[str, Any]:
@@ -365,8 +394,12 @@ def read_toml(path: PathLike, what: str) -> dict[str, Any]:
     """
     text = read_text(path, what, max_bytes=MAX_TOML_BYTES)
     try:
-        return tomllib.loads(text)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise KinergyError(f"{path}: not valid TOML: {exc}") from None
     except RecursionError:
         raise KinergyError(f"{path}: not a {what}: its tables or arrays nest too deeply") from None
+    huge = _huge_integer(data)
+    if huge is not None:
+        raise KinergyError(f"{path}: {huge}: an integer too large for any number kinergy reads")
+    return data

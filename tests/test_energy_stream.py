@@ -54,7 +54,7 @@ def test_one_pass_equals_in_memory(
 ) -> None:
     # actual: accelerations from a spline of the noisy speed, carried across chunk boundaries
     want = energy_of_log(ur5e, long_log, source=source, recovery=recovery).to_dict()
-    got = energy_figures_of_log(ur5e, long_log, source=source, recovery=recovery, rows=1000)
+    got, _ = energy_figures_of_log(ur5e, long_log, source=source, recovery=recovery, rows=1000)
     assert got.samples == want["samples"] >= 10_000 and got.segments == 1
     assert "measured" in want
     _assert_same(got.to_dict(), want)
@@ -71,7 +71,9 @@ def test_a_gap_is_never_integrated_across(
     write_log(parts["b"], t_b, b.signals)
     joined = {k: np.concatenate([a[k], b[k]]) for k in a.signals}
     write_log(parts["ab"], np.concatenate([a.t, t_b]), joined)
-    one = {k: energy_figures_of_log(ur5e, p, source="actual", rows=1000) for k, p in parts.items()}
+    one = {
+        k: energy_figures_of_log(ur5e, p, source="actual", rows=1000)[0] for k, p in parts.items()
+    }
     ab, sa, sb = one["ab"], one["a"], one["b"]
     assert ab.segments == 2 and sa.segments == sb.segments == 1
     assert ab.duration == pytest.approx(sa.duration + sb.duration, rel=1e-12)

@@ -100,7 +100,7 @@ def test_a_joint_that_never_moves_gets_a_message_not_numbers(ur5e: kinergy.Robot
     entry = result.joints[3]
     assert entry.identified is False and "never moves" in entry.problem
     assert entry.torque_constant == ur5e.joints[3].drive.torque_constant  # the model's, untouched
-    assert any("joint 4 (wrist_1) never moves" in w for w in result.warnings)
+    assert any("joint 4 (wrist_1) never moves" in w for w in result.notes)
     assert all(j.identified for k, j in enumerate(result.joints) if k != 3)
 
 

@@ -175,7 +175,7 @@ def test_moment_recovers_the_true_base_parameters_and_rotor_inertias(
         "rotor inertia of joint 1 (shoulder_pan)",
         "rotor inertia of joint 2 (shoulder_lift)",
     ]
-    assert sum("cannot be told apart" in w for w in result.warnings) == 2
+    assert sum("cannot be told apart" in n for n in result.notes) == 2
     for m, (entry, joint) in enumerate(zip(result.joints, ur5e.joints, strict=True)):
         assert entry.rotor_inertia_merged == (m < 2)
         if m >= 2:  # the separable rotor inertias are exact
@@ -377,7 +377,7 @@ def test_unphysical_base_parameters_are_flagged(ur5e: kinergy.Robot, ur5e_motion
     result = identify_full(ur5e, [_moment_log(ur5e, ur5e_motion, pi_b)], target="moment")
     values, _ = identified_base(result)
     assert values[izz6] == pytest.approx(-0.05, rel=1e-6)  # what the data say ...
-    flagged = [w for w in result.warnings if w.startswith("link 6 (wrist_3)")]
+    flagged = [w for w in result.notes if w.startswith("link 6 (wrist_3)")]
     assert len(flagged) == 1 and "not positive definite" in flagged[0]
     # ... and a valid robot anyway: the fit constrained to physical links
     assert result.fit.write_back == "physically consistent least squares"

@@ -11,6 +11,8 @@ import pytest
 import kinergy
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.rtde import write_log
+from kinergy.logs.reading import LogReading
+from kinergy.model import load_robot
 from kinergy.simulate import simulate
 from kinergy.trajectory.programs import paper_trajectory
 from kinergy.workflows.logs import prepared_logs
@@ -26,9 +28,10 @@ def test_a_log_with_a_gap_is_identified_as_its_segments(
     write_log(joined, t, signals)
     write_log(single, twin.t, twin.signals)
 
-    notes: list[str] = []
-    parts = prepared_logs([joined], n_joints=6, note=notes.append)
-    twice = prepared_logs([single, single], n_joints=6)
+    ur5e = load_robot("ur5e")
+    parts, inputs = prepared_logs([joined], ur5e, LogReading())
+    twice, _ = prepared_logs([single, single], ur5e, LogReading())
+    notes = [n for n in inputs.notes if "segments" in n]
     assert len(parts) == 2
     assert len(notes) == 1 and "2 segments (gaps up to 3600.000 s)" in notes[0]
     for got, want in zip(parts, twice, strict=True):

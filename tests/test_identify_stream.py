@@ -16,6 +16,7 @@ from kinergy.identify.log_chunks import spill_log
 from kinergy.identify.sequential import identify_sequential, sequential_from
 from kinergy.identify.streamed import LogsInChunks, WholeSegment, streams
 from kinergy.io.rtde import write_log
+from kinergy.logs.reading import CheckedLog, LogReading
 from kinergy.model import Robot, load_robot
 from kinergy.simulate import TwinSettings, realistic_truth, simulate
 from kinergy.trajectory.programs import paper_trajectory
@@ -80,17 +81,12 @@ def test_the_default_identify_streams() -> None:
 @pytest.mark.parametrize("rows", [997, 4000])
 def test_streamed_identify_equals_in_memory(twin_log: Path, tmp_path: Path, rows: int) -> None:
     ur5e = load_robot("ur5e")
-    notes_whole: list[str] = []
-    notes_chunks: list[str] = []
-    whole = identify_model(
-        ur5e, prepared_logs([twin_log], n_joints=6, note=notes_whole.append), tmp_path / "a.toml"
-    )
-    chunked = identify_logs(
-        ur5e, [twin_log], tmp_path / "b.toml", reading={"note": notes_chunks.append}, rows=rows
-    )
-    assert notes_chunks == notes_whole and "2 segments" in notes_chunks[0]
+    datas, read = prepared_logs([twin_log], ur5e, LogReading())
+    whole = identify_model(ur5e, datas)
+    chunked = identify_logs(ur5e, [twin_log], tmp_path / "b.toml", rows=rows)
+    assert chunked.inputs.notes == read.notes and "2 segments" in read.notes[0]
     _assert_same(chunked.robot, whole.robot)
-    _assert_same(load_robot(tmp_path / "b.toml"), load_robot(tmp_path / "a.toml"))
+    _assert_same(load_robot(tmp_path / "b.toml"), whole.robot)
     assert chunked.fit.logs == whole.fit.logs and chunked.fit.samples == whole.fit.samples
     np.testing.assert_allclose(chunked.fit.lag, whole.fit.lag, rtol=RTOL)
     for key in ("torque", "current"):
@@ -100,12 +96,13 @@ def test_streamed_identify_equals_in_memory(twin_log: Path, tmp_path: Path, rows
                 [want.mean, want.max, want.rms, want.r2],
                 rtol=1e-8,
             )
-    assert chunked.warnings == whole.warnings
+    assert chunked.fit.warnings == whole.fit.warnings and chunked.fit.notes == whole.fit.notes
 
 
 def test_prepared_chunks_equal_the_prepared_segments(twin_log: Path) -> None:
-    datas = prepared_logs([twin_log], n_joints=6)
-    with chunked_logs([twin_log], n_joints=6, rows=1500) as segments:
+    ur5e = load_robot("ur5e")
+    datas, _ = prepared_logs([twin_log], ur5e, LogReading())
+    with chunked_logs([twin_log], ur5e, LogReading(), rows=1500) as (segments, _):
         assert [s.path for s in segments] == [d.path for d in datas]
         for segment, data in zip(segments, datas, strict=True):
             parts = list(segment.chunks(1500))
@@ -120,7 +117,7 @@ def test_friction_held_through_standstill_crosses_chunks(twin_log: Path) -> None
     """With the hold on, each chunk's columns and predictions recall the last moving sample
     of the chunks before it; the result equals the whole logs' (chunks of one log held whole)."""
     ur5e = load_robot("ur5e")
-    datas = prepared_logs([twin_log], n_joints=6)
+    datas, _ = prepared_logs([twin_log], ur5e, LogReading())
     whole = identify_sequential(ur5e, datas, hold=True)
     logs = LogsInChunks(ur5e, [WholeSegment(d) for d in datas], rows=700)
     chunked = sequential_from(ur5e, logs, hold=True)
@@ -132,7 +129,7 @@ def test_friction_held_through_standstill_crosses_chunks(twin_log: Path) -> None
 
 
 def test_the_spill_is_removed(twin_log: Path) -> None:
-    spill = spill_log(twin_log, rows=1000)
+    spill = spill_log(CheckedLog(twin_log, load_robot("ur5e"), rows=1000))
     name = Path(f"/proc/self/fd/{spill.file.fileno()}").resolve()
     assert len(spill) > 1000 and spill.read(10, 12).t.size == 2
     spill.close()
@@ -145,7 +142,7 @@ def test_a_log_without_a_target_is_prepared_whole(tmp_path: Path) -> None:
     signals = {k: v for k, v in twin.signals.items() if not k.startswith("target_q")}
     path = tmp_path / "actual.csv"
     write_log(path, twin.t, signals)
-    whole = identify_model(ur5e, prepared_logs([path], n_joints=6), tmp_path / "a.toml")
+    whole = identify_model(ur5e, prepared_logs([path], ur5e, LogReading())[0])
     chunked = identify_logs(ur5e, [path], tmp_path / "b.toml", rows=1000)
     _assert_same(chunked.robot, whole.robot)
 

@@ -10,6 +10,7 @@ import pytest
 
 import kinergy
 from kinergy.cli import main
+from kinergy.identify.options import IdentifyOptions
 from kinergy.identify.preprocess import prepare
 from kinergy.io.rtde import read_log, write_log
 from kinergy.simulate import TwinSettings, realistic_truth, simulate
@@ -73,7 +74,7 @@ def test_identification_recovers_the_truth_not_the_model(
     ur5e: kinergy.Robot, twin_log: tuple[Path, kinergy.Robot]
 ) -> None:
     path, truth = twin_log
-    result = identify_model(ur5e, [prepare(read_log(path), 6)], friction="auto")
+    result = identify_model(ur5e, [prepare(read_log(path), 6)], IdentifyOptions(friction="auto"))
     got, want = result.robot, truth
     for gj, tj in zip(got.joints, want.joints, strict=True):
         assert gj.drive.torque_constant == pytest.approx(tj.drive.torque_constant, rel=0.05)
@@ -85,7 +86,7 @@ def test_identification_recovers_the_truth_not_the_model(
     assert choices is not None and all(c is not None for c in choices)
     # the concave truth beats a straight line on every joint
     assert all(c.model != "viscous_coulomb" and c.gain_over_viscous_coulomb > 0 for c in choices)
-    assert any("written into the model" in w for w in result.warnings)
+    assert any("written into the model" in n for n in result.notes)
 
 
 def test_cli_simulate_mismatch_writes_the_truth(
@@ -103,6 +104,6 @@ def test_cli_simulate_mismatch_writes_the_truth(
     model = tmp_path / "id.toml"
     ident = ["identify", str(out), "--robot", "ur5e", "--friction", "auto", "--out", str(model)]
     assert main(ident) == 0
-    text = capsys.readouterr().out
-    assert "Friction chosen per joint" in text and "vs Coulomb+viscous [%]" in text
-    assert "R = " in text and "standby power" in text
+    out, err = capsys.readouterr()
+    assert "Friction chosen per joint" in out and "vs Coulomb+viscous [%]" in out
+    assert "kinergy: note: joint 1 (shoulder_pan): R = " in err and "standby power" in err

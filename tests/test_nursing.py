@@ -334,7 +334,7 @@ def test_identify_nursing_on_a_noise_free_excitation(arm, tmp_path) -> None:
     assert max(ridge.rmse_test) < 5e-3  # N m, on torques of 0.1-0.5 N m spread
     assert max(m.rms for m in result.fit.current) < 1e-3  # A
     # no friction runs: the motors keep the model's friction, and say so
-    assert any("no friction run" in w for w in result.warnings)
+    assert any("no friction run" in n for n in result.notes)
     save_robot(result.robot, tmp_path / "identified.toml")
     assert load_robot(str(tmp_path / "identified.toml")).n == 6
     json.dumps(result.to_dict(), default=float)

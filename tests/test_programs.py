@@ -74,7 +74,7 @@ def test_written_program_reproduces_optimized_csv(optimized: tuple[Path, dict]) 
     log = read_log(folder / "motions" / "optimized.csv")
     assert {"target_q", "target_qd", "target_qdd"} <= set(log.signals)
     assert (folder / "motions" / "optimized.csv").read_text().startswith("timestamp target_q_0")
-    again = read_motion(folder / "small_opt.script", n_joints=6, robot=load_robot("ur5e"))
+    again, _ = read_motion(folder / "small_opt.script", load_robot("ur5e"))
     q = log["target_q"]
     n = min(q.shape[0], again.q.shape[0])
     assert abs(q.shape[0] - again.q.shape[0]) <= 1

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import kinergy
+from kinergy.identify.options import IdentifyOptions, Method
 from kinergy.identify.validation import (
     HOLD_SECONDS,
     SignalMetrics,
@@ -16,10 +17,16 @@ from kinergy.identify.validation import (
     holding_mask,
     validation_report,
 )
+from kinergy.io.columns import parse_columns
+from kinergy.logs.reading import LogReading
 from kinergy.workflows.logs import prepared_logs
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "ur10e-innopolis"
 UR10E_COLUMNS = "timestamp,actual_q:6,actual_qd:6,actual_current:6,target_current:6,target_moment:6"
+
+
+def _reading(spec: str = UR10E_COLUMNS) -> LogReading:
+    return LogReading(columns=tuple(parse_columns(spec, 6)))
 
 
 def test_holding_mask_keeps_only_long_holds() -> None:
@@ -50,7 +57,7 @@ def test_real_program_with_holds_is_reported_per_log_and_segment() -> None:
         DATASETS / "validation_data" / "ur-20_01_17-ptp_10_points.csv",
         DATASETS / "validation_data" / "ur-20_01_17-p1.csv",
     ]
-    datas = prepared_logs(paths, n_joints=6, columns=UR10E_COLUMNS)
+    datas, _ = prepared_logs(paths, robot, _reading())
     report = validation_report(robot, datas)
     assert [Path(log.log).name for log in report.logs] == [p.name for p in paths]
     assert report.samples == sum(log.samples for log in report.logs)
@@ -74,35 +81,35 @@ def test_a_log_shorter_than_a_second_is_refused_and_nothing_written(tmp_path: Pa
     fourier = DATASETS / "identification_data" / "ur-20_02_12-50sec_12harm.csv"
     short = tmp_path / "short.csv"
     short.write_text("".join(fourier.read_text().splitlines(keepends=True)[1000:1080]))
-    datas = prepared_logs([short], n_joints=6, columns=UR10E_COLUMNS)
-    out = tmp_path / "model.toml"
+    datas, _ = prepared_logs([short], kinergy.load_robot("ur10e"), _reading())
     with pytest.raises(KinergyError, match=r"span 0\.\d+ s: identification needs at least 1 s"):
-        identify_model(kinergy.load_robot("ur10e"), datas, out, method="full")
-    assert not out.exists()
+        identify_model(kinergy.load_robot("ur10e"), datas, IdentifyOptions(method=Method.FULL))
 
 
 @pytest.mark.skipif(not DATASETS.exists(), reason="shared datasets not available")
 def test_a_corrupted_log_is_refused_in_one_line() -> None:
     from kinergy.errors import KinergyError
-    from kinergy.identify.sanity import check_signals
 
     corrupted = DATASETS / "identification_data" / "ur-19_09_27-11_32_02.csv"  # speeds of 1e293
-    datas = prepared_logs(
-        [corrupted], n_joints=6, columns="timestamp,actual_q:6,actual_qd:6,actual_current:6"
-    )
-    with pytest.raises(KinergyError, match=r"not a value a robot logs .* a corrupted log$"):
-        check_signals(datas)
+    spec = "timestamp,actual_q:6,actual_qd:6,actual_current:6"
+    with pytest.raises(KinergyError, match=r"units check failed: actual_q of joint \d .* beyond"):
+        prepared_logs([corrupted], kinergy.load_robot("ur10e"), _reading(spec))
 
 
 @pytest.mark.skipif(not DATASETS.exists(), reason="shared datasets not available")
 def test_a_static_log_is_refused_by_every_method(tmp_path: Path) -> None:
     from kinergy.errors import KinergyError
-    from kinergy.workflows.identify import METHODS, identify_model
+    from kinergy.workflows.identify import identify_logs
 
     static = DATASETS / "validation_data" / "ur-20_01_17-p1.csv"  # holds only
-    datas = prepared_logs([static], n_joints=6, columns=UR10E_COLUMNS)
-    for method in METHODS:
+    for method in Method:
         out = tmp_path / f"{method}.toml"
         with pytest.raises(KinergyError, match="no joint moves in these logs"):
-            identify_model(kinergy.load_robot("ur10e"), datas, out, method=method)
+            identify_logs(
+                kinergy.load_robot("ur10e"),
+                [static],
+                out,
+                reading=_reading(),
+                options=IdentifyOptions(method=method),
+            )
         assert not out.exists()

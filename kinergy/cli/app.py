@@ -26,7 +26,8 @@ __all__ = ["COMMANDS", "NOTES", "QUIET", "LazyGroup", "cli", "main", "one_line",
 
 #: key in click's ``ctx.meta``: the global ``--quiet`` was given (no progress on stderr)
 QUIET = "kinergy.quiet"
-#: key in the context object :func:`main` passes: the notes held back until the command succeeds
+#: key in the context object :func:`main` passes: the notes and warnings held back until the
+#: command succeeds, as (level, text) with level "note" or "warning"
 NOTES = "kinergy.notes"
 
 #: command name -> "module:attribute" of its click command, in the order ``--help`` lists them
@@ -65,14 +66,23 @@ class LazyGroup(click.Group):
 
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="kinergy")
-@click.option("--quiet", "-q", is_flag=True, help="No progress display on stderr.")
+@click.option(
+    "--quiet",
+    "-q",
+    is_flag=True,
+    help="No progress display and no notes on stderr (warnings stay).",
+)
 @click.pass_context
 def cli(ctx: click.Context, quiet: bool) -> None:
     """Electro-mechanical models of robot arms from controller logs.
 
-    Long steps show their progress on stderr when it is a terminal (not with --quiet).
+    Long steps show their progress on stderr when it is a terminal. Besides its result (on
+    stdout), a command says on stderr what is routine ("note:") and what may make the result
+    wrong ("warning:"); --quiet drops the progress and the notes.
     """
     ctx.meta[QUIET] = quiet
+    if isinstance(ctx.obj, dict):
+        ctx.obj[QUIET] = quiet
 
 
 _CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")
@@ -86,14 +96,15 @@ def one_line(message: str) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point: run the CLI, turning user errors into one line and a non-zero exit."""
-    notes: list[str] = []
+    notes: list[tuple[str, str]] = []
+    obj: dict[str, object] = {NOTES: notes}
     try:
         with terminate_on_signals():
             cli.main(
                 args=list(argv) if argv is not None else None,
                 prog_name="kinergy",
                 standalone_mode=False,
-                obj={NOTES: notes},
+                obj=obj,
             )
     except KinergyError as exc:
         click.echo(f"kinergy: error: {one_line(str(exc))}", err=True)
@@ -114,8 +125,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         return exc.exit_code
     except BrokenPipeError:
         return 0
-    for message in notes:
-        click.echo(f"kinergy: note: {one_line(message)}", err=True)
+    for level, message in notes:
+        if level == "note" and obj.get(QUIET):
+            continue
+        click.echo(f"kinergy: {level}: {one_line(message)}", err=True)
     return 0
 
 

@@ -17,14 +17,19 @@ from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElaps
 from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_output, check_outputs
+from kinergy.io.columns import parse_columns
+from kinergy.logs.checks import Check, parse_accept
+from kinergy.logs.reading import LogReading
 from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
+    "accept_option",
     "columns_option",
     "cutoff_option",
     "fmt",
     "fmt_vector",
     "load",
+    "log_reading",
     "note",
     "output_file_option",
     "payload_option",
@@ -34,6 +39,8 @@ __all__ = [
     "report_folder_option",
     "seed_option",
     "table",
+    "tell",
+    "warn",
     "writes",
 ]
 
@@ -57,6 +64,20 @@ def fmt(x: float) -> str:
 def fmt_vector(v: Any) -> str:
     """``[a, b, c]`` with :func:`fmt` numbers."""
     return "[" + ", ".join(fmt(float(x)) for x in np.asarray(v)) + "]"
+
+
+def log_reading(
+    robot: Robot,
+    *,
+    columns: str | None = None,
+    repair: bool = False,
+    cutoff: float | None = None,
+    accept: Sequence[str] = (),
+) -> LogReading:
+    """The log-reading options of a command, parsed for ``robot`` (its joint count checks the
+    ``--columns`` spec)."""
+    names = None if columns is None else tuple(parse_columns(columns, robot.n))
+    return LogReading(columns=names, repair=repair, cutoff=cutoff, accept=parse_accept(accept))
 
 
 def load(robot_name: str, payload: str | None) -> Robot:
@@ -105,7 +126,17 @@ def report_folder_option(contents: str = "the figures") -> Callable[[F], F]:
 columns_option = click.option(
     "--columns",
     metavar="SPEC",
-    help='Layout of a headerless log, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6".',
+    help="Layout of a headerless log: UR's RTDE field names, NAME:N for an N-vector, _ (or _:N) "
+    'for columns to skip, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6".',
+)
+accept_option = click.option(
+    "--accept",
+    "accept",
+    multiple=True,
+    metavar="CHECK",
+    help="Go on although this check fails (repeatable; recorded in the result): "
+    + ", ".join(c.value for c in Check)
+    + ", or all.",
 )
 cutoff_option = click.option(
     "--cutoff",
@@ -172,6 +203,9 @@ def writes(
                 for name in (*files, *folders, *into)
                 for path in _given(kwargs[name])
             ]
+            for flag, path in outputs:
+                if not path.strip():
+                    raise KinergyError(f"{flag}: an empty path names no file or folder")
             for name, check in [(n, check_output) for n in files] + [
                 (n, check_folder) for n in folders
             ]:
@@ -217,15 +251,34 @@ def progress(*, quiet: bool = False) -> Iterator[Callable[[str], None]]:
                 bar.update(current[-1], completed=1)
 
 
-def note(message: str) -> None:
-    """A note for the user on stderr (what reading a file changed). Under :func:`kinergy.cli.main`
-    the notes are held back and shown when the command succeeds: a refusal stays one line."""
+def _say(level: str, message: str) -> None:
     ctx = click.get_current_context(silent=True)
     held = ctx.find_object(dict) if ctx is not None else None
     if held is not None and NOTES in held:
-        held[NOTES].append(message)
-    else:
-        click.echo(f"kinergy: note: {message}", err=True)
+        held[NOTES].append((level, message))
+    elif level != "note" or ctx is None or not ctx.meta.get(QUIET):
+        click.echo(f"kinergy: {level}: {message}", err=True)
+
+
+def note(message: str) -> None:
+    """A note for the user on stderr: something routine (what reading a file changed, a value
+    written, a default used); ``--quiet`` drops it. Under :func:`kinergy.cli.main` notes and
+    warnings are held back and shown when the command succeeds: a refusal stays one line."""
+    _say("note", message)
+
+
+def warn(message: str) -> None:
+    """A warning for the user on stderr: something that may make the result wrong (held back as
+    :func:`note` is, never dropped)."""
+    _say("warning", message)
+
+
+def tell(notes: Sequence[str], warnings: Sequence[str]) -> None:
+    """:func:`note` each of ``notes`` and :func:`warn` each of ``warnings``."""
+    for text in notes:
+        note(text)
+    for text in warnings:
+        warn(text)
 
 
 def print_tables(tables: Mapping[str, Sequence[Any]], keys: Sequence[str]) -> None:

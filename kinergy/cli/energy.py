@@ -8,7 +8,15 @@ from typing import Any
 import click
 
 from kinergy.accounting.supply import MEASURED_INCLUDES, PREDICTED_INCLUDES
-from kinergy.cli.common import columns_option, load, payload_option, table
+from kinergy.cli.common import (
+    accept_option,
+    columns_option,
+    load,
+    log_reading,
+    payload_option,
+    table,
+    tell,
+)
 from kinergy.jsonable import dumps
 from kinergy.workflows.energy import energy_figures_of_log
 
@@ -83,7 +91,8 @@ def energy_text(report: dict[str, Any]) -> str:
 @click.argument("model", metavar="MODEL")
 @click.argument("motion_path", metavar="LOG_OR_MOTION", type=click.Path(dir_okay=False))
 @columns_option
-@click.option("--json", "as_json", is_flag=True, help="Print JSON (DESIGN.md shape).")
+@accept_option
+@click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option(
     "--no-recovery", is_flag=True, help="Clip negative power: the supply takes no energy back."
 )
@@ -103,15 +112,25 @@ def energy(
     no_recovery: bool,
     source: str,
     payload: str | None,
+    accept: tuple[str, ...],
 ) -> None:
     """What a logged or planned motion draws from the arm's supply, and per-joint mechanical and
     electrical energy; a log's measured supply energy beside the prediction.
 
     MODEL is a built-in name or a model file; LOG_OR_MOTION a log (record.py layout, or headerless
-    with --columns) or a motion file.
+    with --columns), a motion file, a URScript program (.script) or a built-in motion (test-a,
+    test-b: the UR5e doc's tests A and B planned for MODEL).
     """
     r = load(model, payload)
-    report = energy_figures_of_log(
-        r, motion_path, columns=columns, source=source, recovery=not no_recovery
-    ).to_dict()
+    reading = log_reading(r, columns=columns, accept=accept)
+    figures, inputs = energy_figures_of_log(
+        r, motion_path, reading, source=source, recovery=not no_recovery
+    )
+    report = {
+        **figures.to_dict(),
+        "inputs": inputs.records(),
+        "notes": inputs.notes,
+        "warnings": inputs.warnings,
+    }
+    tell(inputs.notes, inputs.warnings)
     click.echo(dumps(report) if as_json else energy_text(report))

@@ -5,24 +5,26 @@ from __future__ import annotations
 import click
 
 from kinergy.cli.common import (
+    accept_option,
     columns_option,
     cutoff_option,
-    note,
+    log_reading,
     output_file_option,
     progress,
     repair_option,
     table,
+    tell,
     writes,
 )
 from kinergy.cli.validate import validation_text
 from kinergy.friction.registry import MODELS
 from kinergy.identify.full import FullFit
+from kinergy.identify.options import IdentifyOptions, Method, Solver, Target
 from kinergy.identify.payload import PayloadEstimate
 from kinergy.identify.result import FLAGS, IDENTIFIED, DriveEstimate, IdentificationResult
 from kinergy.jsonable import dumps
 from kinergy.model import load_robot
 from kinergy.workflows.identify import METHODS, identify_logs, identify_payload_model
-from kinergy.workflows.logs import LogReading, prepared_logs
 
 __all__ = ["identify"]
 
@@ -35,7 +37,6 @@ def _payload_text(report: PayloadEstimate, out: str) -> str:
         )
         + f"] m (flange frame), from {report.signal}; wrote {out}"
     ]
-    lines += [f"note: {n}" for n in report.notes]
     return "\n".join(lines)
 
 
@@ -137,7 +138,7 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     text = validation_text(result.fit, result.robot.joint_names)
     if text:
         lines.append("\nFit on the identification logs\n" + text)
-    lines += [f"warning: {w}" for w in result.warnings]
+    lines += [f"accepted: {a}" for a in result.accepted]
     lines.append(f"wrote {out}")
     return "\n".join(lines)
 
@@ -160,7 +161,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 )
 @output_file_option("--out", "Model file to write (TOML).", required=True)
 @columns_option
-@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (DESIGN.md shape).")
+@accept_option
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @click.option(
     "--friction",
     "friction",
@@ -214,6 +216,7 @@ def identify(
     payload_only: bool,
     cutoff: float | None,
     repair: bool,
+    accept: tuple[str, ...],
 ) -> None:
     """Identify a model from controller logs and write it as a robot file.
 
@@ -222,28 +225,32 @@ def identify(
     actual_current; the full method regresses the base inertial parameters too.
     """
     r = load_robot(robot_name)
-    reading: LogReading = {"columns": columns, "repair": repair, "cutoff": cutoff, "note": note}
+    reading = log_reading(r, columns=columns, repair=repair, cutoff=cutoff, accept=accept)
+    options = IdentifyOptions(
+        method=Method(method),
+        friction=friction,
+        target=Target(target),
+        solver=Solver(solver),
+        ridge=ridge,
+    )
     with progress() as say:
         if payload_only:
-            say(f"reading {len(logs)} log(s)")
-            datas = prepared_logs(logs, n_joints=r.n, **reading)
-            say("identifying the payload")
-            _, report = identify_payload_model(r, datas, out)
+            say(f"reading {len(logs)} log(s) and identifying the payload")
+            _, report, inputs = identify_payload_model(r, logs, out, reading)
         else:
             say(f"reading and identifying {len(logs)} log(s) ({method} method)")
-            result = identify_logs(
-                r,
-                logs,
-                out,
-                reading=reading,
-                method=method,
-                friction=friction,
-                target=target,
-                solver=solver,
-                ridge=ridge,
-            )
+            result = identify_logs(r, logs, out, reading=reading, options=options)
     if payload_only:
-        summary = {"robot": r.name, "method": "payload", "payload": report}
+        tell([*inputs.notes, *report.notes], inputs.warnings)
+        summary = {
+            "robot": r.name,
+            "method": "payload",
+            "payload": report,
+            "inputs": inputs.records(),
+            "notes": [*inputs.notes, *report.notes],
+            "warnings": inputs.warnings,
+        }
         click.echo(dumps(summary) if as_json else _payload_text(report, out))
         return
+    tell(result.notes, result.warnings)
     click.echo(dumps(result.to_dict()) if as_json else _result_text(result, len(logs), out))

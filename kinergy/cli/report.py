@@ -5,14 +5,16 @@ from __future__ import annotations
 import click
 
 from kinergy.cli.common import (
+    accept_option,
     columns_option,
     load,
-    note,
+    log_reading,
     payload_option,
     print_tables,
     progress,
     repair_option,
     report_folder_option,
+    tell,
     writes,
 )
 from kinergy.errors import KinergyError
@@ -46,6 +48,7 @@ __all__ = ["report"]
 )
 @report_folder_option()
 @columns_option
+@accept_option
 @payload_option
 @repair_option
 @writes(folders=("out",), inputs=("model", "identify_logs", "validate_logs", "energy_logs"))
@@ -58,22 +61,24 @@ def report(
     columns: str | None,
     payload: str | None,
     repair: bool,
+    accept: tuple[str, ...],
 ) -> None:
     """Build the study report (tables, figures, report.html) from your own model and logs."""
     if not (identify_logs or validate_logs or energy_logs):
         raise KinergyError("report: give logs with --identify, --validate or --energy")
+    robot = load(model, payload)
+    reading = log_reading(robot, columns=columns, repair=repair, accept=accept)
     with progress() as say:
-        path, tables = study_report(
-            load(model, payload),
+        path, tables, said = study_report(
+            robot,
             out,
             identify_logs=identify_logs,
             validate_logs=validate_logs,
             energy_logs=energy_logs,
-            columns=columns,
-            repair=repair,
+            reading=reading,
             model_name=model,
             progress=say,
-            note=note,
         )
+    tell(said.notes, said.warnings)
     print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown"])
     click.echo(f"\nreport: {path}")

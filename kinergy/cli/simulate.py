@@ -5,8 +5,10 @@ from __future__ import annotations
 import click
 
 from kinergy.cli.common import (
+    accept_option,
     columns_option,
     load,
+    log_reading,
     output_file_option,
     payload_option,
     seed_option,
@@ -71,6 +73,7 @@ __all__ = ["simulate"]
 @seed_option
 @payload_option
 @columns_option
+@accept_option
 @writes(files=("out", "truth_out"), inputs=("robot_name", "trajectory"))
 def simulate(
     robot_name: str,
@@ -87,6 +90,7 @@ def simulate(
     seed: int,
     payload: str | None,
     columns: str | None,
+    accept: tuple[str, ...],
 ) -> None:
     """Run the digital twin: write the log a UR controller would record (record.py layout, 500 Hz).
 
@@ -94,6 +98,7 @@ def simulate(
     differs from (--mismatch realistic).
     """
     r = load(robot_name, payload)
+    reading = log_reading(r, columns=columns, accept=accept)
     if exact:
         base = TwinSettings.exact()
     elif mismatch == "realistic":
@@ -113,7 +118,7 @@ def simulate(
         initial_temperature=initial_temperature,
     )
     t = simulate_to_file(
-        r, trajectory, out, settings, columns=columns, mismatch=mismatch, truth_out=truth_out
+        r, trajectory, out, settings, reading=reading, mismatch=mismatch, truth_out=truth_out
     ).t
     click.echo(
         f"wrote {out}: {len(t)} samples, {t[-1] - t[0]:.3f} s, {r.name}, trajectory {trajectory}, "

@@ -9,13 +9,15 @@ import click
 import numpy as np
 
 from kinergy.cli.common import (
+    accept_option,
     columns_option,
     cutoff_option,
     load,
-    note,
+    log_reading,
     payload_option,
     repair_option,
     table,
+    tell,
     writes,
 )
 from kinergy.identify.metrics import JointMetrics
@@ -27,7 +29,6 @@ from kinergy.identify.validation import (
     ValidationReport,
 )
 from kinergy.jsonable import dumps
-from kinergy.workflows.logs import prepared_logs
 from kinergy.workflows.validate import validate_logs
 
 __all__ = ["report_text", "validate", "validation_text"]
@@ -115,7 +116,8 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
 @click.argument("model", metavar="MODEL")
 @click.argument("logs", metavar="LOG...", nargs=-1, required=True)
 @columns_option
-@click.option("--json", "as_json", is_flag=True, help="Print JSON (DESIGN.md shape).")
+@accept_option
+@click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option(
     "--plots",
     "plots",
@@ -136,13 +138,13 @@ def validate(
     cutoff: float | None,
     payload: str | None,
     repair: bool,
+    accept: tuple[str, ...],
 ) -> None:
     """How well a model predicts logs: torque (UR5e Table V) and current (Table VII) errors and R^2."""
     r = load(model, payload)
-    datas = prepared_logs(
-        logs, n_joints=r.n, columns=columns, repair=repair, cutoff=cutoff, note=note
-    )
-    report = validate_logs(r, datas, plots=plots)
+    reading = log_reading(r, columns=columns, repair=repair, cutoff=cutoff, accept=accept)
+    report = validate_logs(r, logs, reading, plots=plots)
+    tell(report.notes, report.warnings)
     if as_json:
         click.echo(dumps(report))
         return

@@ -39,6 +39,7 @@ from kinergy.identify.result import (
 )
 from kinergy.jsonable import OPTIONAL
 from kinergy.linalg import Reduced, scaled_lstsq, scaled_solution
+from kinergy.messages import Messages
 from kinergy.model.robot import Friction, Joint, Robot
 
 __all__ = [
@@ -277,7 +278,7 @@ def _current_fit(
 
 
 def rotor_step(
-    robot: Robot, problem: Reduced | None, active: list[int], warnings: list[str]
+    robot: Robot, problem: Reduced | None, active: list[int], said: Messages
 ) -> tuple[Array, Array, float | None]:
     """Rotor inertias (kg m^2, motor side) from step 2's triangle (:func:`rotor_problem`; None
     when no log has ``target_moment``), their standard errors (NaN where not identified) and
@@ -293,10 +294,10 @@ def rotor_step(
                 f"rotor inertia regression is singular (condition {cond:.3g}): too little acceleration"
             )
     else:
-        warnings.append("the logs have no target_moment: rotor inertias kept from the model")
+        said.note("the logs have no target_moment: rotor inertias kept from the model")
     for j, joint in enumerate(robot.joints):
         if rotor[j] < 0:
-            warnings.append(
+            said.warn(
                 f"joint {j + 1} ({joint.name}): identified rotor inertia {rotor[j]:.3g} kg m^2 "
                 "is negative, not a physical value (target_moment does not fit this model): "
                 f"kept the model's {joint.drive.rotor_inertia:.4g} kg m^2"
@@ -305,7 +306,7 @@ def rotor_step(
     return rotor, rotor_std, cond
 
 
-def with_rotor_inertias(robot: Robot, rotor: Array, warnings: list[str]) -> Robot:
+def with_rotor_inertias(robot: Robot, rotor: Array, said: Messages) -> Robot:
     """Motor inertia = rotor inertia - the model's reducer inertia (Table IV), at least 0."""
     joints = []
     for j, joint in enumerate(robot.joints):
@@ -316,7 +317,7 @@ def with_rotor_inertias(robot: Robot, rotor: Array, warnings: list[str]) -> Robo
         )
     for j, joint in enumerate(robot.joints):
         if rotor[j] < joint.drive.reducer_inertia:
-            warnings.append(
+            said.note(
                 f"joint {j + 1} ({joint.name}): rotor inertia {rotor[j]:.3g} is below the model's "
                 f"reducer inertia {joint.drive.reducer_inertia:.3g}; motor inertia set to 0"
             )
@@ -501,7 +502,7 @@ def _unsupported(model: str, values: Array, kt: float) -> str | None:
 
 
 def _apply_current_fit(
-    m: int, joint: Joint, fit: _CurrentFit, warnings: list[str]
+    m: int, joint: Joint, fit: _CurrentFit, said: Messages
 ) -> tuple[Joint, CurrentStats]:
     """``joint`` with the torque constant and friction of ``fit``, and their standard errors;
     a fit that is not a physical drive is not written (the model's values, flagged)."""
@@ -515,7 +516,7 @@ def _apply_current_fit(
     values = x[1:] * kt
     problem = _unsupported(fit.model, values, kt)
     if problem is not None:
-        warnings.append(
+        said.warn(
             f"joint {m + 1} ({joint.name}): {problem}, not a physical drive (the currents do "
             f"not support friction model {fit.model!r} here): kept the model's torque constant "
             "and friction"
@@ -523,7 +524,7 @@ def _apply_current_fit(
         kept = {name: KEPT for name in ("torque_constant", *names)}
         return joint, CurrentStats(condition_current=fit.cond, flags=kept)
     if fit.fixed:
-        warnings.append(
+        said.note(
             f"joint {m + 1} ({joint.name}): the logs do not pin the torque constant down "
             "(too little load torque against friction and noise); kept the model's "
             f"{joint.drive.torque_constant:.4g} N m/A"
@@ -549,14 +550,14 @@ def current_step(
     logs: Sequence[IdentData],
     problems: dict[int, str],
     options: tuple[str | None, str | bool],
-    warnings: list[str],
+    said: Messages,
 ) -> tuple[Robot, list[CurrentStats], tuple[float | None, ...], tuple[FrictionChoice | None, ...]]:
     """Torque constants and friction of every identifiable motor from the currents (eqs 17-18);
     ``options`` = (friction model, ``"auto"`` or None; hold). Returns the robot, each joint's
     statistics, the friction fraction held through standstill and, with ``"auto"``, how each
     joint's model was chosen (None where not fitted)."""
     fitter = current_fitter(staged, rotor, logs, options)
-    return fit_joints(staged, problems, fitter, warnings)
+    return fit_joints(staged, problems, fitter, said)
 
 
 def current_fitter(
@@ -593,7 +594,7 @@ JointFitter = Callable[[int, Joint, float], tuple[_CurrentFit, "FrictionChoice |
 
 
 def fit_joints(
-    staged: Robot, problems: dict[int, str], fit_joint: JointFitter, warnings: list[str]
+    staged: Robot, problems: dict[int, str], fit_joint: JointFitter, said: Messages
 ) -> tuple[Robot, list[CurrentStats], tuple[float | None, ...], tuple[FrictionChoice | None, ...]]:
     """Step 3 over the joints: each identifiable joint fitted by ``fit_joint`` and written
     (:func:`_apply_current_fit`); returns as :func:`current_step`."""
@@ -611,7 +612,7 @@ def fit_joints(
         fit, choice = fit_joint(m, joint, STILL_SPEED * abs(joint.drive.gear_ratio))
         held.append(float(fit.params.get("holding", 0.0)))
         chosen.append(choice)
-        new, stat = _apply_current_fit(m, joint, fit, warnings)
+        new, stat = _apply_current_fit(m, joint, fit, said)
         joints.append(new)
         stats.append(stat)
     return staged.with_joints(joints), stats, tuple(held), tuple(chosen)

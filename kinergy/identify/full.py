@@ -101,6 +101,7 @@ from kinergy.identify.result import (
 from kinergy.identify.sequential import DrivesFromCurrents, drives_from_currents
 from kinergy.identify.writeback import WriteBack, write_back
 from kinergy.jsonable import OPTIONAL
+from kinergy.messages import Messages
 from kinergy.model.robot import Friction, Robot
 
 __all__ = [
@@ -453,22 +454,22 @@ def _fit(
     stacked, flow, solved, written = steps.stacked, steps.flow, steps.solved, steps.written
     cols, y3 = stacked.cols, stacked.y3
     predicted = (stacked.a_flat @ solved.x).reshape(y3.shape)
-    warnings = (
-        []
-        if flow.settled
-        else [
+    said = Messages()
+    if not flow.settled:
+        said.warn(
             f"the friction's power-flow directions did not settle in {flow.iterations} iterations"
-        ]
-    )
+        )
     if steps.drives is not None:
-        warnings += list(steps.drives.warnings)
+        said.extend(steps.drives.said)
+    said.extend(steps.merging.said)
+    said.extend(written.said)
     weighted = solved.weights is not None
     b = cols.n_link
     return FullFit(
         **fit_fields(
             steps.robot,
             datas,
-            (*warnings, *steps.merging.warnings, *written.warnings),
+            said,
             samples=int(y3.shape[0]),
         ),
         target=target,

@@ -36,6 +36,7 @@ zero-phase filter reaches much further than a spline (its own padding and initia
 
 from __future__ import annotations
 
+import itertools
 import os
 import tempfile
 from collections.abc import Iterator, Sequence
@@ -63,10 +64,11 @@ from kinergy.identify.preprocess import (
     running_range,
     uniform_grid,
 )
-from kinergy.io.formats import CHUNK_ROWS, iter_log
+from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
 from kinergy.io.motion_stream import HALO
 from kinergy.io.segments import segment_bounds
+from kinergy.logs.reading import CheckedLog
 
 __all__ = [
     "SIGNALS",
@@ -146,34 +148,28 @@ class LogSpill:
         return Log(self.path, self.state.t[start:stop], signals)
 
 
-def spill_log(
-    path: str | os.PathLike[str],
-    *,
-    columns: str | None = None,
-    repair: bool = False,
-    rows: int = CHUNK_ROWS,
-) -> LogSpill:
-    """Read the log at ``path`` once, in chunks of ``rows``, into a :class:`LogSpill` (the
-    caller closes it)."""
-    first = next(iter_log(path, columns=columns, repair=repair, rows=2), None)
+def spill_log(log: CheckedLog) -> LogSpill:
+    """Read ``log`` once, in its chunks (through its checks), into a :class:`LogSpill` (the
+    caller closes it). ``log`` selects the signals identification uses (:data:`SIGNALS`) and the
+    state (:data:`STATE`)."""
+    chunks = log.chunks()
+    first = next(chunks, None)
     if first is None:
-        raise KinergyError(f"{path}: the log has no samples")
+        raise KinergyError(f"{log.path}: the log has no samples")
     names = first.signals
     # with the commanded motion, the measured positions are not used (only looked for)
     skip = {"actual_q"} if {"target_q", "target_qd"} <= set(names) else set()
-    wanted = [s for s in (*SIGNALS, *STATE) if s in names and s not in skip]
     layout = [
         (s, 1 if names[s].ndim == 1 else names[s].shape[1], names[s].ndim == 2)
         for s in SIGNALS
-        if s in wanted
+        if s in names and s not in skip
     ]
-    spill = LogSpill(os.fspath(path), layout, tempfile.TemporaryFile())
+    spill = LogSpill(log.path, layout, tempfile.TemporaryFile())
     spill.names, spill.head = set(names), first
     times: list[Array] = []
     state: dict[str, list[Array]] = {s: [] for s in STATE if s in names}
     try:
-        for chunk in iter_log(path, columns=columns, repair=repair, select=wanted, rows=rows):
-            spill.notes += chunk.notes
+        for chunk in itertools.chain([first], chunks):
             spill.append(chunk)
             # copies: a view would keep the chunk's whole block of values alive
             times.append(np.array(chunk.t, dtype=float))
@@ -183,6 +179,7 @@ def spill_log(
     except BaseException:
         spill.close()
         raise
+    spill.notes = list(log.notes)
     spill.state = Log(
         spill.path, np.concatenate(times), {k: np.concatenate(v) for k, v in state.items()}
     )

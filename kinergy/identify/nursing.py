@@ -65,6 +65,7 @@ from kinergy.identify.result import (
 )
 from kinergy.identify.ridge import RidgeFit, ridge_minimal
 from kinergy.jsonable import OPTIONAL
+from kinergy.messages import Messages
 from kinergy.model.robot import Friction, Joint, Link, Robot, Source
 
 __all__ = [
@@ -214,7 +215,7 @@ def _sort_logs(
 
 
 def _joint_fits(
-    robot: Robot, runs: dict[int, list[FrictionPoints]], fitter: Fitter, warnings: list[str]
+    robot: Robot, runs: dict[int, list[FrictionPoints]], fitter: Fitter, said: Messages
 ) -> tuple[list[JointFrictionFit], dict[int, tuple[Array, Array, MakkarFit]]]:
     """Per joint with runs, its Makkar curve (eq 13, joint side) from the level means; and the
     points and fit of each, for pooling per motor group."""
@@ -225,7 +226,7 @@ def _joint_fits(
         v = np.concatenate([p.speeds for p in pts])
         f = np.concatenate([p.friction for p in pts])
         if v.size < 6:
-            warnings.append(
+            said.note(
                 f"joint {j + 1} ({robot.joints[j].name}): {v.size} speed levels, Makkar's model "
                 "needs at least 6; its motors keep the model's friction"
             )
@@ -310,17 +311,15 @@ def _motor_fits(
     return new_friction, motor_fits
 
 
-def _with_friction(robot: Robot, new_friction: dict[int, Friction], warnings: list[str]) -> Robot:
-    """``robot`` with the identified motors' friction; a warning for every other motor."""
+def _with_friction(robot: Robot, new_friction: dict[int, Friction], said: Messages) -> Robot:
+    """``robot`` with the identified motors' friction; a note for every other motor."""
     joints = []
     for m, jt in enumerate(robot.joints):
         if m in new_friction:
             drive = dataclasses.replace(jt.drive, friction=new_friction[m])
             joints.append(dataclasses.replace(jt, drive=drive))
         else:
-            warnings.append(
-                f"motor {m + 1} ({jt.name}): no friction run; kept the model's friction"
-            )
+            said.note(f"motor {m + 1} ({jt.name}): no friction run; kept the model's friction")
             joints.append(jt)
     return robot.with_joints(joints)
 
@@ -390,7 +389,7 @@ def _regress_links(
 # 4. Write-back
 
 
-def _identified_link(j: int, joint: Joint, standard: Array, warnings: list[str]) -> Joint:
+def _identified_link(j: int, joint: Joint, standard: Array, said: Messages) -> Joint:
     """Joint ``j`` (0-based) with the link of the standard parameters (10,), or as it was when
     they do not make a valid link (with a warning)."""
     mass, com, i_c = link_from_standard(standard)
@@ -398,12 +397,12 @@ def _identified_link(j: int, joint: Joint, standard: Array, warnings: list[str])
     try:
         link = Link(mass=mass, com=com, inertia=inertia)
     except KinergyError as err:
-        warnings.append(f"link {j + 1} ({joint.name}): {err}; kept the model's link data")
+        said.warn(f"link {j + 1} ({joint.name}): {err}; kept the model's link data")
         return joint
     return dataclasses.replace(joint, link=link)
 
 
-def _write_links(robot: Robot, rf: RidgeFit, warnings: list[str]) -> tuple[Robot, tuple[int, ...]]:
+def _write_links(robot: Robot, rf: RidgeFit, said: Messages) -> tuple[Robot, tuple[int, ...]]:
     """Links with the identified base parameters: the standard parameters closest to the model's
     (:func:`kinergy.identify.physical.standard_from_base`); a link that is not physical keeps the
     model's data, with a warning. Returns the robot and the kept links (1-based)."""
@@ -415,10 +414,10 @@ def _write_links(robot: Robot, rf: RidgeFit, warnings: list[str]) -> tuple[Robot
     joints = []
     for j, (jt, row, problem) in enumerate(zip(robot.joints, links, problems, strict=True)):
         if problem is not None:
-            warnings.append(f"link {j + 1} ({jt.name}): {problem}; kept the model's link data")
+            said.warn(f"link {j + 1} ({jt.name}): {problem}; kept the model's link data")
             joints.append(jt)
         else:
-            joints.append(_identified_link(j, jt, row, warnings))
+            joints.append(_identified_link(j, jt, row, said))
     kept = tuple(j + 1 for j, p in enumerate(problems) if p is not None)
     return robot.with_joints(joints), kept
 
@@ -516,26 +515,24 @@ def identify_nursing(
         No logs, a log without ``actual_current``, an unknown ``fit``.
     """
     _check_inputs(datas, fit)
-    warnings: list[str] = []
+    said = Messages()
     fitter = _fitter(fit, seed)
     runs, excitation = _sort_logs(robot, datas, eta, trim)
-    joint_fits, pooled = _joint_fits(robot, runs, fitter, warnings)
+    joint_fits, pooled = _joint_fits(robot, runs, fitter, said)
     new_friction, motor_fits = _motor_fits(robot, pooled, fitter)
-    staged = _with_friction(robot, new_friction, warnings)
+    staged = _with_friction(robot, new_friction, said)
     identified, rf, summary, kept = staged, None, None, None
     if excitation:
         rf, summary = _regress_links(
             staged, excitation, eta=eta, period=period, cutoff=cutoff, split=split, alphas=alphas
         )
-        identified, kept = _write_links(staged, rf, warnings)
+        identified, kept = _write_links(staged, rf, said)
     else:
-        warnings.append(
-            "no excitation log (every log moves one joint): link data kept from the model"
-        )
+        said.note("no excitation log (every log moves one joint): link data kept from the model")
     links = kept is not None and len(kept) < robot.n
     identified = _sources(identified, friction=bool(new_friction), links=links)
     fit_out = NursingFit(
-        **fit_fields(identified, datas, warnings),
+        **fit_fields(identified, datas, said),
         friction_runs=tuple(joint_fits),
         friction_motors=tuple(motor_fits),
         ridge=summary,

@@ -30,6 +30,7 @@ from kinergy.identify.columns import (
     set_friction,
 )
 from kinergy.linalg import Reduced, ReducedSolution, pivoted_rank, reduce, solve_reduced
+from kinergy.messages import Messages
 from kinergy.model.robot import Robot
 from kinergy.predict import drive_state
 
@@ -331,12 +332,12 @@ class MergedColumn:
 
 @dataclass(frozen=True, eq=False)
 class Merging:
-    """Every dropped column (:class:`MergedColumn`), a warning for each, and for each merged rotor
+    """Every dropped column (:class:`MergedColumn`), a note for each, and for each merged rotor
     inertia whose column is a combination of link base columns only, that combination (motor ->
     coefficients, (b,))."""
 
     columns: tuple[MergedColumn, ...]
-    warnings: tuple[str, ...]
+    said: Messages
     rotor: dict[int, Array]
 
 
@@ -368,18 +369,18 @@ def merged_columns(ols: OlsFit, cols: Columns) -> Merging:
     reduced triangle, in the unknowns' own units)."""
     red, kept, dropped, n_link = ols.reduced, ols.kept, ols.dropped, cols.n_link
     if not dropped.size:
-        return Merging((), (), {})
+        return Merging((), Messages(), {})
     coef_s = np.linalg.lstsq(red.r_a[:, kept], red.r_a[:, dropped], rcond=None)[0]
     coef = coef_s * red.scale[dropped][None, :] / red.scale[kept][:, None]
     excited = np.linalg.norm(red.r_a[:, dropped], axis=0) > 0
-    entries, warnings, rotor = [], [], {}
+    entries, said, rotor = [], Messages(), {}
     for i, k in enumerate(dropped):
         text, entry = _merge_note(int(k), cols, kept, coef[:, i] if excited[i] else None)
-        warnings.append(text)
+        said.note(text)
         entries.append(entry)
         if cols.group[k] == "rotor" and entry.into and all(e.index < n_link for e in entry.into):
             c_vec = np.zeros(n_link)
             for e in entry.into:
                 c_vec[e.index] = e.coefficient
             rotor[int(k - n_link)] = c_vec
-    return Merging(tuple(entries), tuple(warnings), rotor)
+    return Merging(tuple(entries), said, rotor)

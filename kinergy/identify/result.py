@@ -25,6 +25,8 @@ from kinergy.drives.transmission import joint_torque
 from kinergy.identify.metrics import JointMetrics, fit_metrics
 from kinergy.identify.preprocess import IdentData
 from kinergy.jsonable import to_jsonable
+from kinergy.logs.reading import InputLogs
+from kinergy.messages import Messages
 from kinergy.model.robot import Joint, Robot
 from kinergy.predict import drive_state
 
@@ -70,12 +72,14 @@ class Validation:
 @dataclass(frozen=True)
 class Fit(Validation):
     """The fit on the identification logs (the identified model's :class:`Validation`) and what
-    every method reports: samples used, the logs, each log's lag (s) and the warnings."""
+    every method reports: samples used, the logs, each log's lag (s), the warnings (what may make
+    the model wrong) and the notes (what is routine: values written, defaults kept)."""
 
     samples: int = 0
     logs: tuple[str, ...] = ()
     lag: tuple[float, ...] = ()
     warnings: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
 
 def friction_entry(joint: Joint) -> dict[str, Any]:
@@ -129,21 +133,35 @@ class IdentificationResult:
         Per joint, the identified drive (a method's subclass adds its standard errors and flags).
     fit : Fit
         Fit statistics on the identification logs (a method's subclass adds its diagnostics).
+    inputs : InputLogs
+        The logs it was identified from (by content) and what their checks found.
+    accepted : tuple of str
+        Checks that failed and the user accepted (``--accept``), with what they saw.
     """
 
     robot: Robot = field(metadata={"json": lambda r: r.name})
     method: str
     joints: tuple[DriveEstimate, ...]
     fit: Fit
+    inputs: InputLogs = field(default_factory=InputLogs, metadata={"json": lambda i: i.records()})
+    accepted: tuple[str, ...] = ()
 
     @property
     def warnings(self) -> list[str]:
-        return list(self.fit.warnings)
+        """What may make the model wrong: the logs' checks' and the fit's."""
+        return [*self.inputs.warnings, *self.fit.warnings]
+
+    @property
+    def notes(self) -> list[str]:
+        """What is routine: how the logs were read, values written, defaults kept."""
+        return [*self.inputs.notes, *self.fit.notes]
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``identify --json`` shape of DESIGN.md."""
+        """The ``identify --json`` shape: ``robot``, ``method``, ``joints``, ``fit``, ``inputs``,
+        ``accepted``, ``notes`` and ``warnings``."""
         out = to_jsonable(self)
         assert isinstance(out, dict)
+        out["notes"], out["warnings"] = self.notes, self.warnings
         return out
 
 
@@ -178,19 +196,20 @@ def predict(robot: Robot, data: IdentData) -> Prediction:
 def fit_fields(
     robot: Robot,
     datas: Sequence[IdentData],
-    warnings: Sequence[str],
+    said: Messages,
     *,
     samples: int | None = None,
 ) -> dict[str, Any]:
     """The :class:`Fit` fields every method reports, as keyword arguments of its fit: the
     identified ``robot``'s :func:`validation_metrics` on ``datas``, the samples used (all the
-    logs' unless given), the logs, their lags (s) and ``warnings``."""
+    logs' unless given), the logs, their lags (s) and what the fit ``said``."""
     return {
         **vars(validation_metrics(robot, datas)),
         "samples": int(sum(len(d) for d in datas)) if samples is None else samples,
         "logs": tuple(d.path for d in datas),
         "lag": tuple(d.lag for d in datas),
-        "warnings": tuple(warnings),
+        "warnings": tuple(said.warnings),
+        "notes": tuple(said.notes),
     }
 
 

@@ -62,6 +62,7 @@ from kinergy.identify.result import (
 )
 from kinergy.jsonable import OPTIONAL
 from kinergy.linalg import Reduced
+from kinergy.messages import Messages
 from kinergy.model.robot import Joint, Robot, Source
 
 __all__ = [
@@ -336,22 +337,22 @@ def sequential_from(
 ) -> IdentificationResult:
     """:func:`identify_sequential` on logs however held (:class:`SequentialLogs`)."""
     problems = motion_problems(robot, logs.summary())
-    warnings: list[str] = [f"{text}; kept the model's values" for text in problems.values()]
+    said = Messages([f"{text}; kept the model's values" for text in problems.values()])
     if not (logs.has_ref or logs.has_current):
         raise KinergyError(
             "identification needs target_moment (rotor inertia) or actual_current (torque "
             "constant and friction); the logs have neither"
         )
     active = [j for j in range(robot.n) if j not in problems]
-    rotor, rotor_std, cond = rotor_step(robot, logs.rotor_problem(robot), active, warnings)
-    staged = with_rotor_inertias(robot, rotor, warnings)
+    rotor, rotor_std, cond = rotor_step(robot, logs.rotor_problem(robot), active, said)
+    staged = with_rotor_inertias(robot, rotor, said)
     stats: list[CurrentStats] = [CurrentStats() for _ in range(robot.n)]
     held = choices = None
     if logs.has_current:
         fitter = logs.fitter(staged, rotor, (friction, hold))
-        staged, stats, held, choices = fit_joints(staged, problems, fitter, warnings)
+        staged, stats, held, choices = fit_joints(staged, problems, fitter, said)
     else:
-        warnings.append(
+        said.note(
             "the logs have no actual_current: torque constants and friction kept from the model"
         )
     sources = _sources(staged, logs.has_ref, logs.has_current)
@@ -361,7 +362,8 @@ def sequential_from(
         samples=logs.samples,
         logs=logs.paths,
         lag=logs.lags,
-        warnings=tuple(warnings),
+        warnings=tuple(said.warnings),
+        notes=tuple(said.notes),
         condition_rotor_inertia=cond,
         friction_holding=held,
         friction_choice=choices if friction == "auto" else None,
@@ -375,13 +377,13 @@ class DrivesFromCurrents:
     """Step 3 on its own (:func:`drives_from_currents`): the robot with the torque constants and
     friction the currents give, per joint the flags and standard errors of those parameters
     (:class:`~kinergy.identify.result.DriveEstimate`), the friction fraction held through
-    standstill (None where not fitted) and the warnings."""
+    standstill (None where not fitted) and what the fit said (:class:`~kinergy.messages.Messages`)."""
 
     robot: Robot
     flags: tuple[dict[str, str], ...]
     std: tuple[dict[str, float | None], ...]
     holding: tuple[float | None, ...]
-    warnings: tuple[str, ...]
+    said: Messages
 
 
 def drives_from_currents(
@@ -401,14 +403,14 @@ def drives_from_currents(
         current regression.
     """
     problems = _diagnose_motion(robot, logs)
-    warnings = [
-        f"{text}; kept the model's torque constant and friction" for text in problems.values()
-    ]
+    said = Messages(
+        [f"{text}; kept the model's torque constant and friction" for text in problems.values()]
+    )
     rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
-    out, stats, held, _ = current_step(robot, rotor, logs, problems, (friction, hold), warnings)
+    out, stats, held, _ = current_step(robot, rotor, logs, problems, (friction, hold), said)
     flags, std = [], []
     for joint, stat in zip(out.joints, stats, strict=True):
         f, s = _drive_flags(joint, float(joint.drive.rotor_inertia), np.nan, stat)
         flags.append({k: v for k, v in f.items() if k != "rotor_inertia"})
         std.append({k: v for k, v in s.items() if k != "rotor_inertia"})
-    return DrivesFromCurrents(out, tuple(flags), tuple(std), held, tuple(warnings))
+    return DrivesFromCurrents(out, tuple(flags), tuple(std), held, said)

@@ -14,7 +14,7 @@ wandering standstill friction no motion model predicts; so every figure is given
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,6 +23,7 @@ from kinergy.arrays import Array
 from kinergy.identify.metrics import JointMetrics, fit_metrics
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import Validation, predict
+from kinergy.logs.reading import InputLogs
 from kinergy.model.robot import Robot
 
 __all__ = [
@@ -81,9 +82,13 @@ class LogValidation(SegmentedValidation):
 @dataclass(frozen=True)
 class ValidationReport(SegmentedValidation):
     """``validate``'s result: the pooled :class:`SegmentedValidation` (its ``torque``,
-    ``current``, ``joint_torque`` keep DESIGN.md's ``validate --json`` keys) and each log's."""
+    ``current``, ``joint_torque`` keep the ``validate --json`` keys), each log's, and what the
+    logs were (by content) with their checks."""
 
     logs: tuple[LogValidation, ...] = ()
+    inputs: InputLogs = field(default_factory=InputLogs, metadata={"json": lambda i: i.records()})
+    notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
 
 def holding_mask(t: Array, qd: Array) -> NDArray[np.bool_]:

@@ -37,6 +37,7 @@ from kinergy.identify.physical import (
 )
 from kinergy.identify.regression import Solved
 from kinergy.identify.result import AT_BOUND, IDENTIFIED, KEPT
+from kinergy.messages import Messages
 from kinergy.model.robot import Drive, Friction, Joint, Link, Robot, Source
 
 __all__ = ["CLOSEST", "CONSTRAINED", "WriteBack", "write_back"]
@@ -74,7 +75,8 @@ class WriteBack:
         Per link, whether the robot's link is the identified one (else the model's).
     standard_parameters : dict
         The written standard parameters by name (kg, kg m, kg m^2).
-    warnings : tuple of str
+    said : Messages
+        What writing the robot did (notes) and what may be wrong with it (warnings).
     """
 
     robot: Robot
@@ -87,7 +89,7 @@ class WriteBack:
     links_not_physical_closest: tuple[int, ...]
     links_physical: tuple[bool, ...]
     standard_parameters: dict[str, float]
-    warnings: tuple[str, ...]
+    said: Messages
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,9 +121,9 @@ def _links(
     problem: Solved,
     stacked: Stacked,
     merged_rotor: dict[int, Array],
-    warnings: list[str],
+    said: Messages,
 ) -> _Links:
-    """Steps 1 and 2 of the module docstring (warnings appended for the constrained fit)."""
+    """Steps 1 and 2 of the module docstring (what the constrained fit did, said)."""
     cols = stacked.cols
     n_link, x = cols.n_link, problem.x
     pi0 = inertial_parameters(robot)
@@ -138,7 +140,7 @@ def _links(
     )
     if refit is None:
         for col, phrase in outside.items():  # never written: the model's value instead
-            warnings.append(f"{phrase}: kept the model's value (the constrained fit failed)")
+            said.warn(f"{phrase}: kept the model's value (the constrained fit failed)")
             x = x.copy()
             x[col] = cols.prior[col]
         return _Links(pi - payload, x, CLOSEST, None, flagged)
@@ -149,14 +151,14 @@ def _links(
         "unconstrained fit)"
     )
     for j, p in flagged.items():
-        warnings.append(f"link {j + 1} ({robot.joints[j].name}): {p}; {instead}")
+        said.note(f"link {j + 1} ({robot.joints[j].name}): {p}; {instead}")
     for phrase in outside.values():
-        warnings.append(f"{phrase}; {instead}")
+        said.note(f"{phrase}; {instead}")
     return _Links(refit.pi - payload, refit.x, CONSTRAINED, refit, flagged)
 
 
 def _with_links(
-    robot: Robot, links: Array, warnings: list[str]
+    robot: Robot, links: Array, said: Messages
 ) -> tuple[list[Joint], Array, list[bool]]:
     """Step 3: the joints with the links ``links`` (payload excluded, (p,)) where physical, the
     model's elsewhere (with a warning); the standard parameters written (p,); and per link
@@ -174,7 +176,7 @@ def _with_links(
             except KinergyError as err:
                 problem = str(err)
         if problem is not None:
-            warnings.append(
+            said.warn(
                 f"link {j + 1} ({joint.name}): {problem}; kept the model's mass, centre of mass "
                 "and inertia for this link, so the returned robot's torques differ from the "
                 "identified base parameters' (fit['regression'] is the identified fit, "
@@ -186,7 +188,7 @@ def _with_links(
     return joints, links, physical
 
 
-def _with_rotor(m: int, joint: Joint, rotor: float, warnings: list[str]) -> Drive:
+def _with_rotor(m: int, joint: Joint, rotor: float, said: Messages) -> Drive:
     """``joint``'s drive with rotor inertia ``rotor`` = J_m + J_r (kg m^2, motor side)."""
     drive = joint.drive
     if rotor >= drive.reducer_inertia:
@@ -194,7 +196,7 @@ def _with_rotor(m: int, joint: Joint, rotor: float, warnings: list[str]) -> Driv
     # motor inertia clipped at 0; the reducer inertia gives way too, so the written J_m + J_r is
     # the identified one (arms with link-side torque sensors see about 0)
     reducer = max(rotor, 0.0)
-    warnings.append(
+    said.note(
         f"joint {m + 1} ({joint.name}): identified rotor inertia {rotor:.3g} kg m^2 is "
         + ("not positive" if rotor <= 0.0 else "below the model's reducer inertia")
         + f" ({drive.reducer_inertia:.3g}): motor inertia set to 0 and reducer inertia "
@@ -204,16 +206,14 @@ def _with_rotor(m: int, joint: Joint, rotor: float, warnings: list[str]) -> Driv
 
 
 def _with_friction(
-    m: int, joint: Joint, friction: tuple[str, dict[str, float]], values: Array, warnings: list[str]
+    m: int, joint: Joint, friction: tuple[str, dict[str, float]], values: Array, said: Messages
 ) -> Drive:
     """``joint``'s drive with friction ``(model, parameters)`` at the levels ``values`` (motor
     side)."""
     model, params = friction
     for name, value in zip(get_model(model).linear, values, strict=True):
         if value < 0.0 and name != "gamma1":
-            warnings.append(
-                f"joint {m + 1} ({joint.name}): friction {name} = {value:.3g} is negative"
-            )
+            said.warn(f"joint {m + 1} ({joint.name}): friction {name} = {value:.3g} is negative")
     new = with_linear_parameters(model, params, values)
     return dataclasses.replace(joint.drive, friction=Friction(model, new))
 
@@ -254,16 +254,16 @@ def _flags(cols: Columns, problem: Solved, written: _Links) -> tuple[str, ...]:
 
 
 def _with_drive(
-    m: int, joint: Joint, stacked: Stacked, x: Array, commanded: bool, warnings: list[str]
+    m: int, joint: Joint, stacked: Stacked, x: Array, commanded: bool, said: Messages
 ) -> Joint:
     """``joint`` with motor ``m``'s rotor inertia and friction (not ``commanded``) from the
     unknowns ``x``."""
     cols = stacked.cols
-    drive = _with_rotor(m, joint, float(x[cols.n_link + m]), warnings)
+    drive = _with_rotor(m, joint, float(x[cols.n_link + m]), said)
     joint = dataclasses.replace(joint, drive=drive)
     if not commanded:
         friction = (stacked.models[m], stacked.params[m])
-        drive = _with_friction(m, joint, friction, cols.friction(x, m), warnings)
+        drive = _with_friction(m, joint, friction, cols.friction(x, m), said)
         joint = dataclasses.replace(joint, drive=drive)
     return joint
 
@@ -280,12 +280,12 @@ def write_back(
     docstring). ``commanded``: a fit against ``target_moment``, which keeps the model's
     friction; ``merged_rotor`` gives each merged rotor inertia's column in link base columns
     (motor -> (b,)), which the constrained fit may move."""
-    warnings: list[str] = []
+    said = Messages()
     cols = stacked.cols
-    written = _links(robot, base, problem, stacked, merged_rotor, warnings)
-    link_joints, links, physical = _with_links(robot, written.links, warnings)
+    written = _links(robot, base, problem, stacked, merged_rotor, said)
+    link_joints, links, physical = _with_links(robot, written.links, said)
     final = [
-        _with_drive(m, joint, stacked, written.x, commanded, warnings)
+        _with_drive(m, joint, stacked, written.x, commanded, said)
         for m, joint in enumerate(link_joints)
     ]
     sources = _sources(robot, written.method, physical, commanded)
@@ -301,5 +301,5 @@ def write_back(
         links_not_physical_closest=tuple(sorted(j + 1 for j in written.flagged)),
         links_physical=tuple(physical),
         standard_parameters=dict(zip(parameter_names(robot), links.tolist(), strict=True)),
-        warnings=tuple(warnings),
+        said=said,
     )

@@ -5,8 +5,8 @@ RTDE writes an n-vector as columns ``name_0 .. name_{n-1}``; a column spec names
 
 Examples
 --------
->>> parse_columns("timestamp,actual_q:2,robot_mode")
-['timestamp', 'actual_q_0', 'actual_q_1', 'robot_mode']
+>>> parse_columns("timestamp,actual_q:2,_,robot_mode")
+['timestamp', 'actual_q_0', 'actual_q_1', '_0', 'robot_mode']
 >>> group_columns(["timestamp", "a_0", "a_1"], "log.csv")
 {'a': ['a_0', 'a_1'], 'timestamp': ['timestamp']}
 """
@@ -14,12 +14,12 @@ Examples
 from __future__ import annotations
 
 import re
-from collections import Counter
 from collections.abc import Sequence
 
 from kinergy.errors import KinergyError
+from kinergy.io.fields import FIELDS, JOINTS, SKIP, closest, is_known
 
-__all__ = ["MAX_COLUMNS", "group_columns", "parse_columns", "printable"]
+__all__ = ["MAX_COLUMNS", "compact_columns", "group_columns", "parse_columns", "printable"]
 
 #: the most columns a log may have (RTDE's whole output recipe is a few hundred)
 MAX_COLUMNS = 2000
@@ -35,22 +35,36 @@ def printable(text: str, limit: int = 60) -> str:
     return _CONTROL.sub(lambda m: repr(m.group())[1:-1], short)
 
 
-def parse_columns(spec: str) -> list[str]:
+def parse_columns(spec: str, n_joints: int | None = None) -> list[str]:
     """Expand a column spec ``"timestamp,actual_q:6,..."`` into column names.
+
+    Every entry is a known field (:mod:`kinergy.io.fields`: UR's RTDE names and kinergy's own),
+    ``NAME`` for one column or ``NAME:COUNT`` for a vector; ``_`` or ``_:COUNT`` skips columns
+    (named ``_0``, ``_1``, ... in the result, which readers leave out).
+
+    Parameters
+    ----------
+    spec : str
+    n_joints : int, optional
+        The robot's joint count: a joint field (``actual_q``) must have exactly this many columns.
 
     Raises
     ------
     KinergyError
-        An empty or malformed entry, a bad count, more than :data:`MAX_COLUMNS` columns (refused
-        before they are expanded), a repeated name, or no ``timestamp``.
+        An empty or malformed entry, an unknown name (with the closest known one), a count that
+        does not fit the field, more than :data:`MAX_COLUMNS` columns (refused before they are
+        expanded), a repeated name, or no ``timestamp``.
     """
     names: list[str] = []
+    seen: dict[str, str] = {}
+    skipped = 0
     for raw in spec.split(","):
         item = raw.strip()
         if not item:
             raise KinergyError(f"--columns: empty entry in {printable(spec)!r}")
         name, colon, count = item.partition(":")
-        if colon and (not name or not count.isdigit() or int(count) < 1):
+        name = name.strip()
+        if colon and (not name or not count.strip().isdigit() or int(count) < 1):
             raise KinergyError(
                 f"--columns: {printable(item)!r} must be NAME or NAME:COUNT with COUNT >= 1"
             )
@@ -60,13 +74,76 @@ def parse_columns(spec: str) -> list[str]:
                 f"--columns: the spec expands to more than {MAX_COLUMNS} columns "
                 f"(at {printable(item)!r})"
             )
-        names.extend([f"{name}_{k}" for k in range(width)] if colon else [item])
-    dup = sorted(n for n, times in Counter(names).items() if times > 1)
-    if dup:
-        raise KinergyError(f"--columns: repeated column(s) {printable(', '.join(dup))}")
+        if name == SKIP:
+            names.extend(f"_{skipped + k}" for k in range(width))
+            skipped += width
+            continue
+        _check_entry(name, colon == ":", width, n_joints, seen)
+        seen[name] = item
+        names.extend([f"{name}_{k}" for k in range(width)] if colon else [name])
     if "timestamp" not in names:
         raise KinergyError("--columns: needs a 'timestamp' column")
     return names
+
+
+def _check_entry(
+    name: str, vector: bool, width: int, n_joints: int | None, seen: dict[str, str]
+) -> None:
+    """Refuse a spec entry that is unknown, repeated or of the wrong width, in one line."""
+    if not is_known(name):
+        guess = closest(name)
+        hint = f" (did you mean {guess}?)" if guess else ""
+        raise KinergyError(
+            f"--columns: unknown field {printable(name)!r}{hint}; give UR's RTDE names "
+            f"(timestamp, actual_q:N, actual_qd:N, actual_current:N, target_moment:N, ...) and "
+            f"skip a column with _ (or _:N)"
+        )
+    if name in seen:
+        guess = closest(name, [f for f in FIELDS if f != name and f not in seen])
+        hint = f" (did you mean {guess} for one of them?)" if guess else ""
+        raise KinergyError(f"--columns: {printable(name)!r} is given twice{hint}")
+    kind = FIELDS.get(name, 1)
+    if kind == JOINTS:
+        if not vector:
+            joints = n_joints if n_joints is not None else "N"
+            raise KinergyError(f"--columns: {name} has one value per joint: write {name}:{joints}")
+        if n_joints is not None and width != n_joints:
+            raise KinergyError(
+                f"--columns: {name}:{width} but the robot has {n_joints} joints "
+                f"(write {name}:{n_joints})"
+            )
+    elif isinstance(kind, int) and (width != kind or vector != (kind > 1)):
+        shown = f"{name}:{kind}" if kind > 1 else name
+        raise KinergyError(
+            f"--columns: {name} has {kind} value{'s' if kind > 1 else ''}: write {shown}"
+        )
+
+
+def compact_columns(names: Sequence[str]) -> str:
+    """A column spec for ``names`` (the inverse of :func:`parse_columns`): runs of
+    ``name_0 .. name_{k-1}`` as ``name:k``, skipped columns as ``_`` or ``_:k``."""
+    out: list[str] = []
+    k = 0
+    while k < len(names):
+        if re.fullmatch(r"_\d+", names[k]):
+            width = 1
+            while k + width < len(names) and re.fullmatch(r"_\d+", names[k + width]):
+                width += 1
+            out.append("_" if width == 1 else f"_:{width}")
+            k += width
+            continue
+        m = _VECTOR.match(names[k])
+        base = m["name"] if m else None
+        if base is not None and m is not None and m["index"] == "0":
+            width = 1
+            while k + width < len(names) and names[k + width] == f"{base}_{width}":
+                width += 1
+            out.append(f"{base}:{width}")
+            k += width
+        else:
+            out.append(names[k])
+            k += 1
+    return ",".join(out)
 
 
 def group_columns(columns: Sequence[str], path: str) -> dict[str, list[str]]:

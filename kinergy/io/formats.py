@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from kinergy.errors import KinergyError
+from kinergy.io.columns import parse_columns
 from kinergy.io.log import Log
 
 __all__ = ["CHUNK_ROWS", "LogFormat", "formats", "iter_log", "read_log", "register"]
@@ -90,7 +91,7 @@ def _format_of(path: Path, name: str | None) -> LogFormat:
 def iter_log(
     path: str | os.PathLike[str],
     *,
-    columns: str | None = None,
+    columns: str | Sequence[str] | None = None,
     repair: bool = False,
     select: Sequence[str] | None = None,
     rows: int = CHUNK_ROWS,
@@ -102,8 +103,9 @@ def iter_log(
     Parameters
     ----------
     path : path
-    columns : str, optional
-        Column spec of a headerless file (:func:`kinergy.io.columns.parse_columns`).
+    columns : str or sequence of str, optional
+        The layout of a headerless file: its column spec (``"timestamp,actual_q:6,..."``, parsed
+        by :func:`kinergy.io.columns.parse_columns`) or the column names it expands to.
     repair : bool
         Drop malformed rows instead of rejecting the file; the first chunk's ``notes`` say
         which.
@@ -122,6 +124,8 @@ def iter_log(
     if rows < 2:
         raise KinergyError(f"chunks of {rows} rows: need at least 2")
     path = Path(path)
+    if isinstance(columns, str):
+        columns = parse_columns(columns)
     fmt = _format_of(path, format)
     yield from fmt.chunks(path, columns=columns, repair=repair, select=select, rows=rows)
 
@@ -129,7 +133,7 @@ def iter_log(
 def read_log(
     path: str | os.PathLike[str],
     *,
-    columns: str | None = None,
+    columns: str | Sequence[str] | None = None,
     repair: bool = False,
     select: Sequence[str] | None = None,
     format: str | None = None,

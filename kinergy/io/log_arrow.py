@@ -8,6 +8,7 @@ finite, raises :class:`NotPlain`, and the caller asks :mod:`kinergy.io.log_text`
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator, Sequence
 
 import numpy as np
@@ -20,6 +21,10 @@ __all__ = ["NotPlain", "arrow_chunks"]
 
 #: the name given to the empty field after a trailing delimiter
 _TRAILING = "\x00trailing"
+
+
+#: the names of skipped columns (``_`` in a column spec)
+_SKIPPED = re.compile(r"_\d+")
 
 
 class NotPlain(Exception):
@@ -39,20 +44,24 @@ def arrow_chunks(layout: LogLayout, wanted: Sequence[int], rows: int) -> Iterato
     from pyarrow import csv
 
     names = list(layout.names) + ([_TRAILING] if layout.trailing else [])
-    selected = [layout.names[i] for i in wanted]
+    # every column is converted (a cell that is not a number anywhere is a damaged line), the
+    # skipped ones (``_0``, ``_1``, ...) excepted; the wanted ones are returned
+    checked = [n for n in layout.names if not _SKIPPED.fullmatch(n)]
+    position = {name: k for k, name in enumerate(checked)}
+    keep = [position[layout.names[i]] for i in wanted]
     options = {
         "read_options": csv.ReadOptions(column_names=names, block_size=1 << 20),
         "parse_options": csv.ParseOptions(delimiter=layout.sep, quote_char=False),
         "convert_options": csv.ConvertOptions(
-            column_types=dict.fromkeys(selected, pa.float64()),
-            include_columns=selected,
+            column_types=dict.fromkeys(checked, pa.float64()),
+            include_columns=checked,
             null_values=[],
             strings_can_be_null=False,
         ),
     }
     try:
         blocks = _line_blocks(layout, _block_size(layout, rows))
-        tables = (_values(csv.read_csv(pa.py_buffer(text), **options)) for text in blocks)
+        tables = (_values(csv.read_csv(pa.py_buffer(text), **options))[:, keep] for text in blocks)
         yield from _rebatched(tables, rows)
     except (pa.ArrowInvalid, pa.ArrowTypeError, OSError, UnicodeDecodeError):
         raise NotPlain from None

@@ -7,11 +7,12 @@ column spec (:func:`kinergy.io.columns.parse_columns`). A UTF-8 byte-order mark 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from kinergy.errors import KinergyError
-from kinergy.io.columns import MAX_COLUMNS, parse_columns
+from kinergy.io.columns import MAX_COLUMNS
 
 __all__ = ["LogLayout", "first_lines", "log_layout"]
 
@@ -29,7 +30,7 @@ class LogLayout:
     names : list of str
         The columns, in file order.
     sep : str
-        ``","`` or ``" "`` (any run of white space when not :attr:`plain`).
+        ``","``, ``";"`` or ``" "`` (any run of white space when not :attr:`plain`).
     skip : int
         Header lines before the data (0 or 1).
     source : str
@@ -59,6 +60,7 @@ def first_lines(path: Path, count: int) -> list[str]:
     KinergyError
         The file cannot be opened or read, or a first line is longer than the limit.
     """
+    _check_encoding(path)
     lines: list[str] = []
     try:
         with path.open("r", encoding="utf-8-sig", errors="replace", newline="") as fh:
@@ -75,8 +77,43 @@ def first_lines(path: Path, count: int) -> list[str]:
     return lines
 
 
-def log_layout(path: Path, columns: str | None) -> LogLayout:
-    """The layout of the log at ``path``; ``columns`` is the spec of a headerless file.
+def _check_encoding(path: Path) -> None:
+    """Refuse a log in UTF-16 or UTF-32 (a spreadsheet's "Unicode text"), or a binary file."""
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(4096)
+    except OSError as exc:
+        raise KinergyError(f"{path}: cannot read log ({exc.strerror})") from None
+    if head.startswith((b"\xff\xfe\x00\x00", b"\x00\x00\xfe\xff")):
+        raise KinergyError(f"{path}: the log is UTF-32 text; save it as UTF-8")
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")) or head[1::2].count(0) > len(head) // 4 > 0:
+        raise KinergyError(f"{path}: the log is UTF-16 text; save it as UTF-8")
+    if b"\x00" in head:
+        raise KinergyError(f"{path}: not a text log (it holds NUL bytes)")
+
+
+def _separator(path: Path, head: str, data: str) -> str:
+    """The field separator of a delimited log from its first lines: ``","``, ``";"`` or ``" "``
+    (any run of white space, tabs too).
+
+    Raises
+    ------
+    KinergyError
+        Fields separated by ``;`` whose numbers have decimal commas (a spreadsheet's locale).
+    """
+    if ";" in head:
+        if "," in data or "," in head:
+            raise KinergyError(
+                f"{path}: fields separated by ';' with decimal commas ({data.strip()[:40]!r}...): "
+                "save the log with '.' as the decimal mark (and ',' or spaces between fields)"
+            )
+        return ";"
+    return "," if "," in head else " "
+
+
+def log_layout(path: Path, columns: Sequence[str] | None) -> LogLayout:
+    """The layout of the log at ``path``; ``columns`` names the columns of a headerless file
+    (:func:`kinergy.io.columns.parse_columns` of its ``--columns`` spec).
 
     Raises
     ------
@@ -87,9 +124,9 @@ def log_layout(path: Path, columns: str | None) -> LogLayout:
     head, data = first_lines(path, 2)
     if not head.strip():
         raise KinergyError(f"{path}: empty log")
-    sep = "," if "," in head else " "
+    sep = _separator(path, head, data)
     if columns is None:
-        fields = head.strip().replace(",", " ").split()
+        fields = head.strip().replace(sep if sep != " " else ",", " ").split()
         if len(fields) > MAX_COLUMNS:
             raise KinergyError(
                 f"{path}: the header names {len(fields)} columns; at most {MAX_COLUMNS}"
@@ -101,7 +138,7 @@ def log_layout(path: Path, columns: str | None) -> LogLayout:
             )
         names, skip, source = fields, 1, "header"
     else:
-        names, skip, source, data = parse_columns(columns), 0, "--columns spec", head
+        names, skip, source, data = list(columns), 0, "--columns spec", head
     if "timestamp" not in names:
         raise KinergyError(f"{path}: no 'timestamp' column")
     if len(set(names)) != len(names):
@@ -109,6 +146,6 @@ def log_layout(path: Path, columns: str | None) -> LogLayout:
     cells = data.rstrip("\r\n").split(sep)
     trailing = len(cells) == len(names) + 1 and cells[-1] == ""
     same_width = len(cells) == len(names) + trailing
-    single = sep == "," or cells == data.split()
+    single = sep in ",;" or cells == data.split()
     plain = same_width and single and "\t" not in data and '"' not in data
     return LogLayout(path, names, sep, skip, source, plain, trailing)

@@ -7,6 +7,7 @@ and the readers fall back to this one to say what is wrong with a file it refuse
 
 from __future__ import annotations
 
+import re
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -51,6 +52,7 @@ def read_text_table(layout: LogLayout, *, repair: bool = False) -> tuple[Array, 
     frame = _text_frame(layout)
     values = _numbers(frame)
     bad = ~np.isfinite(values)
+    bad[:, [k for k, name in enumerate(names) if re.fullmatch(r"_\d+", name)]] = False
     notes: list[str] = []
     t_col = names.index("timestamp")
     if repair:
@@ -90,6 +92,20 @@ def check_times(
         )
 
 
+def _parser_problem(text: str, layout: LogLayout) -> str:
+    """The CSV parser's complaint in the reader's own words (line numbers of the file)."""
+    m = re.search(r"Expected (\d+) fields in line (\d+), saw (\d+)", text)
+    if m:
+        line = int(m[2])
+        return (
+            f"line {line} has {m[3]} fields where the {layout.source} names {m[1]} (a line cut "
+            "short or run together: --repair drops such lines)"
+        )
+    if "EOF inside string" in text or "quote" in text.lower():
+        return "a quote opened and never closed: a log holds numbers, not quoted text"
+    return "cannot be read as delimited text: " + printable(text.strip().splitlines()[-1], 80)
+
+
 def _text_frame(layout: LogLayout) -> pd.DataFrame:
     """The file as a pandas frame of strings, one column per name (a trailing empty column
     dropped)."""
@@ -99,7 +115,7 @@ def _text_frame(layout: LogLayout) -> pd.DataFrame:
     try:
         frame = pd.read_csv(
             path,
-            sep="," if layout.sep == "," else r"\s+",
+            sep=layout.sep if layout.sep in ",;" else r"\s+",
             header=None,
             skiprows=layout.skip,
             dtype=str,
@@ -110,7 +126,7 @@ def _text_frame(layout: LogLayout) -> pd.DataFrame:
             skip_blank_lines=True,
         )
     except pd.errors.ParserError as exc:
-        raise KinergyError(f"{path}: {printable(str(exc).strip().splitlines()[-1], 200)}") from None
+        raise KinergyError(f"{path}: {_parser_problem(str(exc), layout)}") from None
     except pd.errors.EmptyDataError:
         raise KinergyError(f"{path}: no data rows") from None
     # a trailing delimiter gives one more, empty column

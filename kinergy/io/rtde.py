@@ -93,7 +93,7 @@ class _Chunker:
 def _rtde_chunks(
     path: Path,
     *,
-    columns: str | None,
+    columns: Sequence[str] | None,
     repair: bool,
     select: Sequence[str] | None,
     rows: int,

@@ -31,6 +31,8 @@ __all__ = [
     "SOURCE_STATUSES",
     "Drive",
     "Friction",
+    "Identified",
+    "InputRecord",
     "Joint",
     "Limits",
     "Link",
@@ -398,6 +400,39 @@ def _transform(value: Any, what: str) -> Array:
     return arr
 
 
+@dataclass(frozen=True)
+class InputRecord:
+    """One log a model was identified from, by content.
+
+    Attributes
+    ----------
+    path : str
+    sha256 : str
+        Of the file's bytes (hex).
+    size : int
+        Bytes.
+    rows : int
+        Samples read.
+    """
+
+    path: str
+    sha256: str
+    size: int
+    rows: int
+
+
+@dataclass(frozen=True)
+class Identified:
+    """Where an identified model came from: the kinergy version, the command and its options,
+    the logs by content, and the checks the user accepted (``--accept``)."""
+
+    kinergy: str
+    command: str
+    options: Mapping[str, str | float | bool]
+    inputs: tuple[InputRecord, ...]
+    accepted: tuple[str, ...] = ()
+
+
 @dataclass(frozen=True, eq=False)
 class Robot:
     """A serial arm of revolute joints, as data.
@@ -429,6 +464,8 @@ class Robot:
         ``kinergy identify`` measures it from ``actual_robot_current``).
     bus_voltage : float
         DC bus voltage the joints are supplied from, V (48 V on UR e-Series).
+    identified : Identified or None
+        Where the model was identified from, when it was (``kinergy identify`` writes it).
     """
 
     name: str
@@ -443,6 +480,7 @@ class Robot:
     description: str = ""
     standby_power: float = 0.0
     bus_voltage: float = 48.0
+    identified: Identified | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:

@@ -67,6 +67,8 @@ from kinergy.model.robot import (
     SOURCE_CATEGORIES,
     Drive,
     Friction,
+    Identified,
+    InputRecord,
     Joint,
     Limits,
     Link,
@@ -87,6 +89,7 @@ __all__ = [
 T = TypeVar("T")
 
 _ROBOT_KEYS = {
+    "identified",
     "name",
     "convention",
     "gravity",
@@ -293,6 +296,7 @@ def robot_from_dict(data: Mapping[str, Any]) -> Robot:
             raise exc.prefixed(f"sources.{cat}") from None
     flange = _pose_from_dict(data["flange"], "flange") if "flange" in data else np.eye(4)
     base = _pose_from_dict(data["base"], "base") if "base" in data else np.eye(4)
+    identified = _identified(data["identified"]) if "identified" in data else None
     return Robot(
         name=_take(data, "name", "robot"),
         convention=_take(data, "convention", "robot"),
@@ -306,6 +310,45 @@ def robot_from_dict(data: Mapping[str, Any]) -> Robot:
         description=str(data.get("description", "")),
         standby_power=data.get("standby_power", 0.0),
         bus_voltage=data.get("bus_voltage", 48.0),
+        identified=identified,
+    )
+
+
+def _identified(data: Any) -> Identified:
+    """The ``[identified]`` table: where a model was identified from."""
+    where = "identified"
+    data = _known(data, ("kinergy", "command", "options", "inputs", "accepted"), where)
+    options = _table(data.get("options", {}), f"{where}.options")
+    for key, value in options.items():
+        if not isinstance(value, str | float | int | bool):
+            raise KinergyError(f"{where}.options.{key}: must be a string, number or boolean")
+    inputs = []
+    raw = data.get("inputs", [])
+    if not isinstance(raw, list):
+        raise KinergyError(f"{where}.inputs: must be an array of tables ([[identified.inputs]])")
+    for k, item in enumerate(raw):
+        at = f"{where}.inputs[{k}]"
+        item = _known(item, ("path", "sha256", "size", "rows"), at)
+        try:
+            inputs.append(
+                InputRecord(
+                    path=str(_take(item, "path", at)),
+                    sha256=str(_take(item, "sha256", at)),
+                    size=int(_take(item, "size", at)),
+                    rows=int(_take(item, "rows", at)),
+                )
+            )
+        except (TypeError, ValueError):
+            raise KinergyError(f"{at}: size and rows must be integers") from None
+    accepted = data.get("accepted", [])
+    if not isinstance(accepted, list) or not all(isinstance(a, str) for a in accepted):
+        raise KinergyError(f"{where}.accepted: must be an array of strings")
+    return Identified(
+        kinergy=str(data.get("kinergy", "")),
+        command=str(data.get("command", "")),
+        options=dict(options),
+        inputs=tuple(inputs),
+        accepted=tuple(accepted),
     )
 
 
@@ -344,6 +387,18 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         cat: {"status": robot.sources[cat].status, "ref": robot.sources[cat].ref}
         for cat in SOURCE_CATEGORIES
     }
+    if robot.identified is not None:
+        ident = robot.identified
+        out["identified"] = {
+            "kinergy": ident.kinergy,
+            "command": ident.command,
+            "options": dict(ident.options),
+            "accepted": list(ident.accepted),
+            "inputs": [
+                {"path": i.path, "sha256": i.sha256, "size": i.size, "rows": i.rows}
+                for i in ident.inputs
+            ],
+        }
     joints = []
     for j in robot.joints:
         drive: dict[str, Any] = {key: getattr(j.drive, key) for key in _DRIVE_NUMBERS}

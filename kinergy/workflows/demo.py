@@ -28,6 +28,7 @@ from pathlib import Path
 from kinergy.files import output_folder
 from kinergy.friction.model import SMOOTHING
 from kinergy.identify.metrics import fit_metrics
+from kinergy.identify.options import AUTO, IdentifyOptions
 from kinergy.identify.preprocess import IdentData, prepare
 from kinergy.identify.result import IdentificationResult, predict
 from kinergy.identify.sequential import identify_sequential
@@ -138,7 +139,7 @@ def _identify(model: Robot, data: IdentData, realistic: bool) -> IdentificationR
     """The sequential method from guessed drives; with the realistic twin, friction chosen per
     joint and the electrics and standby from the logged voltages and supply."""
     if realistic:
-        return identify_model(nominal_drives(model), [data], friction="auto")
+        return identify_model(nominal_drives(model), [data], IdentifyOptions(friction=AUTO))
     return identify_sequential(nominal_drives(model), [data])
 
 

@@ -12,11 +12,10 @@ from kinergy.accounting.energy_stream import EnergyAccumulator
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.accounting.supply import measured_supply
 from kinergy.arrays import Array
-from kinergy.io.formats import iter_log
 from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
 from kinergy.io.motion_stream import iter_motion
-from kinergy.io.rtde import read_log
+from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.predict import drive_state
 from kinergy.trajectory.motion import Motion
@@ -47,17 +46,12 @@ def _measured_power(log: Log) -> Array | None:
 _EXTRAS = ("joint_temperatures", "actual_robot_voltage", "actual_robot_current", "segment")
 
 
-def _signals_used(
-    path: str | os.PathLike[str], columns: str | None, source: str
-) -> list[str] | None:
-    """The signals of the log at ``path`` its energy uses (the others are never converted):
-    the motion of ``source`` (``auto`` as :func:`kinergy.io.motion.motion_from_log`) and
-    :data:`_EXTRAS`, those the log has; None (all) when it has no joint positions, so the
-    error lists what it has."""
-    first = next(iter_log(path, columns=columns, rows=2), None)
-    if first is None:
-        return None
-    names = first.signals
+def _signals_used(log: CheckedLog, source: str) -> list[str] | None:
+    """The signals of ``log`` its energy uses (the others are never converted): the motion of
+    ``source`` (``auto`` as :func:`kinergy.io.motion.motion_from_log`) and :data:`_EXTRAS`,
+    those the log has; None (all) when it has no joint positions, so the error lists what it
+    has."""
+    names = log.names()
     if source == "auto":
         source = "target" if "target_q" in names else "actual"
     if f"{source}_q" not in names:
@@ -69,8 +63,8 @@ def _signals_used(
 def energy_of_log(
     robot: Robot,
     path: str | os.PathLike[str],
+    reading: LogReading | None = None,
     *,
-    columns: str | None = None,
     source: str = "auto",
     recovery: bool = True,
 ) -> EnergyReport:
@@ -80,8 +74,9 @@ def energy_of_log(
     one where it has both. A URScript program (``*.script``) is run as the controller would
     (:func:`kinergy.workflows.logs.read_motion`)."""
     if os.fspath(path).endswith(".script"):
-        return energy(robot, read_motion(path, n_joints=robot.n, robot=robot), recovery=recovery)
-    log = read_log(path, columns=columns)
+        motion, _ = read_motion(path, robot)
+        return energy(robot, motion, recovery=recovery)
+    log = CheckedLog(path, robot, reading or LogReading()).read()
     motion = motion_from_log(log, n_joints=robot.n, source=source)
     report = energy(robot, motion, recovery=recovery, temperature=_temperature(log, motion))
     if "actual_robot_voltage" in log and "actual_robot_current" in log:
@@ -93,28 +88,30 @@ def energy_of_log(
 def energy_figures_of_log(
     robot: Robot,
     path: str | os.PathLike[str],
+    reading: LogReading | None = None,
     *,
-    columns: str | None = None,
     source: str = "auto",
     recovery: bool = True,
     rows: int = ENERGY_ROWS,
-) -> EnergyFigures:
+) -> tuple[EnergyFigures, InputLogs]:
     """The figures of :func:`energy_of_log` (what ``kinergy energy`` prints), a log read in one
-    pass: chunks of ``rows`` samples (:func:`kinergy.io.formats.iter_log`), their motion as the
-    whole log's (:func:`kinergy.io.motion_stream.iter_motion`), predicted and accumulated
-    (:class:`kinergy.accounting.energy_stream.EnergyAccumulator`); memory bounded by the chunk.
-    Segments (a time gap or a ``segment`` change) are never integrated across. A URScript
-    program takes the in-memory path."""
+    pass through its checks: chunks of ``rows`` samples (:class:`~kinergy.logs.reading.CheckedLog`),
+    their motion as the whole log's (:func:`kinergy.io.motion_stream.iter_motion`), predicted
+    and accumulated (:class:`kinergy.accounting.energy_stream.EnergyAccumulator`); memory
+    bounded by the chunk. Segments (a time gap or a ``segment`` change) are never integrated
+    across. A URScript program takes the in-memory path. Also returns what the log was."""
+    inputs = InputLogs()
     if os.fspath(path).endswith(".script"):
-        return energy_of_log(robot, path, recovery=recovery).figures()
+        return energy_of_log(robot, path, recovery=recovery).figures(), inputs
     acc = EnergyAccumulator(robot, recovery=recovery)
     measured = False
-    select = _signals_used(path, columns, source)
-    chunks = iter_log(path, columns=columns, rows=rows, select=select)
-    for part in iter_motion(chunks, n_joints=robot.n, source=source):
+    log = CheckedLog(path, robot, reading or LogReading(), rows=rows)
+    log.select = _signals_used(log, source)
+    for part in iter_motion(log.chunks(), n_joints=robot.n, source=source):
         m = part.motion
         state = drive_state(robot, m.q, m.qd, m.qdd, temperature=_temperature(part.log, m))
         power = _measured_power(part.log)
         measured = power is not None
         acc.add(m.t, state, starts=part.starts, measured_power=power)
-    return acc.figures(measured=measured)
+    inputs.add(log)
+    return acc.figures(measured=measured), inputs

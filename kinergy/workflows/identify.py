@@ -6,7 +6,7 @@ import contextlib
 import dataclasses
 import datetime
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, Protocol
 
 import numpy as np
@@ -17,17 +17,22 @@ from kinergy.errors import KinergyError
 from kinergy.identify.electrics import ElectricsFit, fit_electrics, fit_standby, with_electrics
 from kinergy.identify.full import identify_full
 from kinergy.identify.nursing import identify_nursing
+from kinergy.identify.options import IdentifyOptions, Method
 from kinergy.identify.payload import PayloadEstimate, identify_payload
 from kinergy.identify.preprocess import IdentData
-from kinergy.identify.result import IdentificationResult
+from kinergy.identify.result import IDENTIFIED, IdentificationResult
 from kinergy.identify.sanity import check_motion, check_signals
 from kinergy.identify.sequential import identify_sequential, sequential_from
 from kinergy.identify.streamed import LogsInChunks, streams
+from kinergy.io.columns import compact_columns
 from kinergy.io.formats import CHUNK_ROWS
+from kinergy.io.log import Log
+from kinergy.logs.checks import Check
+from kinergy.logs.reading import InputLogs, LogReading
 from kinergy.model import Payload, Robot, save_robot
-from kinergy.model.robot import Source
+from kinergy.model.robot import Identified, InputRecord, Source
 from kinergy.predict import drive_state
-from kinergy.workflows.logs import LogReading, chunked_logs, prepared_logs
+from kinergy.workflows.logs import chunked_logs, prepared_logs
 
 __all__ = [
     "METHODS",
@@ -37,10 +42,11 @@ __all__ = [
     "identify_model",
     "identify_payload_model",
     "measured_electrics",
+    "unsupported_fit",
 ]
 
 #: identification methods by the name ``--method`` takes
-METHODS = ("sequential", "full", "nursing")
+METHODS = tuple(m.value for m in Method)
 #: s: the shortest logs (all together) an identification accepts
 MIN_SECONDS = 1.0
 
@@ -64,39 +70,129 @@ def _check_seconds(seconds: float) -> None:
 def identify_model(
     robot: Robot,
     datas: Sequence[IdentData],
-    out: str | os.PathLike[str] | None = None,
-    *,
-    method: str = "sequential",
-    friction: str | None = None,
-    target: str = "auto",
-    solver: str = "ols",
-    ridge: float = 0.0,
+    options: IdentifyOptions | None = None,
 ) -> IdentificationResult:
-    """Identify ``robot`` from prepared logs by ``method``, then the motor electrics and the
-    standby power where the logs have voltages and the supply (:func:`measured_electrics`);
-    write the identified model to ``out`` when given.
+    """Identify ``robot`` from prepared logs as ``options`` say, then the motor electrics and the
+    standby power where the logs have voltages and the supply (:func:`measured_electrics`).
 
     Raises
     ------
     KinergyError
         Logs spanning less than :data:`MIN_SECONDS` together, with signals no robot logs or
-        without motion (:mod:`kinergy.identify.sanity`); nothing is written.
+        without motion (:mod:`kinergy.identify.sanity`).
     """
+    options = options or IdentifyOptions()
     check_signals(datas)
     check_motion(datas)
     _check_seconds(sum(float(d.t[-1] - d.t[0]) for d in datas))
-    if method == "sequential":
-        result = identify_sequential(robot, list(datas), friction=friction)
-    elif method == "nursing":
+    if options.method == Method.SEQUENTIAL:
+        result = identify_sequential(robot, list(datas), friction=options.friction)
+    elif options.method == Method.NURSING:
         result = identify_nursing(robot, list(datas))
     else:
         result = identify_full(
-            robot, list(datas), target=target, solver=solver, ridge=ridge, friction=friction
+            robot,
+            list(datas),
+            target=options.target,
+            solver=options.solver,
+            ridge=options.ridge,
+            friction=options.friction,
         )
-    result = measured_electrics(result, datas)
+    return measured_electrics(result, datas)
+
+
+def unsupported_fit(result: IdentificationResult) -> str:
+    """Why the identified model is not supported by its own logs, or "": no drive parameter
+    identified, or an R^2 below 0 on the identification logs for a joint that moved (module
+    docstring of :mod:`kinergy.logs.checks`, check ``fit``)."""
+    flags = [f for j in result.joints for k, f in j.flags.items()]
+    if flags and all(f != IDENTIFIED for f in flags):
+        return (
+            "no drive parameter could be identified from these logs (every one kept from the "
+            "model): nothing in them excites the drives, or their layout is wrong"
+        )
+    moved = [getattr(j, "identified", True) for j in result.joints]
+    worst = []
+    for key, unit in (("torque", "target_moment"), ("current", "actual_current")):
+        metrics = getattr(result.fit, key)
+        if metrics is None:
+            continue
+        for k, m in enumerate(metrics):
+            if moved[k] and m.r2 < 0:
+                worst.append(f"{result.robot.joints[k].name} {unit} R^2 {m.r2:.2f}")
+    if worst:
+        return (
+            f"the identified model does not explain its own logs ({', '.join(worst)}): the "
+            "logs' layout, units or robot are likely wrong (check --columns and --robot)"
+        )
+    return ""
+
+
+def _record(
+    robot: Robot, inputs: InputLogs, options: Mapping[str, Any], accepted: Sequence[str]
+) -> Robot:
+    """``robot`` with where it was identified from (:class:`~kinergy.model.robot.Identified`)."""
+    from kinergy import __version__
+
+    plain = {k: v for k, v in options.items() if isinstance(v, str | float | int | bool)}
+    records = tuple(InputRecord(p.path, p.sha256, p.size, p.rows) for p in inputs.provenance)
+    ident = Identified(__version__, "identify", plain, records, tuple(accepted))
+    return dataclasses.replace(robot, identified=ident)
+
+
+def identify_logs(
+    robot: Robot,
+    logs: Sequence[str | os.PathLike[str] | Log],
+    out: str | os.PathLike[str] | None,
+    *,
+    reading: LogReading | None = None,
+    options: IdentifyOptions | None = None,
+    rows: int = CHUNK_ROWS,
+) -> IdentificationResult:
+    """Read (through the checks), prepare and identify ``logs`` (files or logs in memory) and
+    write the model to ``out`` when given.
+
+    ``reading`` says how to read the logs (:class:`~kinergy.logs.reading.LogReading`),
+    ``options`` what to identify. When the method streams
+    (:func:`kinergy.identify.streamed.streams`: the sequential method with a fixed friction
+    model) the logs are read in chunks of ``rows`` samples and never held whole
+    (:func:`~kinergy.workflows.logs.chunked_logs`); other methods prepare them in memory.
+
+    Raises
+    ------
+    KinergyError
+        A log that fails its checks, logs that cannot identify the model, and a model the logs
+        do not support (:func:`unsupported_fit`) unless ``reading.accept`` holds ``fit``;
+        nothing is written then.
+    """
+    reading = reading or LogReading()
+    options = options or IdentifyOptions()
+    if not streams(robot, options.method, options.friction):
+        datas, inputs = prepared_logs(logs, robot, reading)
+        result = identify_model(robot, datas, options)
+    else:
+        with chunked_logs(logs, robot, reading, rows=rows) as (segments, inputs):
+            with contextlib.closing(LogsInChunks(robot, segments, rows)) as chunked:
+                _check_seconds(chunked.seconds)
+                result = sequential_from(robot, chunked, friction=options.friction)
+                result = measured_electrics(result, chunked)
+    accepted = [a for c in inputs.checks for a in c.accepted]
+    problem = unsupported_fit(result)
+    if problem:
+        if Check.FIT not in reading.accept:
+            raise KinergyError(
+                f"fit check failed: {problem}; no model written (if the logs are right, "
+                "--accept fit)"
+            )
+        accepted.append(f"fit: {problem}")
+    result = dataclasses.replace(result, inputs=inputs, accepted=tuple(accepted))
     if out is not None:
+        columns = compact_columns(reading.columns) if reading.columns else None
+        settings = {**vars(options), "columns": columns}
+        model = _record(result.robot, inputs, settings, accepted)
         what = f"{robot.name} identified ({result.method} method)"
-        save_robot(result.robot, out, header=_header(what, [d.path for d in datas]))
+        save_robot(model, out, header=_header(what, [p.path for p in inputs.provenance]))
+        result = dataclasses.replace(result, robot=model)
     return result
 
 
@@ -226,48 +322,21 @@ def measured_electrics(
     if not notes:
         return result
     robot = dataclasses.replace(robot, sources=sources)
-    fit = dataclasses.replace(result.fit, warnings=(*result.fit.warnings, *notes))
+    fit = dataclasses.replace(result.fit, notes=(*result.fit.notes, *notes))
     return dataclasses.replace(result, robot=robot, fit=fit)
 
 
-def identify_logs(
-    robot: Robot,
-    paths: Sequence[str | os.PathLike[str]],
-    out: str | os.PathLike[str],
-    *,
-    reading: LogReading | None = None,
-    rows: int = CHUNK_ROWS,
-    **options: Any,
-) -> IdentificationResult:
-    """Read, prepare and identify the logs at ``paths`` and write the model to ``out``.
-
-    ``reading`` says how to read the logs (:class:`~kinergy.workflows.logs.LogReading`),
-    ``options`` are :func:`identify_model`'s. When the method
-    streams (:func:`kinergy.identify.streamed.streams`: the sequential method with a fixed
-    friction model) the logs are read in chunks of ``rows`` samples and never held whole
-    (:func:`~kinergy.workflows.logs.chunked_logs`); other methods prepare them in memory.
-    """
-    reading = reading or {}
-    method, friction = options.get("method", "sequential"), options.get("friction")
-    if not streams(robot, method, friction):
-        datas = prepared_logs(paths, n_joints=robot.n, **reading)
-        return identify_model(robot, datas, out, **options)
-    with chunked_logs(paths, n_joints=robot.n, rows=rows, **reading) as segments:
-        with contextlib.closing(LogsInChunks(robot, segments, rows)) as logs:
-            _check_seconds(logs.seconds)
-            result = sequential_from(robot, logs, friction=friction)
-            result = measured_electrics(result, logs)
-    what = f"{robot.name} identified ({result.method} method)"
-    save_robot(result.robot, out, header=_header(what, [s.path for s in segments]))
-    return result
-
-
 def identify_payload_model(
-    robot: Robot, datas: Sequence[IdentData], out: str | os.PathLike[str]
-) -> tuple[Payload, PayloadEstimate]:
-    """Identify the payload of ``robot`` (the model without it) and write the model with it."""
+    robot: Robot,
+    logs: Sequence[str | os.PathLike[str] | Log],
+    out: str | os.PathLike[str],
+    reading: LogReading | None = None,
+) -> tuple[Payload, PayloadEstimate, InputLogs]:
+    """Identify the payload of ``robot`` (the model without it) from ``logs`` taken with it
+    (read through the checks) and write the model with it."""
+    datas, inputs = prepared_logs(logs, robot, reading or LogReading())
     check_signals(datas)
     payload, report = identify_payload(robot, list(datas))
     what = f"{robot.name} with the payload identified"
     save_robot(robot.with_payload(payload), out, header=_header(what, [d.path for d in datas]))
-    return payload, report
+    return payload, report, inputs

@@ -10,68 +10,37 @@ from __future__ import annotations
 import contextlib
 import itertools
 import os
-from collections.abc import Callable, Iterator, Sequence
-from typing import TypedDict, Unpack
+from collections.abc import Iterator, Sequence
 
 from kinergy.arrays import Array
-from kinergy.errors import KinergyError
-from kinergy.identify.log_chunks import prepare_segment, spill_log, streamable
+from kinergy.identify.log_chunks import SIGNALS, STATE, prepare_segment, spill_log, streamable
 from kinergy.identify.preprocess import IdentData, prepare
 from kinergy.identify.streamed import Segment, WholeSegment
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
-from kinergy.io.rtde import read_log
 from kinergy.io.segments import segment_bounds
 from kinergy.io.urscript_reader import read_program
+from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.program_motion import program_motion
 from kinergy.trajectory.program_path import program_path
 
-__all__ = ["MIN_SEGMENT", "LogReading", "chunked_logs", "prepared_logs", "read_motion"]
+__all__ = ["MIN_SEGMENT", "InputLogs", "LogReading", "chunked_logs", "prepared_logs", "read_motion"]
 
 
 MIN_SEGMENT = 1.0
 """Shortest segment of a log (s) :func:`prepared_logs` identifies from."""
 
 
-class LogReading(TypedDict, total=False):
-    """How :func:`prepared_logs` and :func:`chunked_logs` read and prepare each log (every key
-    may be left out).
-
-    Attributes
-    ----------
-    columns : str or None
-        The layout of a headerless file (``--columns``, :mod:`kinergy.io.formats`); None: the
-        file names its columns (UR's record.py layout).
-    repair : bool
-        Drop rows that cannot be read (each drop noted) instead of failing; default False.
-    cutoff : float or None
-        Low-pass cutoff for measured speeds, Hz (:func:`kinergy.identify.preprocess.prepare`);
-        None: its default.
-    note : callable or None
-        Receives what reading changed (rows dropped by ``repair``, segments), one message each.
-    """
-
-    columns: str | None
-    repair: bool
-    cutoff: float | None
-    note: Callable[[str], None] | None
-
-
 def _segments(
-    path: str | os.PathLike[str],
-    t: Array,
-    segment: Array | None,
-    notes: Sequence[str],
-    note: Callable[[str], None] | None,
+    path: str | os.PathLike[str], t: Array, segment: Array | None, notes: list[str]
 ) -> list[tuple[str, tuple[int, int]]]:
     """The segments of the log at ``path`` identified from (time stamps ``t``, its ``segment``
     signal if any: :func:`~kinergy.io.segments.segment_bounds`), each with the name
     :func:`~kinergy.io.segments.split_segments` gives it: those shorter than :data:`MIN_SEGMENT`
-    are left out. ``note`` receives the log's reading ``notes`` and, where there are several
-    segments, what was done with them."""
+    are left out. Where there are several segments, ``notes`` receives what was done with them."""
     name, bounds = os.fspath(path), segment_bounds(t, segment)
     if len(bounds) == 1:
         kept = [(name, bounds[0])]
@@ -81,86 +50,88 @@ def _segments(
             max(parts, key=lambda p: p[1][1] - p[1][0])
         ]
         gaps = [t[b[0]] - t[a[1] - 1] for a, b in itertools.pairwise(bounds)]
-        notes = [
-            *notes,
+        notes.append(
             f"{path}: {len(parts)} segments (gaps up to {max(gaps):.3f} s), each prepared on "
-            f"its own; {len(parts) - len(kept)} shorter than {MIN_SEGMENT:g} s left out",
-        ]
-    if note is not None:
-        for text in notes:
-            note(text)
+            f"its own; {len(parts) - len(kept)} shorter than {MIN_SEGMENT:g} s left out"
+        )
     return kept
 
 
+#: the signals a spill keeps: what identification uses, and the state that decides segments
+SPILLED = (*SIGNALS, *STATE)
+
+
 def prepared_logs(
-    paths: Sequence[str | os.PathLike[str]], *, n_joints: int, **reading: Unpack[LogReading]
-) -> list[IdentData]:
-    """Read and prepare every log (:func:`kinergy.identify.preprocess.prepare`), each segment of
-    a log on its own (:func:`kinergy.io.segments.segment_bounds`: nothing is filtered or
-    differentiated across a gap or a reconnection), as ``reading`` says (:class:`LogReading`).
+    paths: Sequence[str | os.PathLike[str] | Log], robot: Robot, reading: LogReading
+) -> tuple[list[IdentData], InputLogs]:
+    """Read (through the checks, :class:`~kinergy.logs.reading.CheckedLog`) and prepare every
+    log (:func:`kinergy.identify.preprocess.prepare`), each segment of a log on its own
+    (:func:`kinergy.io.segments.segment_bounds`: nothing is filtered or differentiated across a
+    gap or a reconnection), as ``reading`` says.
 
     Segments shorter than :data:`MIN_SEGMENT` seconds are left out and counted in a note.
     """
     datas: list[IdentData] = []
+    inputs = InputLogs()
     for path in paths:
-        log = read_log(path, columns=reading.get("columns"), repair=reading.get("repair", False))
+        checked = CheckedLog(path, robot, reading)
+        log = checked.read()
+        inputs.add(checked)
         segment = log.signals.get("segment")
-        for name, (a, b) in _segments(path, log.t, segment, log.notes, reading.get("note")):
-            part = Log(
-                name, log.t[a:b], {k: v[a:b] for k, v in log.signals.items()}, list(log.notes)
-            )
-            datas.append(prepare(part, n_joints, cutoff=reading.get("cutoff")))
-    return datas
+        for name, (a, b) in _segments(checked.path, log.t, segment, inputs.notes):
+            part = Log(name, log.t[a:b], {k: v[a:b] for k, v in log.signals.items()})
+            datas.append(prepare(part, robot.n, cutoff=reading.cutoff))
+    return datas, inputs
 
 
 @contextlib.contextmanager
 def chunked_logs(
-    paths: Sequence[str | os.PathLike[str]],
+    paths: Sequence[str | os.PathLike[str] | Log],
+    robot: Robot,
+    reading: LogReading,
     *,
-    n_joints: int,
     rows: int = CHUNK_ROWS,
-    **reading: Unpack[LogReading],
-) -> Iterator[list[Segment]]:
+) -> Iterator[tuple[list[Segment], InputLogs]]:
     """:func:`prepared_logs` as segments that yield their samples in chunks of ``rows``
-    (:mod:`kinergy.identify.log_chunks`: each log read once into a temporary spill, removed on
-    leaving the context). A log without the commanded motion is prepared whole
-    (:class:`~kinergy.identify.streamed.WholeSegment`)."""
-    cutoff = reading.get("cutoff")
+    (:mod:`kinergy.identify.log_chunks`: each log read once, through the checks, into a
+    temporary spill, removed on leaving the context). A log without the commanded motion is
+    prepared whole (:class:`~kinergy.identify.streamed.WholeSegment`)."""
+    cutoff = reading.cutoff
+    inputs = InputLogs()
     with contextlib.ExitStack() as stack:
         segments: list[Segment] = []
         for path in paths:
-            spill = spill_log(
-                path, columns=reading.get("columns"), repair=reading.get("repair", False), rows=rows
-            )
+            checked = CheckedLog(path, robot, reading, select=SPILLED, rows=rows)
+            spill = spill_log(checked)
             stack.callback(spill.close)
+            inputs.add(checked)
             t, segment = spill.state.t, spill.state.signals.get("segment")
-            for name, ab in _segments(path, t, segment, spill.notes, reading.get("note")):
+            for name, ab in _segments(checked.path, t, segment, inputs.notes):
                 if streamable(spill):
-                    segments.append(prepare_segment(spill, ab, name, n_joints, cutoff))
+                    segments.append(prepare_segment(spill, ab, name, robot.n, cutoff))
                 else:
                     part = spill.read(*ab)
                     state = {k: v[ab[0] : ab[1]] for k, v in spill.state.signals.items()}
                     log = Log(name, part.t, {**part.signals, **state})
-                    segments.append(WholeSegment(prepare(log, n_joints, cutoff=cutoff)))
-        yield segments
+                    segments.append(WholeSegment(prepare(log, robot.n, cutoff=cutoff)))
+        yield segments, inputs
 
 
 def read_motion(
     path: str | os.PathLike[str],
+    robot: Robot,
+    reading: LogReading | None = None,
     *,
-    n_joints: int,
-    columns: str | None = None,
-    repair: bool = False,
     source: str = "auto",
-    robot: Robot | None = None,
-) -> Motion:
-    """The joint motion of a log or motion file (:func:`kinergy.io.motion.motion_from_log`), or
-    of a URScript program (``*.script``) on ``robot`` as the controller runs it (one cycle,
-    starting where it ends, at 500 Hz)."""
+) -> tuple[Motion, InputLogs]:
+    """The joint motion of a log or motion file (:func:`kinergy.io.motion.motion_from_log`,
+    read through the checks), or of a URScript program (``*.script``) on ``robot`` as the
+    controller runs it (one cycle, starting where it ends, at 500 Hz)."""
+    inputs = InputLogs()
     if os.fspath(path).endswith(".script"):
-        if robot is None:
-            raise KinergyError(f"{path}: a URScript program needs the robot it runs on")
         motion, _ = program_motion(robot, program_path(robot, read_program(path)))
-        return motion
-    log = read_log(path, columns=columns, repair=repair)
-    return motion_from_log(log, n_joints=n_joints, source=source)
+        return motion, inputs
+    checked = CheckedLog(path, robot, reading or LogReading())
+    log = checked.read()
+    inputs.add(checked)
+    return motion_from_log(log, n_joints=robot.n, source=source), inputs

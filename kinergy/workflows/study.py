@@ -15,11 +15,13 @@ from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult, predict
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.task import Task
+from kinergy.logs.reading import LogReading
+from kinergy.messages import Messages
 from kinergy.model.robot import Robot
 from kinergy.report.html import Section, Table, write_report
 from kinergy.report.study import Comparison, Study, Timing, study_sections
 from kinergy.trajectory.motion import Motion
-from kinergy.workflows.logs import LogReading, prepared_logs, read_motion
+from kinergy.workflows.logs import prepared_logs, read_motion
 from kinergy.workflows.optimize import optimize_task
 
 __all__ = ["optimal_timing", "run_study", "study_report", "write_study"]
@@ -120,39 +122,39 @@ def study_report(
     identify_logs: Sequence[str] = (),
     validate_logs: Sequence[str] = (),
     energy_logs: Sequence[str] = (),
-    columns: str | None = None,
-    repair: bool = False,
+    reading: LogReading | None = None,
     model_name: str = "",
     progress: Progress | None = None,
-    note: Callable[[str], None] | None = None,
-) -> tuple[Path, dict[str, list[Table]]]:
+) -> tuple[Path, dict[str, list[Table]], Messages]:
     """``kinergy report``: identify (sequential method) on ``identify_logs`` if any, validate on
     ``validate_logs``, account the energy of ``energy_logs``, and write ``out/report.html``.
 
     The folder is built beside ``out`` and renamed into place at the end
     (:func:`kinergy.files.atomic_folder`); ``out`` None: a new folder ``kinergy-report-*`` in the
-    system's temporary folder. Returns the path of ``report.html`` and the tables.
+    system's temporary folder. Returns the path of ``report.html``, the tables, and what the
+    logs' reading and the identification said (notes and warnings).
     """
     say = progress or (lambda _msg: None)
-    reading: LogReading = {"columns": columns, "repair": repair, "note": note}
+    reading = reading or LogReading()
+    said = Messages()
     result = None
     if identify_logs:
         say("identifying")
-        result = identify_sequential(
-            robot, prepared_logs(identify_logs, n_joints=robot.n, **reading)
-        )
+        datas, inputs = prepared_logs(identify_logs, robot, reading)
+        result = identify_sequential(robot, datas)
+        said.notes += [*inputs.notes, *result.notes]
+        said.warnings += [*inputs.warnings, *result.warnings]
         robot = result.robot
-    validation = dict(
-        zip(
-            (Path(p).name for p in validate_logs),
-            prepared_logs(validate_logs, n_joints=robot.n, **reading),
-            strict=True,
-        )
-    )
-    motions = {
-        Path(p).name: read_motion(p, n_joints=robot.n, columns=columns, repair=repair)
-        for p in energy_logs
-    }
+    datas, inputs = prepared_logs(validate_logs, robot, reading)
+    said.notes += inputs.notes
+    said.warnings += inputs.warnings
+    validation = {Path(d.path).name: d for d in datas}
+    motions = {}
+    for p in energy_logs:
+        motion, inputs = read_motion(p, robot, reading)
+        said.notes += inputs.notes
+        said.warnings += inputs.warnings
+        motions[Path(p).name] = motion
     study = run_study(
         robot, validation=validation, motions=motions, result=result, progress=progress
     )
@@ -167,4 +169,4 @@ def study_report(
                 "logs": ", ".join([*identify_logs, *validate_logs, *energy_logs]),
             },
         )
-    return target / "report.html", tables
+    return target / "report.html", tables, said

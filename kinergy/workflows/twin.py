@@ -6,6 +6,7 @@ import os
 
 from kinergy.io.log import Log
 from kinergy.io.rtde import write_log
+from kinergy.logs.reading import LogReading
 from kinergy.model.robot import Robot
 from kinergy.model.toml import save_robot
 from kinergy.simulate import TwinSettings, realistic_truth, simulate
@@ -22,10 +23,11 @@ def twin_truth(robot: Robot, mismatch: str, seed: int) -> Robot:
     return realistic_truth(robot, seed) if mismatch == "realistic" else robot
 
 
-def _target(robot: Robot, trajectory: str, columns: str | None) -> Motion:
+def _target(robot: Robot, trajectory: str, reading: LogReading) -> Motion:
     if trajectory in TEST_TRAJECTORIES:
         return paper_trajectory(robot, trajectory)
-    return read_motion(trajectory, n_joints=robot.n, columns=columns, source="target", robot=robot)
+    motion, _ = read_motion(trajectory, robot, reading, source="target")
+    return motion
 
 
 def simulate_to_file(
@@ -34,7 +36,7 @@ def simulate_to_file(
     out: str | os.PathLike[str],
     settings: TwinSettings,
     *,
-    columns: str | None = None,
+    reading: LogReading | None = None,
     mismatch: str = "none",
     truth_out: str | os.PathLike[str] | None = None,
 ) -> Log:
@@ -46,7 +48,7 @@ def simulate_to_file(
     ``truth_out`` when given. The program is planned on the model, as a user would.
     """
     truth = twin_truth(robot, mismatch, settings.seed)
-    motion = _target(robot, trajectory, columns)
+    motion = _target(robot, trajectory, reading or LogReading())
     twin = simulate(truth, motion, settings, name=os.fspath(out))
     write_log(out, twin.t, twin.signals)
     if truth_out is not None:

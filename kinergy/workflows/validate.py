@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -11,23 +12,49 @@ from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import predict
 from kinergy.identify.sanity import check_signals
 from kinergy.identify.validation import ValidationReport, validation_report
+from kinergy.io.log import Log
+from kinergy.logs.reading import InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.report.plots import error_boxplot, save, time_series
+from kinergy.workflows.logs import prepared_logs
 
-__all__ = ["validate_logs", "write_validation_plots"]
+__all__ = ["identified_from", "validate_logs", "write_validation_plots"]
+
+
+def identified_from(robot: Robot, inputs: InputLogs) -> list[str]:
+    """Warnings for each log the model ``robot`` was identified from (same SHA-256): a
+    validation on it is not on unseen motion."""
+    if robot.identified is None:
+        return []
+    seen = {i.sha256: i.path for i in robot.identified.inputs}
+    return [
+        f"{p.path}: the model was identified from this log (as {seen[p.sha256]}, same SHA-256): "
+        "this validation is not on unseen motion"
+        for p in inputs.provenance
+        if p.sha256 in seen
+    ]
 
 
 def validate_logs(
-    robot: Robot, datas: Sequence[IdentData], *, plots: str | os.PathLike[str] | None = None
+    robot: Robot,
+    logs: Sequence[str | os.PathLike[str] | Log],
+    reading: LogReading | None = None,
+    *,
+    plots: str | os.PathLike[str] | None = None,
 ) -> ValidationReport:
-    """UR5e Tables V and VII for ``datas``, pooled and per log, moving and holding apart
-    (:func:`~kinergy.identify.validation.validation_report`); with ``plots``, also write the
-    measured-against-predicted figures to that folder."""
+    """UR5e Tables V and VII for ``logs`` (read through the checks), pooled and per log, moving
+    and holding apart (:func:`~kinergy.identify.validation.validation_report`); with ``plots``,
+    also write the measured-against-predicted figures to that folder. A log the model was
+    identified from is named in a warning."""
+    datas, inputs = prepared_logs(logs, robot, reading or LogReading())
     check_signals(datas)
     report = validation_report(robot, list(datas))
     if plots is not None:
         write_validation_plots(robot, datas, plots)
-    return report
+    warnings = [*inputs.warnings, *identified_from(robot, inputs)]
+    return dataclasses.replace(
+        report, inputs=inputs, notes=tuple(inputs.notes), warnings=tuple(warnings)
+    )
 
 
 def write_validation_plots(

@@ -1,0 +1,294 @@
+"""Reading a user's log: its chunks, checked for plausibility as they pass, and what the log was.
+
+Every command that takes a log reads it through :class:`CheckedLog`: the chunks of
+:func:`kinergy.io.formats.iter_log` (or of a log already in memory, as one chunk), each folded
+into the checks of :mod:`kinergy.logs.checks` before it is passed on. After the last chunk the
+checks give their verdict: a failure the user did not accept raises, so nothing computed from the
+chunks is shown. The log's provenance (:class:`Provenance`: SHA-256, size and rows) is recorded
+as it is read, for the results to say which data they came from.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import threading
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from kinergy.errors import KinergyError
+from kinergy.io.formats import CHUNK_ROWS, iter_log
+from kinergy.io.log import Log
+from kinergy.logs.checks import Check, LogCheck, LogChecks
+from kinergy.model.robot import Robot
+
+__all__ = ["CHECKED_SIGNALS", "CheckedLog", "InputLogs", "LogReading", "Provenance"]
+
+#: the signals the checks read whenever a log has them (besides those a command asks for)
+CHECKED_SIGNALS = (
+    "target_q",
+    "target_qd",
+    "target_qdd",
+    "actual_q",
+    "actual_qd",
+    "target_moment",
+    "actual_current",
+    "target_current",
+    "actual_joint_torque",
+    "actual_current_as_torque",
+    "actual_joint_voltage",
+    "joint_temperatures",
+    "actual_robot_voltage",
+    "actual_robot_current",
+)
+
+
+@dataclass(frozen=True)
+class LogReading:
+    """How a command reads its logs, parsed once from its options.
+
+    Attributes
+    ----------
+    columns : tuple of str or None
+        The columns of a headerless file (:func:`kinergy.io.columns.parse_columns` of the
+        ``--columns`` spec); None: the file names them in a header line (UR's record.py layout).
+    repair : bool
+        Drop rows that cannot be read (each drop noted) instead of refusing the file.
+    cutoff : float or None
+        Low-pass cutoff for measured speeds, Hz; None: min(10 Hz, a fifth of the sample rate).
+    accept : frozenset of Check
+        Checks whose failure the user accepts (``--accept``); the results record them.
+    """
+
+    columns: tuple[str, ...] | None = None
+    repair: bool = False
+    cutoff: float | None = None
+    accept: frozenset[Check] = frozenset()
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """What a log was, by content: enough to tell later whether two results came from the same
+    data.
+
+    Attributes
+    ----------
+    path : str
+    sha256 : str
+        Of the file's bytes (of the samples' bytes for a log held in memory).
+    size : int
+        Bytes.
+    rows : int
+        Samples read (after ``repair``).
+    """
+
+    path: str
+    sha256: str
+    size: int
+    rows: int
+
+
+def _file_hash(path: Path, out: list[str], stop: threading.Event) -> None:
+    """SHA-256 of the file at ``path`` into ``out`` (nothing when ``stop`` is set first)."""
+    digest = hashlib.sha256()
+    try:
+        with path.open("rb") as fh:
+            while block := fh.read(1 << 23):
+                if stop.is_set():
+                    return
+                digest.update(block)
+    except OSError:
+        return
+    out.append(digest.hexdigest())
+
+
+def _log_hash(log: Log) -> tuple[str, int]:
+    """SHA-256 and size of a log's samples: its time stamps and signals, by name."""
+    digest = hashlib.sha256()
+    size = 0
+    for name, x in [("timestamp", log.t), *sorted(log.signals.items())]:
+        data = np.ascontiguousarray(x, dtype=float).tobytes()
+        digest.update(name.encode())
+        digest.update(data)
+        size += len(data)
+    return digest.hexdigest(), size
+
+
+@dataclass(eq=False)
+class CheckedLog:
+    """One log, read through the plausibility checks (module docstring).
+
+    Parameters
+    ----------
+    source : path or Log
+        A log file, or a log already in memory (one chunk).
+    robot : Robot
+        The robot the log is read for (the checks compare it with the log).
+    reading : LogReading
+    select : sequence of str, optional
+        The signals the command uses, of those the log has (default all); the checks' signals
+        are read too.
+    rows : int
+        The most samples per chunk.
+
+    Attributes
+    ----------
+    path : str
+    checks : LogChecks or None
+        The checks' verdict, once :meth:`chunks` has run to the end.
+    provenance : Provenance or None
+        Likewise.
+    notes : list of str
+        What reading changed (time stamps converted, rows dropped by ``repair``).
+    """
+
+    source: str | os.PathLike[str] | Log
+    robot: Robot
+    reading: LogReading = field(default_factory=LogReading)
+    select: Sequence[str] | None = None
+    rows: int = CHUNK_ROWS
+    checks: LogChecks | None = None
+    provenance: Provenance | None = None
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def path(self) -> str:
+        return self.source.path if isinstance(self.source, Log) else os.fspath(self.source)
+
+    def _raw(self, select: Sequence[str] | None) -> Iterator[Log]:
+        if isinstance(self.source, Log):
+            log = self.source
+            names = log.signals if select is None else [s for s in select if s in log.signals]
+            for start in range(0, len(log), self.rows):
+                stop = min(start + self.rows, len(log))
+                yield Log(
+                    log.path,
+                    log.t[start:stop],
+                    {k: log.signals[k][start:stop] for k in names},
+                    list(log.notes) if start == 0 else [],
+                )
+            return
+        yield from iter_log(
+            self.source,
+            columns=self.reading.columns,
+            repair=self.reading.repair,
+            select=select,
+            rows=self.rows,
+        )
+
+    def names(self) -> set[str]:
+        """The signals the log has (its first rows read to tell)."""
+        head = self._head()
+        return set() if head is None else set(head.signals)
+
+    def _head(self) -> Log | None:
+        if isinstance(self.source, Log):
+            return self.source
+        return next(
+            iter_log(self.source, columns=self.reading.columns, repair=self.reading.repair, rows=2),
+            None,
+        )
+
+    def _wanted(self) -> list[str] | None:
+        """The signals to read: those selected and those the checks use, of the log's."""
+        if self.select is None:
+            return None
+        have = self.names()
+        return [s for s in dict.fromkeys([*self.select, *CHECKED_SIGNALS]) if s in have]
+
+    def chunks(self) -> Iterator[Log]:
+        """The log's chunks in order, each folded into the checks first; after the last one,
+        the checks' verdict (:attr:`checks`, :attr:`provenance`).
+
+        Raises
+        ------
+        KinergyError
+            When the file cannot be read, and after the last chunk when a check failed that
+            the user did not accept (:meth:`kinergy.logs.checks.LogCheck.finish`).
+        """
+        check = LogCheck(self.robot, self.path, self.reading.accept)
+        hashed: list[str] = []
+        stop = threading.Event()
+        hasher = None
+        if not isinstance(self.source, Log):
+            args = (Path(self.source), hashed, stop)
+            hasher = threading.Thread(target=_file_hash, args=args, daemon=True)
+        rows = 0
+        try:
+            for chunk in self._raw(self._wanted()):
+                if hasher is not None and hasher.ident is None:
+                    hasher.start()  # the file opened: hash it beside the reading
+                self.notes.extend(chunk.notes)
+                check.add(chunk)
+                rows += len(chunk)
+                yield chunk
+        except BaseException:
+            stop.set()
+            raise
+        if rows == 0:
+            raise KinergyError(f"{self.path}: the log has no samples")
+        self.checks = check.finish()
+        if isinstance(self.source, Log):
+            digest, size = _log_hash(self.source)
+        else:
+            assert hasher is not None
+            hasher.join()
+            digest, size = (hashed[0] if hashed else ""), Path(self.source).stat().st_size
+        self.provenance = Provenance(self.path, digest, size, rows)
+
+    def read(self) -> Log:
+        """The whole log, checked (its chunks joined)."""
+        return Log.concatenate(list(self.chunks()))
+
+
+@dataclass
+class InputLogs:
+    """What a command's logs were, besides their samples: what the results record and the user
+    is told.
+
+    Attributes
+    ----------
+    provenance : list of Provenance
+        Each log, by content.
+    checks : list of LogChecks
+        Each log's checks.
+    notes : list of str
+        What reading changed (time stamps converted, rows dropped, segments): routine.
+    """
+
+    provenance: list[Provenance] = field(default_factory=list)
+    checks: list[LogChecks] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def warnings(self) -> list[str]:
+        """What passed the checks but may still make a result wrong."""
+        return [w for c in self.checks for w in c.warnings]
+
+    def records(self) -> list[dict[str, object]]:
+        """Per log, as ``--json`` gives it: ``path``, ``sha256``, ``size`` (bytes), ``rows`` and
+        ``checks`` (``passed``, ``accepted``, ``not_checked``)."""
+        out: list[dict[str, object]] = []
+        for p, c in zip(self.provenance, self.checks, strict=True):
+            checks = {"passed": list(c.passed), "accepted": list(c.accepted)}
+            checks["not_checked"] = list(c.not_checked)
+            out.append(
+                {
+                    "path": p.path,
+                    "sha256": p.sha256,
+                    "size": p.size,
+                    "rows": p.rows,
+                    "checks": checks,
+                }
+            )
+        return out
+
+    def add(self, log: CheckedLog) -> None:
+        """Record ``log`` once it has been read to the end."""
+        assert log.provenance is not None and log.checks is not None
+        self.provenance.append(log.provenance)
+        self.checks.append(log.checks)
+        self.notes.extend(log.notes)
