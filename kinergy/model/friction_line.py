@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinergy.arrays import Array
+from kinergy.errors import KinergyError
 from kinergy.friction.registry import get_model
 from kinergy.model.robot import Friction, Robot
 
@@ -68,6 +69,9 @@ SPEEDS = 100
 SPEED_FLOOR = 0.01
 #: loads of the grid (an even count: no load of exactly zero, half of each sign)
 LOADS = 10
+#: the largest friction torque a line is fitted to, N m (a robot file allows 1e6 N m of friction
+#: parameters; far beyond any drive)
+MAGNITUDE = 1e12
 #: a line whose largest error is below this fraction of the model's largest friction is exact
 EXACT = 1e-9
 
@@ -142,13 +146,14 @@ def motor_ranges(robot: Robot) -> tuple[Array, Array]:
     return speed, load
 
 
-def _grid(speed: float, load: float) -> tuple[Array, Array]:
-    """Motor speeds and loads of the fit, each shape (2 SPEEDS LOADS,)."""
-    one_way = np.linspace(SPEED_FLOOR * speed, speed, SPEEDS)
+def _grid(load: float) -> tuple[Array, Array]:
+    """Motor speeds as fractions of ``w_max`` and loads (N m) of the fit, each shape
+    (2 SPEEDS LOADS,)."""
+    one_way = np.linspace(SPEED_FLOOR, 1.0, SPEEDS)
     speeds = np.concatenate([-one_way[::-1], one_way])
     loads = np.linspace(-load, load, LOADS)
-    w, tau = np.meshgrid(speeds, loads, indexing="ij")
-    return w.ravel(), tau.ravel()
+    u, tau = np.meshgrid(speeds, loads, indexing="ij")
+    return u.ravel(), tau.ravel()
 
 
 def friction_line(friction: Friction, speed: float, load: float) -> FrictionLine:
@@ -170,14 +175,24 @@ def friction_line(friction: Friction, speed: float, load: float) -> FrictionLine
     """
     from scipy.optimize import nnls  # heavy (0.2 s): imported on first use
 
-    w, tau_load = _grid(speed, load)
+    u, tau_load = _grid(load)
     spec = get_model(friction.model)
-    f = np.asarray(spec.torque(friction.params, w, tau_load, None), dtype=float)
-    columns = np.column_stack([np.sign(w), w])
-    scale = np.linalg.norm(columns, axis=0)
-    solution, _ = nnls(columns / scale, f)
-    coulomb, viscous = (float(x) for x in solution / scale)
-    residual = f - columns @ np.array([coulomb, viscous])
+    with np.errstate(all="ignore"):  # a non-finite torque is refused below
+        f = np.asarray(spec.torque(friction.params, u * speed, tau_load, None), dtype=float)
+    columns = np.column_stack([np.sign(u), u])  # unknowns c and b w_max: both columns O(1)
+    if not np.all(np.isfinite(f)) or float(np.max(np.abs(f))) > MAGNITUDE:
+        raise KinergyError(
+            f"friction model {friction.model!r} has no finite Coulomb + viscous line over motor "
+            f"speeds up to {speed:g} rad/s and loads up to {load:g} N m"
+        )
+    solution, _ = nnls(columns, f)
+    coulomb, viscous = float(solution[0]), float(solution[1] / speed)
+    if not np.isfinite(viscous):
+        raise KinergyError(
+            f"friction model {friction.model!r}: a motor speed range of {speed:g} rad/s is too "
+            "small for a viscous coefficient"
+        )
+    residual = f - columns @ solution
     largest = float(np.max(np.abs(f)))
     max_error = float(np.max(np.abs(residual)))
     return FrictionLine(
@@ -198,10 +213,13 @@ def friction_lines(
     """:func:`friction_line` of every motor of ``robot``, over its :func:`motor_ranges` (or the
     ``(speed, load)`` of ``ranges``, each shape (n,): a file's record of the grid)."""
     speed, load = motor_ranges(robot) if ranges is None else ranges
-    return tuple(
-        friction_line(j.drive.friction, float(s), float(lo))
-        for j, s, lo in zip(robot.joints, speed, load, strict=True)
-    )
+    lines = []
+    for joint, s, lo in zip(robot.joints, speed, load, strict=True):
+        try:
+            lines.append(friction_line(joint.drive.friction, float(s), float(lo)))
+        except KinergyError as exc:
+            raise exc.prefixed(f"joint {joint.name!r}") from None
+    return tuple(lines)
 
 
 @dataclass(frozen=True)

@@ -271,7 +271,7 @@ def _check_xml(text: bytes, where: str) -> ET.Element:
     otherwise trip on (or silently default: a missing ``ixx`` would become 1 kg m^2)."""
     try:
         root = ET.fromstring(text)
-    except ET.ParseError as exc:
+    except (ET.ParseError, LookupError) as exc:  # LookupError: an unknown declared encoding
         raise _fail(where, f"not well-formed XML ({exc})") from None
     if root.tag != "robot":
         raise _fail(where, f"not a URDF file: the root element is <{root.tag}>, not <robot>")
@@ -712,7 +712,7 @@ def _check_kinematics(
             float(np.linalg.norm(axis - z)),
             float(np.linalg.norm(np.cross(point - turning[:3, 3], z))) / scale,
         )
-        if off > KINEMATICS_TOLERANCE:
+        if not off <= KINEMATICS_TOLERANCE:  # NaN too
             raise _fail(
                 f"{where}: joint {joint.name!r}",
                 f"its axis is {off:.3g} from the one its <kinergy:joint> parameters give: {advice}",
@@ -723,12 +723,21 @@ def _check_kinematics(
         float(np.max(np.abs(flange[:3, :3] - poses[model.flange][:3, :3]))),
         float(np.max(np.abs(flange[:3, 3] - poses[model.flange][:3, 3]))) / scale,
     )
-    if off > KINEMATICS_TOLERANCE:
+    if not off <= KINEMATICS_TOLERANCE:  # NaN too
         raise _fail(
             f"{where}: link {model.flange!r}",
             f"the flange is {off:.3g} from where the <kinergy:model> kinematics put it: {advice}",
         )
     return np.array(frames)
+
+
+def _snapped(com: Array, inertia: Array) -> dict[str, list[float]]:
+    """``com`` (m) and ``inertia`` (kg m^2) with the rounding noise of the frame changes
+    (components below 1e-14 m, or 1e-14 of the largest moment) made the zeros they were."""
+    com = np.where(np.abs(com) < 1e-14, 0.0, com)
+    scale = float(np.max(np.abs(inertia)))
+    inertia = np.where(np.abs(inertia) < 1e-14 * scale, 0.0, inertia)
+    return {"com": com.tolist(), "inertia": inertia.tolist()}
 
 
 def _payload(
@@ -742,7 +751,7 @@ def _payload(
     mass, origin, inertia = _link_inertial(tree.links[model.payload], where)
     pose = np.asarray(np.linalg.solve(flange, poses[model.payload] @ origin), dtype=float)
     mass, com, six = _body_inertial([(mass, pose, inertia)])
-    return {"mass": mass, "com": com.tolist(), "inertia": six.tolist()}
+    return {"mass": mass, **_snapped(com, six)}
 
 
 def _restored_drive(
@@ -798,10 +807,10 @@ def _check_dynamics(robot: Robot, model: KinergyModel, standard: Standard, where
         for label, value, computed in zip(
             ("damping", "friction"), file, (side.damping[k], side.friction[k]), strict=True
         ):
-            if abs(value - computed) > 1e-9 * max(abs(value), abs(computed)):
+            if not abs(value - computed) <= 1e-9 * max(abs(value), abs(computed)):
                 raise _fail(
                     f"{where}: joint {joint.name!r}",
-                    f"<dynamics {label}={value!r}> is not the {computed!r} its drive's "
+                    f"<dynamics {label}={value!r}> is not the {float(computed)!r} its drive's "
                     "<kinergy:friction> gives (was the file edited?); remove that "
                     "<kinergy:friction> to import <dynamics> as Coulomb + viscous friction",
                 )
@@ -857,8 +866,7 @@ def _restored(
                 "name": kin.name,
                 **kin.kinematics,
                 "mass": link.mass,
-                "com": link.com.tolist(),
-                "inertia": link.inertia.tolist(),
+                **_snapped(link.com, link.inertia),
                 "drive": _restored_drive(kin, standard, coupled, where),
                 "limits": limit_table,
             }
@@ -975,11 +983,23 @@ def import_urdf(
     except OSError as exc:
         raise _fail(where, f"cannot read URDF file ({exc.strerror})") from None
     element = _check_xml(text, where)
-    urdf = _load_urdf(text, where)
     standard = read_standard(element, where)
     model = read_kinergy(element, where)
-    if model is not None:
-        return UrdfImport(_restored(urdf, model, standard, path, (root, tip, name)), True)
+    # huge numbers (an origin of 1e308 m) overflow on the way; every value that reaches the robot
+    # is checked finite and bounded, so the overflow is refused there, in one line
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        urdf = _load_urdf(text, where)
+        if model is not None:
+            return UrdfImport(_restored(urdf, model, standard, path, (root, tip, name)), True)
+        return UrdfImport(_generic(urdf, standard, path, (root, tip, name)), False)
+
+
+def _generic(
+    urdf: Any, standard: Standard, path: Path, selection: tuple[str | None, str | None, str | None]
+) -> Robot:
+    """The robot a URDF without a ``<kinergy:model>`` element describes."""
+    where = str(path)
+    root, tip, name = selection
     tree = _tree(urdf, where)
     root = _root_link(tree, root, where)
     tip = _tip_link(tree, root, where) if tip is None else tip
@@ -1019,7 +1039,7 @@ def import_urdf(
         )
     except KinergyError as exc:
         raise exc.prefixed(where) from None
-    return UrdfImport(robot, False)
+    return robot
 
 
 def robot_from_urdf(

@@ -311,6 +311,13 @@ def read_kinergy(root: ET.Element, where: str) -> KinergyModel | None:
     joints = tuple(_joint(e, k, mwhere) for k, e in enumerate(model.findall(_tag("joint"))))
     if not joints:
         raise KinergyError(f"{mwhere}: no <kinergy:joint>")
+    if coupling is not None and (
+        len(coupling) != len(joints) or any(len(row) != len(joints) for row in coupling)
+    ):
+        raise KinergyError(
+            f"{mwhere} <kinergy:coupling>: must be {len(joints)} rows of {len(joints)} numbers "
+            "(one per <kinergy:joint>)"
+        )
     return KinergyModel(
         convention=_required(model, "convention", mwhere),
         gravity=poses["gravity"],
