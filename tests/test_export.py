@@ -23,6 +23,7 @@ real Fourier log with the CLI (skipped when ../shared/datasets is absent):
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import runpy
 from pathlib import Path
@@ -32,6 +33,7 @@ import numpy as np
 import pytest
 from clicase import run_case
 from conftest import random_state
+from scipy.spatial.transform import Rotation
 
 import kinergy
 from kinergy.cli import main
@@ -68,10 +70,24 @@ def identified(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
-@pytest.fixture(params=[*BUILT_IN, "identified"])
+def _wall_mounted() -> kinergy.Robot:
+    """The UR10e on a tilted wall: a base pose, a flange pose and gravity along no axis."""
+    robot = kinergy.load_robot("ur10e")
+    base, flange = np.eye(4), np.eye(4)
+    base[:3, :3] = Rotation.from_euler("xyz", [0.3, -1.2, 0.5]).as_matrix()
+    base[:3, 3] = [0.1, -0.2, 0.8]
+    flange[:3, :3] = Rotation.from_euler("xyz", [0.0, 0.2, 0.4]).as_matrix()
+    flange[:3, 3] = [0.0, 0.01, 0.05]
+    gravity = 9.81 * np.array([-0.6, 0.0, -0.8])
+    return dataclasses.replace(robot, base=base, flange=flange, gravity=gravity)
+
+
+@pytest.fixture(params=[*BUILT_IN, "wall-mounted", "identified"])
 def robot(request: pytest.FixtureRequest) -> kinergy.Robot:
     if request.param == "identified":
         return kinergy.load_robot(request.getfixturevalue("identified"))
+    if request.param == "wall-mounted":
+        return _wall_mounted()
     r = kinergy.load_robot(request.param)
     return _with_payload(r) if request.param == "ur5e" else r
 
@@ -314,6 +330,15 @@ def test_import_urdf_gives_back_the_model(robot: kinergy.Robot, tmp_path: Path) 
     assert _differences(original, robot_to_dict(kinergy.load_robot(urdf))) == []
 
 
+def test_export_takes_a_payload_and_it_comes_back(tmp_path: Path) -> None:
+    args = ["robot", "export", "ur10e", "--payload", "3.5,0.01,0,0.06", "--format", "urdf"]
+    run_case([*args, "--out", "p.urdf"], tmp_path, outputs=["p.urdf"], refuse=False)
+    payload = kinergy.load_robot(tmp_path / "p.urdf").payload
+    assert payload is not None and payload.mass == 3.5
+    assert np.allclose(payload.com, [0.01, 0.0, 0.06], rtol=0.0, atol=1e-15)
+    assert np.allclose(payload.inertia, np.zeros(6), rtol=0.0, atol=1e-15)
+
+
 def test_the_comparison_sees_a_changed_field() -> None:
     robot = robot_to_dict(kinergy.load_robot("ur5e"))
     changed = robot_to_dict(kinergy.load_robot("ur5e"))
@@ -373,6 +398,7 @@ def test_coupled_arm_says_what_urdf_leaves_out_and_mjcf_uses_tendons() -> None:
     robot = kinergy.load_robot("nursing-arm")
     urdf = robot_to_urdf(robot)
     assert any("URDF has no coupled transmission" in n for n in urdf.notes)
+    assert "largest off-diagonal term over largest diagonal term: zero (to rounding)" in urdf.text
     assert "transmission_interface" not in urdf.text  # no SimpleTransmission would be true
     model = mujoco.MjModel.from_xml_string(robot_to_mjcf(robot).text)
     assert model.ntendon == robot.n
@@ -397,7 +423,7 @@ def test_identified_ur10e_exports_say_the_links_are_a_completion(
             refuse=False,
         )
         assert "physically consistent completion" in out.read_text(encoding="utf-8")
-        assert "kinergy: note: Link mass, com, inertia identified" in outcome.err
+        assert "kinergy: note: the link inertials were identified as base parameters" in outcome.err
 
 
 def _recipe() -> str:
@@ -455,6 +481,10 @@ BAD_EXPORTS = {
         ["robot", "export", "bad.toml", "--format", "urdf", "--out", "x.urdf"],
         "bad.toml",
     ),
+    "urdf-model-does-not-load": (
+        ["robot", "export", "bad.urdf", "--format", "mjcf", "--out", "x.xml"],
+        "bad.urdf",
+    ),
     "model-missing": (
         ["robot", "export", "none.toml", "--format", "mjcf", "--out", "x.xml"],
         "none.toml",
@@ -483,6 +513,7 @@ def test_bad_export_is_one_line(case: str, tmp_path: Path) -> None:
     kinergy.save_robot(kinergy.load_robot("panda"), tmp_path / "model.toml")
     text = (tmp_path / "model.toml").read_text(encoding="utf-8")
     (tmp_path / "bad.toml").write_text(text.replace("mass = ", "mass = -", 1), encoding="utf-8")
+    (tmp_path / "bad.urdf").write_text("<robot name='x'><link name='a'/>", encoding="utf-8")
     outcome = run_case(args, tmp_path, refuse=True)
     assert named in outcome.err
 
@@ -586,7 +617,8 @@ def test_foreign_urdf_gives_its_transmissions_and_dynamics(tmp_path: Path) -> No
         outputs=["m.toml"],
         refuse=False,
     )
-    assert "gear ratios from <transmission>" in outcome.out
+    assert "gear ratios from <transmission> and friction from <dynamics>" in outcome.out
+    assert "identify them from logs" in outcome.err
     back = kinergy.load_robot(tmp_path / "m.toml")
     assert back.convention == "mdh" and back.sources["drive_inertia"].status == "nominal"
     c, b = _lines(robot)

@@ -364,8 +364,9 @@ def robot_import_urdf(
     save_robot(
         r, out, header=f"{r.name}: imported from {Path(urdf).name} by kinergy robot import-urdf"
     )
-    if result.restored:
-        what = "the model kinergy exported, with its drives"
-    else:
-        what = f"{r.convention} kinematics, link inertials and limits; {r.description.split('; ', 1)[-1]}"
-    click.echo(f"wrote {out}: {r.name}, {r.n} joints: {what}")
+    if not result.restored:
+        note(
+            "the drives not in the URDF are nominal (marked so in the robot file): identify them "
+            "from logs before trusting energy predictions"
+        )
+    click.echo(f"wrote {out}: {r.name}, {r.n} joints ({r.convention}); {result.drives}")

@@ -2,13 +2,15 @@
 and the comments every exported file carries.
 
 The exports (:mod:`kinergy.model.urdf_export`, :mod:`kinergy.model.mjcf`) lay a robot out the
-same way: body i is the frame joint i turns in, ``F_{i-1} · P_i`` (:func:`~kinergy.model.urdf.
-joint_transforms`), placed in body i-1 by ``C_{i-1} · P_i`` (``C_0`` = the robot's base pose),
+same way: body i is the frame joint i turns in, ``F_{i-1} · P_i``
+(:func:`~kinergy.model.urdf.joint_transforms`), placed in body i-1 by ``C_{i-1} · P_i`` (``C_0``
+= the robot's base pose),
 with joint i about its z axis; link i's frame is ``C_i`` in body i, so its inertial sits at
 ``C_i · com`` with the axes of ``C_i``. The flange is ``C_n · flange`` in body n, the payload a
 body rigidly fixed there.
 
-Drives referred to the joints (:class:`JointSide`), with ``N = diag(gear_ratio) @ coupling``
+Drives referred to the joints (:class:`~kinergy.model.friction_line.JointSide`), with
+``N = diag(gear_ratio) @ coupling``
 (:func:`~kinergy.model.friction_line.transmission`; motor speeds ``wm = N qd``, joint torques
 ``tau = N^T tau_m``):
 
@@ -38,6 +40,7 @@ from kinergy.model.toml import matrix_rpy
 from kinergy.model.urdf import joint_transforms
 
 __all__ = [
+    "COMPLETION_NOTE",
     "Export",
     "Layout",
     "comment",
@@ -159,6 +162,14 @@ def friction_comments(robot: Robot, side: JointSide) -> list[tuple[int, str]]:
     return out
 
 
+#: the note of an export whose link inertials were identified (base parameters)
+COMPLETION_NOTE = (
+    "the link inertials were identified as base parameters: the file holds the physically "
+    "consistent completion kinergy wrote, which gives the identified joint torques but not "
+    "unique link values (see its comment)"
+)
+
+
 def completion_comment(robot: Robot) -> str | None:
     """The comment of a robot whose link inertials were identified (from base parameters)."""
     groups = [g for g in ("mass", "com", "inertia") if robot.sources[g].status == "identified"]
@@ -183,8 +194,8 @@ def coupling_comment(robot: Robot, side: JointSide, *, tendons: bool) -> str | N
         return None
     off = side.reflected - np.diag(side.armature)
     off_visc = side.viscous - np.diag(side.damping)
-    ratio = float(np.max(np.abs(off))) / max(float(np.max(side.armature)), 1e-300)
-    ratio_visc = float(np.max(np.abs(off_visc))) / max(float(np.max(side.damping)), 1e-300)
+    ratio = _share(float(np.max(np.abs(off))), float(np.max(side.armature)))
+    ratio_visc = _share(float(np.max(np.abs(off_visc))), float(np.max(side.damping)))
     if tendons:
         return (
             "Coupled joints: each motor is a fixed tendon whose length is the motor angle "
@@ -198,14 +209,21 @@ def coupling_comment(robot: Robot, side: JointSide, *, tendons: bool) -> str | N
     return (
         "Coupled joints: URDF has no coupled transmission. The reflected rotor inertia "
         "N^T diag(J) N (N = diag(gear_ratio) @ coupling) is not in URDF at all (the kinergy "
-        "element keeps the drives and the coupling); its largest off-diagonal term is "
-        f"{ratio:.3g} of the largest diagonal one. <dynamics damping> is the diagonal of "
-        f"N^T diag(b) N (largest off-diagonal term left out: {ratio_visc:.3g} of the largest "
-        "diagonal one); <dynamics friction> is sum_k |N_kj| c_k, the Coulomb friction of a "
+        "element keeps the drives and the coupling); largest off-diagonal term over largest "
+        f"diagonal term: {ratio}. <dynamics damping> is the diagonal of N^T diag(b) N (the "
+        f"off-diagonal terms left out, largest over largest diagonal: {ratio_visc}); "
+        "<dynamics friction> is sum_k |N_kj| c_k, the Coulomb friction of a "
         "joint moving alone: when several joints turn one motor, the motors' Coulomb torque "
         "N^T (c sign(N qd)) depends on all their speeds, and a joint's share is anywhere from "
         "minus to plus that value. The MJCF export holds the coupling exactly (tendons)."
     )
+
+
+def _share(off: float, diagonal: float) -> str:
+    """``off / diagonal`` in words: zero below rounding (the motors of a coupled joint alike)."""
+    if diagonal <= 0.0 or off <= 1e-12 * diagonal:
+        return "zero (to rounding)"
+    return f"{off / diagonal:.3g}"
 
 
 def reflected_comment(robot: Robot, side: JointSide) -> str:

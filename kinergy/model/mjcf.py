@@ -34,6 +34,7 @@ import numpy as np
 
 from kinergy.arrays import Array
 from kinergy.model.export import (
+    COMPLETION_NOTE,
     Export,
     comment,
     completion_comment,
@@ -133,12 +134,11 @@ def robot_to_mjcf(robot: Robot, *, source: str = "") -> Export:
             )
         )
     )
-    for text in filter(
-        None, [completion_comment(robot), coupling_comment(robot, side, tendons=True)]
-    ):
+    completion = completion_comment(robot)
+    for text in filter(None, [completion, coupling_comment(robot, side, tendons=True)]):
         root.append(ET.Comment(comment(text)))
-        if not text.startswith("Coupled"):
-            notes.append(text)
+    if completion is not None:
+        notes.append(COMPLETION_NOTE)
     ET.SubElement(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="false")
     ET.SubElement(root, "option", gravity=numbers(robot.gravity), integrator="implicitfast")
     default = ET.SubElement(root, "default")

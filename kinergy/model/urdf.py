@@ -2,7 +2,7 @@
 
 A URDF places each link frame with an arbitrary ``<origin xyz rpy>`` and turns it about an
 arbitrary ``<axis>``; kinergy describes an arm by modified Denavit–Hartenberg parameters (Craig,
-``mdh``). :func:`robot_from_urdf` converts one into the other without approximation:
+``mdh``). :func:`import_urdf` converts one into the other without approximation:
 
 1. Walk the tree from ``root`` to ``tip``. ``revolute`` and ``continuous`` joints become kinergy
    joints; ``fixed`` joints are merged (their child links are rigidly part of the body before them).
@@ -21,9 +21,19 @@ Each body's mass, centre of mass and inertia about the centre of mass are the ri
 links' ``<inertial>`` (the URDF inertia is about the centre of mass, in the axes of the inertial
 ``<origin>``; it is rotated into MDH link-frame axes and shifted by the parallel-axis theorem).
 
-URDF carries no drive data (and yourdfpy does not read ``<transmission>``): the drives are nominal (gear ratio 1, no rotor inertia, unit torque
-and motor constants, no friction) and marked ``nominal`` in ``Robot.sources``; identify them from
-logs before trusting energy predictions.
+Drives (:mod:`kinergy.model.urdf_extras` reads the elements): URDF's standard elements give a
+joint's gear ratio (a ROS SimpleTransmission's ``mechanicalReduction``) and its Coulomb + viscous
+friction (``<dynamics friction damping>``, joint side, referred to the motor as ``coulomb =
+friction / |n|``, ``viscous = damping / n^2``); the rest of the drives is nominal (no rotor
+inertia, unit torque and motor constants) and marked ``nominal`` in ``Robot.sources``: identify
+it from logs before trusting energy predictions.
+
+A file ``kinergy robot export`` wrote (:mod:`kinergy.model.urdf_export`) has a
+``<kinergy:model>`` element with what URDF cannot hold; :func:`import_urdf` then gives back the
+robot it was written from instead: its convention and DH or MDH parameters (after checking that
+they give the URDF's joint axes and flange), every link inertial in those frames, the drives,
+friction family and parameters (after checking that they give the file's ``<dynamics>``), and
+the rest of the robot file. A file edited since, so that the two no longer agree, is refused.
 """
 
 from __future__ import annotations
@@ -740,17 +750,26 @@ def _snapped(com: Array, inertia: Array) -> dict[str, list[float]]:
     return {"com": com.tolist(), "inertia": inertia.tolist()}
 
 
-def _payload(
-    tree: _Tree, model: KinergyModel, poses: Mapping[str, Array], flange: Array, where: str
-) -> dict[str, Any] | None:
-    """The payload link's inertial in the flange frame (a robot file's ``[payload]``)."""
+def _payload(tree: _Tree, model: KinergyModel, where: str) -> dict[str, Any] | None:
+    """The payload link's inertial in the flange frame (a robot file's ``[payload]``); the link
+    must hang from the flange link by fixed joints."""
     if model.payload is None:
         return None
     if model.payload not in tree.links:
         raise _fail(f"{where}: <kinergy:model>", f"no link named {model.payload!r} (payload)")
+    pose = np.eye(4)
+    link = model.payload
+    while link != model.flange:
+        joint = tree.parent_joint.get(link)
+        if joint is None or joint.type != "fixed":
+            raise _fail(
+                f"{where}: link {model.payload!r}",
+                f"the payload must be fixed to the flange link {model.flange!r}",
+            )
+        pose = _origin(joint) @ pose
+        link = joint.parent
     mass, origin, inertia = _link_inertial(tree.links[model.payload], where)
-    pose = np.asarray(np.linalg.solve(flange, poses[model.payload] @ origin), dtype=float)
-    mass, com, six = _body_inertial([(mass, pose, inertia)])
+    mass, com, six = _body_inertial([(mass, pose @ origin, inertia)])
     return {"mass": mass, **_snapped(com, six)}
 
 
@@ -888,8 +907,7 @@ def _restored(
     }
     if coupled:
         data["coupling"] = model.coupling
-    flange = frames[-1] @ _pose(model.flange_pose["xyz"], model.flange_pose["rpy"])
-    payload = _payload(tree, model, poses, flange, where)
+    payload = _payload(tree, model, where)
     if payload is not None:
         data["payload"] = payload
     try:
@@ -920,6 +938,34 @@ class UrdfImport:
 
     robot: Robot
     restored: bool
+
+    @property
+    def drives(self) -> str:
+        """Where the drives came from, in words."""
+        if self.restored:
+            return "drives, friction and coupling from its <kinergy:model> element"
+        return _drives_found(self.robot.joints)
+
+
+def _drives_found(robot_joints: Sequence[Joint]) -> str:
+    """What a URDF without a ``<kinergy:model>`` element gave of its drives, in words."""
+    given = [
+        what
+        for what, present in (
+            (
+                "gear ratios from <transmission>",
+                any(j.drive.gear_ratio != 1.0 for j in robot_joints),
+            ),
+            (
+                "friction from <dynamics>",
+                any(j.drive.friction.model != "none" for j in robot_joints),
+            ),
+        )
+        if present
+    ]
+    if not given:
+        return "drives are nominal"
+    return f"{' and '.join(given)}, the rest of the drives nominal"
 
 
 def import_urdf(
@@ -1014,14 +1060,6 @@ def _generic(
     flange = np.linalg.solve(frames[-1], poses[tip])
     flange[np.abs(flange) < 1e-14] = 0.0
     friction = any(j.drive.friction.model != "none" for j in joints)
-    given = [
-        what
-        for what, present in (
-            ("gear ratios from <transmission>", any(j.drive.gear_ratio != 1.0 for j in joints)),
-            ("friction from <dynamics>", friction),
-        )
-        if present
-    ]
     try:
         robot = Robot(
             name=name or urdf.robot.name or path.stem,
@@ -1031,11 +1069,7 @@ def _generic(
             flange=flange,
             sources=_sources(path.name, friction),
             description=f"imported from URDF {path.name} (links {root!r} to {tip!r}); "
-            + (
-                f"{' and '.join(given)}, the rest of the drives nominal"
-                if given
-                else "drives are nominal"
-            ),
+            + _drives_found(joints),
         )
     except KinergyError as exc:
         raise exc.prefixed(where) from None

@@ -40,6 +40,7 @@ import numpy as np
 
 from kinergy.arrays import Array
 from kinergy.model.export import (
+    COMPLETION_NOTE,
     Export,
     comment,
     completion_comment,
@@ -227,11 +228,18 @@ def robot_to_urdf(robot: Robot, *, source: str = "") -> Export:
         )
     )
     root.append(ET.Comment(comment(reflected_comment(robot, side))))
-    for text in filter(
-        None, [completion_comment(robot), coupling_comment(robot, side, tendons=False)]
-    ):
+    completion = completion_comment(robot)
+    coupling = coupling_comment(robot, side, tendons=False)
+    for text in filter(None, [completion, coupling]):
         root.append(ET.Comment(comment(text)))
-        notes.append(text)
+    if completion is not None:
+        notes.append(COMPLETION_NOTE)
+    if coupling is not None:
+        notes.append(
+            "coupled joints: URDF has no coupled transmission nor rotor inertia; <dynamics> holds "
+            "each joint's own share of the motors' friction (the file's comment says what is "
+            "left out; the kinergy element keeps the coupling, the MJCF export holds it exactly)"
+        )
     line_comments = dict(friction_comments(robot, side))
     if line_comments:
         notes.append(
