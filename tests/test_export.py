@@ -560,6 +560,17 @@ BAD_IMPORTS: dict[str, tuple[Any, str]] = {
         ),
         "joint 'shoulder_lift'",
     ),
+    "edited-flange": (
+        lambda f: (
+            _exported(f),
+            _edit(
+                f,
+                '<origin xyz="0.0 0.0 0.0996" rpy="0.0 0.0 0.0"',
+                '<origin xyz="0.0 0.0 0.0996" rpy="0.0 0.0 0.1"',
+            ),
+        ),
+        "link 'flange'",
+    ),
     "edited-dynamics": (
         lambda f: (_exported(f), _edit(f, '<dynamics damping="', '<dynamics damping="1')),
         "joint 'shoulder_pan'",

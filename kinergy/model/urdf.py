@@ -708,7 +708,6 @@ def _check_kinematics(
     )
     pre, post = joint_transforms(model.convention, rows)
     frames = [_pose(model.base["xyz"], model.base["rpy"])]
-    scale = max(1.0, float(np.max(np.abs([poses[j.child][:3, 3] for j in revolute]))))
     advice = (
         "the URDF was edited after kinergy wrote it; remove the <kinergy:model> element to "
         "import its geometry alone"
@@ -718,6 +717,7 @@ def _check_kinematics(
         axis = poses[joint.child][:3, :3] @ _unit_axis(joint, where)
         point = poses[joint.child][:3, 3]
         z = turning[:3, 2]
+        scale = max(1.0, float(np.max(np.abs(point))))  # m: relative beyond a metre
         off = max(
             float(np.linalg.norm(axis - z)),
             float(np.linalg.norm(np.cross(point - turning[:3, 3], z))) / scale,
@@ -729,6 +729,7 @@ def _check_kinematics(
             )
         frames.append(turning @ post[i])
     flange = frames[-1] @ _pose(model.flange_pose["xyz"], model.flange_pose["rpy"])
+    scale = max(1.0, float(np.max(np.abs(poses[model.flange][:3, 3]))))
     off = max(
         float(np.max(np.abs(flange[:3, :3] - poses[model.flange][:3, :3]))),
         float(np.max(np.abs(flange[:3, 3] - poses[model.flange][:3, 3]))) / scale,
