@@ -244,6 +244,30 @@ def test_mujoco_frictionloss_is_the_coulomb_level_away_from_zero_speed(
     assert _close(_inverse(on, q, qd, qdd) - _inverse(off, q, qd, qdd), coulomb, 1e-6) < 1e-6
 
 
+def test_flat_links_on_the_triangle_boundary_compile_in_mujoco() -> None:
+    """A flat plate's principal moments satisfy A + B = C; kinergy accepts them, MuJoCo checks
+    A + B >= C exactly, and an eigen-decomposition lands on either side of it by rounding."""
+    robot = kinergy.load_robot("panda")
+    rng = np.random.default_rng(5)
+    joints = []
+    for joint in robot.joints:
+        a, b = rng.uniform(0.001, 0.05, 2)
+        rot = Rotation.random(random_state=rng).as_matrix()
+        tensor = rot @ np.diag([a, b, a + b]) @ rot.T
+        six = [tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[1, 2], tensor[0, 2]]
+        link = dataclasses.replace(joint.link, inertia=np.array(six))
+        joints.append(dataclasses.replace(joint, link=link))
+    robot = robot.with_joints(joints)
+    _, off = _models(robot)
+    q, qd, qdd = random_state(robot, 10, seed=2)
+    expected = kinergy.rnea(robot, q, qd, qdd) + qdd @ reflected_inertia(robot).T
+    expected += (
+        qd
+        @ (transmission_matrix(robot).T @ np.diag(_lines(robot)[1]) @ transmission_matrix(robot)).T
+    )
+    assert _close(_inverse(off, q, qd, qdd), expected, 1e-9) < 1e-9
+
+
 def _drive_one_joint(on: Any, off: Any, robot: kinergy.Robot, j: int) -> tuple[float, ...]:
     """Joint ``j`` driven for 1 s at constant speed by the frictionless inverse dynamics plus the
     motors' Coulomb level, the other joints at rest: (relative change of its speed, largest

@@ -70,15 +70,15 @@ def principal(inertia: Array) -> tuple[Array, Array]:
     """Principal moments (3,) ascending and axes (3, 3, a proper rotation, columns the axes) of
     an inertia ``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]``.
 
-    A moment that falls short of MuJoCo's exact triangle inequality ``A + B >= C`` by rounding
-    (kinergy accepts 1e-9 of C) is raised to it.
+    A largest moment beyond MuJoCo's exact triangle inequality ``A + B >= C`` (kinergy accepts
+    1e-9 of C: a flat plate's moments, or an identified link on the boundary, fall either side by
+    rounding) is lowered to ``A + B``.
     """
     moments, axes = np.linalg.eigh(inertia_matrix(inertia))
     if np.linalg.det(axes) < 0.0:
         axes[:, 0] = -axes[:, 0]
     moments = np.maximum(moments, 0.0)
-    if moments[0] + moments[1] < moments[2]:
-        moments[1] = moments[2] - moments[0]
+    moments[2] = min(moments[2], moments[0] + moments[1])
     return moments, axes
 
 
