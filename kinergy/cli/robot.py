@@ -1,18 +1,39 @@
-"""``kinergy robot list``, ``show`` and ``import-calibration``: the built-in library and robot
-files."""
+"""``kinergy robot list``, ``show``, ``import-calibration``, ``export`` and ``import-urdf``: the
+built-in library and robot files."""
 
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from pathlib import Path
 
 import click
 import numpy as np
 
-from kinergy.cli.common import fmt, fmt_vector, load, output_file_option, payload_option, table
-from kinergy.files import check_outputs
+from kinergy.cli.common import (
+    fmt,
+    fmt_vector,
+    load,
+    note,
+    output_file_option,
+    payload_option,
+    table,
+    writes,
+)
+from kinergy.errors import KinergyError
+from kinergy.files import atomic_write, check_outputs
 from kinergy.jsonable import dumps
-from kinergy.model import SOURCE_CATEGORIES, Robot, library_names, load_robot, robot_to_dict
+from kinergy.model import (
+    SOURCE_CATEGORIES,
+    Robot,
+    library_names,
+    load_robot,
+    robot_to_dict,
+    save_robot,
+)
+from kinergy.model.export import Export
+from kinergy.model.mjcf import robot_to_mjcf
+from kinergy.model.urdf_export import robot_to_urdf
 from kinergy.workflows.calibration import CalibrationImport, import_calibration
 
 __all__ = ["robot"]
@@ -278,3 +299,74 @@ def robot_import_calibration(
     check_outputs([("--out", out)], inputs)
     result = import_calibration(load_robot(robot_name), calibration, friction=friction, out=out)
     click.echo(dumps(result) if as_json else _calibration_text(result, out, points))
+
+
+#: ``--format`` of ``robot export``: the writer of each format
+_EXPORTERS: dict[str, Callable[..., Export]] = {"urdf": robot_to_urdf, "mjcf": robot_to_mjcf}
+
+
+@robot.command("export")
+@click.argument("model", metavar="MODEL")
+@click.option(
+    "--format",
+    "format_name",
+    type=click.Choice(sorted(_EXPORTERS)),
+    required=True,
+    help="urdf: kinematics, link inertials, limits and joint-side friction, with the drives in a "
+    "<kinergy:model> element (robot import-urdf reads it back); mjcf: a MuJoCo model with the "
+    "reflected rotor inertia as armature, the friction as damping and frictionloss, torque "
+    "actuators.",
+)
+@output_file_option("--out", "File to write.", required=True)
+@payload_option
+@writes(files=("out",), inputs=("model",))
+def robot_export(model: str, format_name: str, out: str, payload: str | None) -> None:
+    """Write MODEL (a built-in name or a robot file) as URDF or MuJoCo MJCF.
+
+    What the format cannot hold exactly (a friction model that is not Coulomb + viscous, a
+    coupled transmission in URDF, link inertials completed from base parameters) is said in the
+    file's comments and in a note here; docs/EXPORT.md has the details.
+    """
+    r = load(model, payload)
+    export = _EXPORTERS[format_name](r, source=Path(model).name if os.path.exists(model) else model)
+    atomic_write(out, lambda fh: fh.write(export.text))
+    for message in export.notes:
+        note(message)
+    click.echo(f"wrote {out}: {r.name}, {r.n} joints, {format_name.upper()}")
+
+
+@robot.command("import-urdf")
+@click.argument("urdf", metavar="URDF", type=click.Path(dir_okay=False))
+@output_file_option("--out", "Robot file to write (TOML).", required=True, metavar="MODEL.toml")
+@click.option("--root", metavar="LINK", help="Link the arm is mounted on [the URDF's root].")
+@click.option("--tip", metavar="LINK", help="Link at the end of the arm [the chain's leaf].")
+@click.option("--name", metavar="NAME", help="Robot name [the URDF's].")
+@writes(files=("out",), inputs=("urdf",))
+def robot_import_urdf(
+    urdf: str, out: str, root: str | None, tip: str | None, name: str | None
+) -> None:
+    """Read a URDF serial chain into a robot file (TOML).
+
+    A URDF written by `kinergy robot export` gives back the model it was written from (its
+    <kinergy:model> element holds the drives and what else URDF cannot). Any other URDF gives
+    modified-DH kinematics, the link inertials and limits, gear ratios from ROS
+    SimpleTransmissions and Coulomb + viscous friction from <dynamics>; the rest of the drives
+    is nominal: identify it from logs before trusting energy predictions.
+    """
+    from kinergy.model.urdf import import_urdf  # needs the urdf extra (yourdfpy)
+
+    if Path(out).suffix.lower() == ".urdf":
+        raise KinergyError(
+            f"--out: {out} would be written as TOML but read back as URDF; name it .toml"
+        )
+    result = import_urdf(urdf, root=root, tip=tip, name=name)
+    r = result.robot
+    save_robot(
+        r, out, header=f"{r.name}: imported from {Path(urdf).name} by kinergy robot import-urdf"
+    )
+    if not result.restored:
+        note(
+            "the drives not in the URDF are nominal (marked so in the robot file): identify them "
+            "from logs before trusting energy predictions"
+        )
+    click.echo(f"wrote {out}: {r.name}, {r.n} joints ({r.convention}); {result.drives}")

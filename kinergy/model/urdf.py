@@ -2,7 +2,7 @@
 
 A URDF places each link frame with an arbitrary ``<origin xyz rpy>`` and turns it about an
 arbitrary ``<axis>``; kinergy describes an arm by modified Denavit–Hartenberg parameters (Craig,
-``mdh``). :func:`robot_from_urdf` converts one into the other without approximation:
+``mdh``). :func:`import_urdf` converts one into the other without approximation:
 
 1. Walk the tree from ``root`` to ``tip``. ``revolute`` and ``continuous`` joints become kinergy
    joints; ``fixed`` joints are merged (their child links are rigidly part of the body before them).
@@ -21,9 +21,19 @@ Each body's mass, centre of mass and inertia about the centre of mass are the ri
 links' ``<inertial>`` (the URDF inertia is about the centre of mass, in the axes of the inertial
 ``<origin>``; it is rotated into MDH link-frame axes and shifted by the parallel-axis theorem).
 
-URDF carries no drive data (and yourdfpy does not read ``<transmission>``): the drives are nominal (gear ratio 1, no rotor inertia, unit torque
-and motor constants, no friction) and marked ``nominal`` in ``Robot.sources``; identify them from
-logs before trusting energy predictions.
+Drives (:mod:`kinergy.model.urdf_extras` reads the elements): URDF's standard elements give a
+joint's gear ratio (a ROS SimpleTransmission's ``mechanicalReduction``) and its Coulomb + viscous
+friction (``<dynamics friction damping>``, joint side, referred to the motor as ``coulomb =
+friction / |n|``, ``viscous = damping / n^2``); the rest of the drives is nominal (no rotor
+inertia, unit torque and motor constants) and marked ``nominal`` in ``Robot.sources``: identify
+it from logs before trusting energy predictions.
+
+A file ``kinergy robot export`` wrote (:mod:`kinergy.model.urdf_export`) has a
+``<kinergy:model>`` element with what URDF cannot hold; :func:`import_urdf` then gives back the
+robot it was written from instead: its convention and DH or MDH parameters (after checking that
+they give the URDF's joint axes and flange), every link inertial in those frames, the drives,
+friction family and parameters (after checking that they give the file's ``<dynamics>``), and
+the rest of the robot file. A file edited since, so that the two no longer agree, is refused.
 """
 
 from __future__ import annotations
@@ -40,7 +50,10 @@ import numpy as np
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
+from kinergy.friction.model import SMOOTHING
+from kinergy.model.friction_line import joint_side, motor_ranges
 from kinergy.model.robot import (
+    CONVENTIONS,
     SOURCE_CATEGORIES,
     Drive,
     Friction,
@@ -50,8 +63,25 @@ from kinergy.model.robot import (
     Robot,
     Source,
 )
+from kinergy.model.toml import robot_from_dict, rpy_matrix
+from kinergy.model.urdf_extras import (
+    KinergyJoint,
+    KinergyModel,
+    Standard,
+    read_kinergy,
+    read_standard,
+)
 
-__all__ = ["mdh_frames", "mdh_parameters", "mdh_transform", "robot_from_urdf"]
+__all__ = [
+    "UrdfImport",
+    "dh_transform",
+    "import_urdf",
+    "joint_transforms",
+    "mdh_frames",
+    "mdh_parameters",
+    "mdh_transform",
+    "robot_from_urdf",
+]
 
 
 #: Consecutive axes closer than this to parallel (|sin| of the angle between them) are treated as
@@ -92,6 +122,57 @@ def mdh_transform(a: float, alpha: float, offset: float, d: float) -> Array:
             [0.0, 0.0, 0.0, 1.0],
         ]
     )
+
+
+def dh_transform(a: float, alpha: float, offset: float, d: float) -> Array:
+    """``Rz(offset) · Tz(d) · Tx(a) · Rx(alpha)``, shape (4, 4): standard DH frame i in frame i-1
+    at q_i = 0.
+
+    Parameters
+    ----------
+    a, d : float
+        a_i and d_i, m.
+    alpha, offset : float
+        alpha_i and offset_i, rad.
+    """
+    ca, sa, ct, st = np.cos(alpha), np.sin(alpha), np.cos(offset), np.sin(offset)
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, a * ct],
+            [st, ct * ca, -ct * sa, a * st],
+            [0.0, sa, ca, d],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
+
+
+def joint_transforms(convention: str, rows: Array) -> tuple[Array, Array]:
+    """The constant transforms of a chain: link frame i is ``F_{i-1} · P_i · Rz(q_i) · C_i``.
+
+    ``dh``: ``P_i = I``, ``C_i`` = :func:`dh_transform`; ``mdh``: ``P_i`` = :func:`mdh_transform`,
+    ``C_i = I`` (the chain of :mod:`kinergy.dynamics.chain`, which ``model/`` cannot import).
+    Joint i turns about the z axis of ``F_{i-1} · P_i``.
+
+    Parameters
+    ----------
+    convention : {'dh', 'mdh'}
+    rows : ndarray, shape (n, 4)
+        ``(a, alpha, offset, d)`` of each joint as the robot stores them (m, rad).
+
+    Returns
+    -------
+    pre, post : ndarray, shape (n, 4, 4)
+        ``P_i`` and ``C_i``.
+    """
+    n = len(rows)
+    pre = np.tile(np.eye(4), (n, 1, 1))
+    post = np.tile(np.eye(4), (n, 1, 1))
+    for i, (a, alpha, offset, d) in enumerate(rows):
+        if convention == "dh":
+            post[i] = dh_transform(a, alpha, offset, d)
+        else:
+            pre[i] = mdh_transform(a, alpha, offset, d)
+    return pre, post
 
 
 def _closest_points(p1: Array, z1: Array, p2: Array, z2: Array) -> tuple[Array, Array]:
@@ -195,12 +276,12 @@ def mdh_parameters(frames: Array) -> Array:
 # --------------------------------------------------------------------------------------------
 
 
-def _check_xml(text: bytes, where: str) -> None:
-    """Well-formed XML with the elements and attributes yourdfpy would otherwise trip on (or
-    silently default: a missing ``ixx`` would become 1 kg m^2)."""
+def _check_xml(text: bytes, where: str) -> ET.Element:
+    """The ``<robot>`` element of well-formed XML with the elements and attributes yourdfpy would
+    otherwise trip on (or silently default: a missing ``ixx`` would become 1 kg m^2)."""
     try:
         root = ET.fromstring(text)
-    except ET.ParseError as exc:
+    except (ET.ParseError, LookupError) as exc:  # LookupError: an unknown declared encoding
         raise _fail(where, f"not well-formed XML ({exc})") from None
     if root.tag != "robot":
         raise _fail(where, f"not a URDF file: the root element is <{root.tag}>, not <robot>")
@@ -232,21 +313,18 @@ def _check_xml(text: bytes, where: str) -> None:
             raise _fail(
                 f"{where}: link {link.get('name')!r}", f"<inertia> lacks {', '.join(missing)}"
             )
+    return root
 
 
-def _load_urdf(path: Path, where: str) -> Any:
-    """The file parsed by yourdfpy (no scene graph, no meshes); every failure a KinergyError."""
+def _load_urdf(text: bytes, where: str) -> Any:
+    """The file's text parsed by yourdfpy (no scene graph, no meshes); every failure a
+    KinergyError."""
     try:
         import yourdfpy
     except ImportError:
         raise KinergyError(
             "reading URDF files needs the 'yourdfpy' package (pip install kinergy[urdf])"
         ) from None
-    try:
-        text = path.read_bytes()
-    except OSError as exc:
-        raise _fail(where, f"cannot read URDF file ({exc.strerror})") from None
-    _check_xml(text, where)
     try:
         return yourdfpy.URDF.load(
             io.BytesIO(text),
@@ -465,18 +543,6 @@ def _limits(joint: Any, where: str) -> Limits:
         raise exc.prefixed(jwhere) from None
 
 
-def _nominal_drive() -> Drive:
-    return Drive(
-        gear_ratio=1.0,
-        motor_inertia=0.0,
-        reducer_inertia=0.0,
-        torque_constant=1.0,
-        motor_constant=1.0,
-        kt_over_kb=1.0,
-        friction=Friction("none", {}),
-    )
-
-
 def _revolute_chain(tree: _Tree, root: str, tip: str, where: str) -> list[Any]:
     """The revolute and continuous joints from ``root`` to ``tip``; fixed joints are skipped,
     any other type is refused."""
@@ -533,9 +599,26 @@ def _body_parts(
     return parts
 
 
-def _joint(joint: Any, row: Array, parts: list[tuple[float, Array, Array]], where: str) -> Joint:
+def _joint(
+    joint: Any, row: Array, parts: list[tuple[float, Array, Array]], drive: Drive, where: str
+) -> Joint:
     """kinergy's joint for a URDF joint: MDH ``row`` = (a, alpha, offset, d), its body's rigid
-    inertial, nominal drive, the URDF's limits."""
+    inertial, ``drive``, the URDF's limits."""
+    a, alpha, offset, d = (float(x) for x in row)
+    return Joint(
+        name=joint.name,
+        d=d,
+        a=a,
+        alpha=alpha,
+        offset=offset,
+        link=_body_link(joint, parts, where),
+        drive=drive,
+        limits=_limits(joint, where),
+    )
+
+
+def _body_link(joint: Any, parts: list[tuple[float, Array, Array]], where: str) -> Link:
+    """The rigid sum of the inertials moved by ``joint``, checked."""
     lwhere = f"{where}: link {joint.child!r}"
     mass, com, inertia = _body_inertial(parts)
     if mass <= 0.0:
@@ -545,42 +628,354 @@ def _joint(joint: Any, row: Array, parts: list[tuple[float, Array, Array]], wher
             "every moving body needs a positive mass",
         )
     try:
-        link = Link(mass=mass, com=com, inertia=inertia)
+        return Link(mass=mass, com=com, inertia=inertia)
     except KinergyError as exc:
         raise exc.prefixed(lwhere) from None
-    a, alpha, offset, d = (float(x) for x in row)
-    return Joint(
-        name=joint.name,
-        d=d,
-        a=a,
-        alpha=alpha,
-        offset=offset,
-        link=link,
-        drive=_nominal_drive(),
-        limits=_limits(joint, where),
+
+
+def _standard_drive(name: str, standard: Standard) -> Drive:
+    """A drive from a URDF's standard elements: the gear ratio of its SimpleTransmission (else 1),
+    Coulomb + viscous friction from its ``<dynamics>`` referred to the motor (``viscous =
+    damping / n^2``, ``coulomb = friction / |n|``), the rest nominal."""
+    gear = standard.reductions.get(name, 1.0)
+    damping, coulomb = standard.dynamics.get(name, (0.0, 0.0))
+    friction = (
+        Friction(
+            "viscous_coulomb",
+            {"viscous": damping / gear**2, "coulomb": coulomb / abs(gear), "smoothing": SMOOTHING},
+        )
+        if damping > 0.0 or coulomb > 0.0
+        else Friction("none", {})
+    )
+    return Drive(
+        gear_ratio=gear,
+        motor_inertia=0.0,
+        reducer_inertia=0.0,
+        torque_constant=1.0,
+        motor_constant=1.0,
+        kt_over_kb=1.0,
+        friction=friction,
     )
 
 
-def _sources(file: str) -> dict[str, Source]:
-    """Provenance: geometry, inertials and limits from the URDF; drives nominal."""
+def _sources(file: str, friction: bool) -> dict[str, Source]:
+    """Provenance: geometry, inertials and limits from the URDF; the friction too when its
+    ``<dynamics>`` give one; the rest of the drives nominal."""
     published = Source("published", f"URDF {file}")
     nominal = Source("nominal", f"not in URDF {file}")
-    drive = ("drive_inertia", "torque_constant", "friction", "motor_constant")
-    return {c: nominal if c in drive else published for c in SOURCE_CATEGORIES}
+    drive = ("drive_inertia", "torque_constant", "motor_constant", "thermal", "supply")
+    out = {c: nominal if c in drive else published for c in SOURCE_CATEGORIES}
+    if not friction:
+        out["friction"] = nominal
+    else:
+        out["friction"] = Source("published", f"URDF {file} <dynamics>, as Coulomb + viscous")
+    return out
 
 
 # --------------------------------------------------------------------------------------------
-# The public function
+# A file kinergy exported: <kinergy:model>
 # --------------------------------------------------------------------------------------------
 
 
-def robot_from_urdf(
+#: how far (m, or rad for directions) the URDF's axes and flange may be from those the
+#: ``<kinergy:model>`` parameters give (rounding of the printed numbers is far below)
+KINEMATICS_TOLERANCE = 1e-9
+
+
+def _pose(xyz: Sequence[float], rpy: Sequence[float]) -> Array:
+    out = np.eye(4)
+    out[:3, :3] = rpy_matrix(rpy)
+    out[:3, 3] = xyz
+    return out
+
+
+def _check_kinematics(
+    model: KinergyModel,
+    revolute: Sequence[Any],
+    poses: Mapping[str, Array],
+    where: str,
+) -> Array:
+    """Link frames (n + 1, 4, 4) at q = 0 in the root frame that the recorded convention and
+    parameters give, frame 0 the recorded base; a KinergyError when their joint axes or flange
+    are not the URDF's (an edited file)."""
+    if model.convention not in CONVENTIONS:
+        raise _fail(
+            f"{where}: <kinergy:model>",
+            f"convention must be one of {', '.join(CONVENTIONS)}, got {model.convention!r}",
+        )
+    rows = np.array(
+        [[k.kinematics[key] for key in ("a", "alpha", "offset", "d")] for k in model.joints]
+    )
+    pre, post = joint_transforms(model.convention, rows)
+    frames = [_pose(model.base["xyz"], model.base["rpy"])]
+    advice = (
+        "the URDF was edited after kinergy wrote it; remove the <kinergy:model> element to "
+        "import its geometry alone"
+    )
+    for i, joint in enumerate(revolute):
+        turning = frames[-1] @ pre[i]
+        axis = poses[joint.child][:3, :3] @ _unit_axis(joint, where)
+        point = poses[joint.child][:3, 3]
+        z = turning[:3, 2]
+        scale = max(1.0, float(np.max(np.abs(point))))  # m: relative beyond a metre
+        off = max(
+            float(np.linalg.norm(axis - z)),
+            float(np.linalg.norm(np.cross(point - turning[:3, 3], z))) / scale,
+        )
+        if not off <= KINEMATICS_TOLERANCE:  # NaN too
+            raise _fail(
+                f"{where}: joint {joint.name!r}",
+                f"its axis is {off:.3g} from the one its <kinergy:joint> parameters give: {advice}",
+            )
+        frames.append(turning @ post[i])
+    flange = frames[-1] @ _pose(model.flange_pose["xyz"], model.flange_pose["rpy"])
+    scale = max(1.0, float(np.max(np.abs(poses[model.flange][:3, 3]))))
+    off = max(
+        float(np.max(np.abs(flange[:3, :3] - poses[model.flange][:3, :3]))),
+        float(np.max(np.abs(flange[:3, 3] - poses[model.flange][:3, 3]))) / scale,
+    )
+    if not off <= KINEMATICS_TOLERANCE:  # NaN too
+        raise _fail(
+            f"{where}: link {model.flange!r}",
+            f"the flange is {off:.3g} from where the <kinergy:model> kinematics put it: {advice}",
+        )
+    return np.array(frames)
+
+
+def _snapped(com: Array, inertia: Array) -> dict[str, list[float]]:
+    """``com`` (m) and ``inertia`` (kg m^2) with the rounding noise of the frame changes
+    (components below 1e-14 m, or 1e-14 of the largest moment) made the zeros they were."""
+    com = np.where(np.abs(com) < 1e-14, 0.0, com)
+    scale = float(np.max(np.abs(inertia)))
+    inertia = np.where(np.abs(inertia) < 1e-14 * scale, 0.0, inertia)
+    return {"com": com.tolist(), "inertia": inertia.tolist()}
+
+
+def _payload(tree: _Tree, model: KinergyModel, where: str) -> dict[str, Any] | None:
+    """The payload link's inertial in the flange frame (a robot file's ``[payload]``); the link
+    must hang from the flange link by fixed joints."""
+    if model.payload is None:
+        return None
+    if model.payload not in tree.links:
+        raise _fail(f"{where}: <kinergy:model>", f"no link named {model.payload!r} (payload)")
+    pose = np.eye(4)
+    link = model.payload
+    while link != model.flange:
+        joint = tree.parent_joint.get(link)
+        if joint is None or joint.type != "fixed":
+            raise _fail(
+                f"{where}: link {model.payload!r}",
+                f"the payload must be fixed to the flange link {model.flange!r}",
+            )
+        pose = _origin(joint) @ pose
+        link = joint.parent
+    mass, origin, inertia = _link_inertial(tree.links[model.payload], where)
+    mass, com, six = _body_inertial([(mass, pose @ origin, inertia)])
+    return {"mass": mass, **_snapped(com, six)}
+
+
+def _restored_drive(
+    kin: KinergyJoint, standard: Standard, coupled: bool, where: str
+) -> dict[str, Any]:
+    """A joint's ``drive`` table (robot file form) from its ``<kinergy:joint>`` and the URDF's
+    standard elements."""
+    jwhere = f"{where}: joint {kin.name!r}"
+    drive: dict[str, Any] = dict(kin.drive)
+    if coupled:
+        if "gear_ratio" not in drive:
+            raise _fail(jwhere, "a coupled robot's <kinergy:drive> needs its gear_ratio")
+    else:
+        if "gear_ratio" in drive:
+            raise _fail(
+                jwhere, "gear_ratio belongs in the joint's <transmission>, not in <kinergy:drive>"
+            )
+        if kin.name not in standard.reductions:
+            raise _fail(jwhere, "no SimpleTransmission with its gear ratio (<mechanicalReduction>)")
+        drive["gear_ratio"] = standard.reductions[kin.name]
+    if kin.friction is not None:
+        drive["friction"] = dict(kin.friction)
+    elif coupled:
+        raise _fail(
+            jwhere,
+            "a coupled robot needs every <kinergy:friction> (<dynamics> holds only each joint's "
+            "share)",
+        )
+    else:
+        damping, coulomb = standard.dynamics.get(kin.name, (0.0, 0.0))
+        gear = float(drive["gear_ratio"])
+        drive["friction"] = {
+            "model": "viscous_coulomb",
+            "viscous": damping / gear**2,
+            "coulomb": coulomb / abs(gear),
+            "smoothing": SMOOTHING,
+        }
+    if kin.thermal is not None:
+        drive["thermal"] = dict(kin.thermal)
+    return drive
+
+
+def _check_dynamics(robot: Robot, model: KinergyModel, standard: Standard, where: str) -> None:
+    """The URDF's ``<dynamics>`` must be what the restored friction exports (else the file was
+    edited after kinergy wrote it)."""
+    speed, load = motor_ranges(robot)
+    for k, kin in enumerate(model.joints):
+        if kin.line is not None:
+            speed[k], load[k] = kin.line
+    side = joint_side(robot, (speed, load))
+    for k, joint in enumerate(robot.joints):
+        file = standard.dynamics.get(joint.name, (0.0, 0.0))
+        for label, value, computed in zip(
+            ("damping", "friction"), file, (side.damping[k], side.friction[k]), strict=True
+        ):
+            if not abs(value - computed) <= 1e-9 * max(abs(value), abs(computed)):
+                raise _fail(
+                    f"{where}: joint {joint.name!r}",
+                    f"<dynamics {label}={value!r}> is not the {float(computed)!r} its drive's "
+                    "<kinergy:friction> gives (was the file edited?); remove that "
+                    "<kinergy:friction> to import <dynamics> as Coulomb + viscous friction",
+                )
+
+
+def _restored(
+    urdf: Any,
+    model: KinergyModel,
+    standard: Standard,
+    path: Path,
+    selection: tuple[str | None, str | None, str | None],
+) -> Robot:
+    """The robot a ``<kinergy:model>`` element and the URDF's standard elements describe."""
+    where = str(path)
+    root, tip, name = selection
+    if (root is not None and root != model.root) or (tip is not None and tip != model.flange):
+        raise _fail(
+            where,
+            f"the <kinergy:model> element describes the chain from link {model.root!r} to "
+            f"{model.flange!r}; give no root and tip, or remove the element",
+        )
+    tree = _tree(urdf, where)
+    _root_link(tree, model.root, where)
+    revolute = _revolute_chain(tree, model.root, model.flange, where)
+    names = [j.name for j in revolute]
+    recorded = [k.name for k in model.joints]
+    if names != recorded:
+        raise _fail(
+            f"{where}: <kinergy:model>",
+            f"describes joints {', '.join(recorded)}, but the chain from {model.root!r} to "
+            f"{model.flange!r} has {', '.join(names)}",
+        )
+    poses, body = _poses_and_bodies(
+        tree, model.root, {j.name: i + 1 for i, j in enumerate(revolute)}
+    )
+    frames = _check_kinematics(model, revolute, poses, where)
+    body = {link: b for link, b in body.items() if link != model.payload}
+    parts = _body_parts(tree, body, poses, frames, len(revolute), where)
+    coupled = model.coupling is not None
+    joints = []
+    for i, (joint, kin) in enumerate(zip(revolute, model.joints, strict=True)):
+        link = _body_link(joint, parts[i], where)
+        limits = _limits(joint, where)
+        limit_table: dict[str, Any] = {
+            "position": limits.position.tolist(),
+            "speed": limits.speed,
+            "torque": limits.torque,
+        }
+        if kin.acceleration is not None:
+            limit_table["acceleration"] = kin.acceleration
+        joints.append(
+            {
+                "name": kin.name,
+                **kin.kinematics,
+                "mass": link.mass,
+                **_snapped(link.com, link.inertia),
+                "drive": _restored_drive(kin, standard, coupled, where),
+                "limits": limit_table,
+            }
+        )
+    sources: dict[str, Any] = dict(model.sources)
+    if any(k.friction is None for k in model.joints):
+        sources["friction"] = {"status": "published", "ref": f"URDF {path.name} <dynamics>"}
+    data: dict[str, Any] = {
+        "name": name or urdf.robot.name or path.stem,
+        "description": model.description,
+        "convention": model.convention,
+        "gravity": model.gravity,
+        "standby_power": model.standby_power,
+        "bus_voltage": model.bus_voltage,
+        "base": model.base,
+        "flange": model.flange_pose,
+        "sources": sources,
+        "joints": joints,
+    }
+    if coupled:
+        data["coupling"] = model.coupling
+    payload = _payload(tree, model, where)
+    if payload is not None:
+        data["payload"] = payload
+    try:
+        robot = robot_from_dict(data)
+    except KinergyError as exc:
+        raise exc.prefixed(f"{where}: <kinergy:model>") from None
+    _check_dynamics(robot, model, standard, where)
+    return robot
+
+
+# --------------------------------------------------------------------------------------------
+# The public functions
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class UrdfImport:
+    """A robot read from a URDF file.
+
+    Attributes
+    ----------
+    robot : Robot
+    restored : bool
+        Whether the file's ``<kinergy:model>`` element gave the drives, the convention and the
+        rest of what URDF cannot hold (a file ``kinergy robot export`` wrote); else the drives
+        are nominal but for the gear ratios and friction the standard elements give.
+    """
+
+    robot: Robot
+    restored: bool
+
+    @property
+    def drives(self) -> str:
+        """Where the drives came from, in words."""
+        if self.restored:
+            return "drives, friction and coupling from its <kinergy:model> element"
+        return _drives_found(self.robot.joints)
+
+
+def _drives_found(robot_joints: Sequence[Joint]) -> str:
+    """What a URDF without a ``<kinergy:model>`` element gave of its drives, in words."""
+    given = [
+        what
+        for what, present in (
+            (
+                "gear ratios from <transmission>",
+                any(j.drive.gear_ratio != 1.0 for j in robot_joints),
+            ),
+            (
+                "friction from <dynamics>",
+                any(j.drive.friction.model != "none" for j in robot_joints),
+            ),
+        )
+        if present
+    ]
+    if not given:
+        return "drives are nominal"
+    return f"{' and '.join(given)}, the rest of the drives nominal"
+
+
+def import_urdf(
     path: str | os.PathLike[str],
     *,
     root: str | None = None,
     tip: str | None = None,
     name: str | None = None,
-) -> Robot:
+) -> UrdfImport:
     """Read the serial chain of revolute joints from ``root`` to ``tip`` of a URDF file.
 
     Parameters
@@ -599,20 +994,28 @@ def robot_from_urdf(
 
     Returns
     -------
-    Robot
-        Convention ``mdh``, one joint per ``revolute``/``continuous`` joint of the chain, named as
-        in the URDF, with the same sign of q. Link inertials are the rigid sums of the links each
+    UrdfImport
+        A file with a ``<kinergy:model>`` element (written by ``kinergy robot export``) gives back
+        the robot it was written from: the recorded convention and DH or MDH parameters (checked
+        against the URDF's axes and flange), base, flange, gravity, coupling, drives, friction
+        family and parameters (checked against ``<dynamics>``), acceleration limits and
+        provenance, with the link inertials, payload, position, speed and torque limits and gear
+        ratios (``<transmission>``) read from the standard elements. Any other file gives
+        convention ``mdh``, one joint per ``revolute``/``continuous`` joint of the chain, named as
+        in the URDF, with the same sign of q; link inertials the rigid sums of the links each
         joint moves (``fixed`` joints merged; a subtree hanging off the chain is lumped in at its
-        q = 0 configuration). Limits from ``<limit>`` (continuous joints: +-2 pi rad); drives
-        nominal (see the module docstring).
+        q = 0 configuration); limits from ``<limit>`` (continuous joints: +-2 pi rad); gear
+        ratios from ROS SimpleTransmissions, Coulomb + viscous friction from ``<dynamics>``, the
+        rest of the drives nominal (see the module docstring).
 
     Raises
     ------
     KinergyError
-        ``PATH: ...`` naming the joint or link at fault: malformed XML, a ``prismatic``,
+        ``PATH: ...`` naming the joint, link or element at fault: malformed XML, a ``prismatic``,
         ``planar`` or ``floating`` joint in the chain, a missing ``<limit>`` or its effort or
         velocity, a negative mass or a non-physical inertia, a moving body without mass,
-        a branching tree without ``tip``; or when ``yourdfpy`` is not installed.
+        a branching tree without ``tip``, a ``<kinergy:model>`` that disagrees with the URDF it is
+        in; or when ``yourdfpy`` is not installed.
 
     Notes
     -----
@@ -622,7 +1025,28 @@ def robot_from_urdf(
     """
     path = Path(path)
     where = str(path)
-    urdf = _load_urdf(path, where)
+    try:
+        text = path.read_bytes()
+    except OSError as exc:
+        raise _fail(where, f"cannot read URDF file ({exc.strerror})") from None
+    element = _check_xml(text, where)
+    standard = read_standard(element, where)
+    model = read_kinergy(element, where)
+    # huge numbers (an origin of 1e308 m) overflow on the way; every value that reaches the robot
+    # is checked finite and bounded, so the overflow is refused there, in one line
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        urdf = _load_urdf(text, where)
+        if model is not None:
+            return UrdfImport(_restored(urdf, model, standard, path, (root, tip, name)), True)
+        return UrdfImport(_generic(urdf, standard, path, (root, tip, name)), False)
+
+
+def _generic(
+    urdf: Any, standard: Standard, path: Path, selection: tuple[str | None, str | None, str | None]
+) -> Robot:
+    """The robot a URDF without a ``<kinergy:model>`` element describes."""
+    where = str(path)
+    root, tip, name = selection
     tree = _tree(urdf, where)
     root = _root_link(tree, root, where)
     tip = _tip_link(tree, root, where) if tip is None else tip
@@ -631,21 +1055,34 @@ def robot_from_urdf(
     params, frames = _mdh_chain(revolute, poses, where)
     parts = _body_parts(tree, body, poses, frames, len(revolute), where)
     joints = [
-        _joint(joint, row, parts[i], where)
+        _joint(joint, row, parts[i], _standard_drive(joint.name, standard), where)
         for i, (joint, row) in enumerate(zip(revolute, params, strict=True))
     ]
     flange = np.linalg.solve(frames[-1], poses[tip])
     flange[np.abs(flange) < 1e-14] = 0.0
+    friction = any(j.drive.friction.model != "none" for j in joints)
     try:
-        return Robot(
+        robot = Robot(
             name=name or urdf.robot.name or path.stem,
             convention="mdh",
             joints=tuple(joints),
             base=frames[0],
             flange=flange,
-            sources=_sources(path.name),
+            sources=_sources(path.name, friction),
             description=f"imported from URDF {path.name} (links {root!r} to {tip!r}); "
-            "drives are nominal",
+            + _drives_found(joints),
         )
     except KinergyError as exc:
         raise exc.prefixed(where) from None
+    return robot
+
+
+def robot_from_urdf(
+    path: str | os.PathLike[str],
+    *,
+    root: str | None = None,
+    tip: str | None = None,
+    name: str | None = None,
+) -> Robot:
+    """The robot of :func:`import_urdf` (same parameters)."""
+    return import_urdf(path, root=root, tip=tip, name=name).robot
