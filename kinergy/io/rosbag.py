@@ -530,22 +530,21 @@ ROSBAG = register(LogFormat("rosbag", is_bag, _bag_chunks, folders=True, joints=
 
 @dataclass(frozen=True)
 class EffortScale:
-    """How a bag's ``effort`` compares with the model's gravity torque (:func:`effort_scale`).
+    """How a log's effort compares with the model's gravity torque (:func:`effort_scale`).
 
     Attributes
     ----------
-    scale : float
-        Least-squares ``s`` in ``effort ~ s * tau_g`` over the joints gravity loads.
-    torque_scale, current_scale : float
-        What ``s`` would be if ``effort`` held joint torques (1) or motor currents
-        (``1 / (k_t * gear ratio)``, the loaded joints' mean).
+    torque : float
+        Least-squares ``s`` in ``effort ~ s * tau_g``: about 1 if the effort holds joint torques.
+    current : float
+        Least-squares ``s`` in ``effort ~ s * tau_g / (k_t * N)``: about 1 if it holds motor
+        currents.
     effort : Effort
-        The nearer of the two (on a log scale).
+        The reading whose scale is nearer 1 (on a log scale).
     """
 
-    scale: float
-    torque_scale: float
-    current_scale: float
+    torque: float
+    current: float
     effort: Effort
 
 
@@ -553,17 +552,17 @@ def effort_scale(robot: Robot, log: Log, signal: str | None = None) -> EffortSca
     """Tell from the data whether a log's effort is motor currents or joint torques.
 
     The gravity torque of the robot's model along the log's positions, ``tau_g(q)`` (RNEA at
-    zero speed and acceleration), carries most of the shoulder's and elbow's torque in any
-    motion slow enough for a robot to log; the effort scales to it by about 1 if it holds joint
-    torques and by ``1 / (k_t * N)`` (UR arms: about 0.08) if it holds motor currents (UR5e eq 17,
-    friction and inertia aside). The least-squares scale over the joints whose gravity torque is
-    at least a fifth of the largest picks the nearer one.
+    zero speed and acceleration), carries most of the torque of the joints gravity loads in any
+    motion a robot logs. Read as joint torques the effort is about ``tau_g``; read as motor
+    currents, about ``tau_g / (k_t N)`` (UR5e eq 17, friction and inertia aside), ten times
+    smaller on a UR arm. Both least-squares scales over the joints whose gravity torque is at
+    least a fifth of the largest are returned; the one nearer 1 names the effort.
 
     Parameters
     ----------
     robot : Robot
     log : Log
-        With ``actual_q`` (N, n) and the effort signal.
+        With ``actual_q`` (N, n) and the effort signal (N, n).
     signal : str, optional
         The effort's signal (default: ``actual_current`` or ``actual_joint_torque``, whichever
         the log has).
@@ -578,19 +577,20 @@ def effort_scale(robot: Robot, log: Log, signal: str | None = None) -> EffortSca
     if signal is None:
         signal = next((s.signal for s in Effort if s.signal in log), Effort.CURRENT.signal)
     log.require("actual_q", signal, purpose="telling the effort's kind")
-    q = log["actual_q"]
-    step = max(1, len(q) // 2000)  # 2000 samples are plenty for a scale
-    q, effort = q[::step], log[signal][::step]
+    step = max(1, len(log) // 2000)  # 2000 samples are plenty for a scale
+    q, effort = log["actual_q"][::step], log[signal][::step]
     tau_g = gravity_torque(robot, q)
     size = np.sqrt(np.mean(tau_g**2, axis=0))
-    loaded = size >= 0.2 * size.max() if size.max() > 0 else np.zeros(robot.n, dtype=bool)
-    if not loaded.any():
+    loaded = size >= 0.2 * size.max()
+    if not size.max() > 0:
         raise KinergyError(f"{log.path}: gravity loads no joint along this motion")
-    g, e = tau_g[:, loaded], effort[:, loaded]
-    scale = float(np.sum(g * e) / np.sum(g * g))
-    gear = np.array([j.drive.gear_ratio for j in robot.joints])[loaded]
-    current = float(np.mean(1.0 / (torque_constants(robot)[loaded] * gear)))
-    near_torque = abs(np.log(max(abs(scale), 1e-12))) <= abs(
-        np.log(max(abs(scale), 1e-12) / current)
+    gear = np.array([j.drive.gear_ratio for j in robot.joints])
+    fits = []
+    for model in (tau_g, tau_g / (torque_constants(robot) * gear)):
+        g, e = model[:, loaded], effort[:, loaded]
+        fits.append(float(np.sum(g * e) / np.sum(g * g)))
+    torque, current = fits
+    distance = [abs(np.log(max(abs(s), 1e-12))) for s in fits]
+    return EffortScale(
+        torque, current, Effort.TORQUE if distance[0] <= distance[1] else Effort.CURRENT
     )
-    return EffortScale(scale, 1.0, current, Effort.TORQUE if near_torque else Effort.CURRENT)
