@@ -66,6 +66,7 @@ from kinergy.identify.preprocess import (
 from kinergy.io.formats import CHUNK_ROWS, iter_log
 from kinergy.io.log import Log
 from kinergy.io.motion_stream import HALO
+from kinergy.io.rosbag import BagOptions
 from kinergy.io.segments import segment_bounds
 
 __all__ = [
@@ -152,10 +153,15 @@ def spill_log(
     columns: str | None = None,
     repair: bool = False,
     rows: int = CHUNK_ROWS,
+    joints: Sequence[str] | None = None,
+    bag: BagOptions | None = None,
 ) -> LogSpill:
     """Read the log at ``path`` once, in chunks of ``rows``, into a :class:`LogSpill` (the
-    caller closes it)."""
-    first = next(iter_log(path, columns=columns, repair=repair, rows=2), None)
+    caller closes it); ``joints`` and ``bag`` as :func:`kinergy.io.formats.iter_log` takes
+    them."""
+    first = next(
+        iter_log(path, columns=columns, repair=repair, rows=2, joints=joints, bag=bag), None
+    )
     if first is None:
         raise KinergyError(f"{path}: the log has no samples")
     names = first.signals
@@ -172,7 +178,10 @@ def spill_log(
     times: list[Array] = []
     state: dict[str, list[Array]] = {s: [] for s in STATE if s in names}
     try:
-        for chunk in iter_log(path, columns=columns, repair=repair, select=wanted, rows=rows):
+        chunks = iter_log(
+            path, columns=columns, repair=repair, select=wanted, rows=rows, joints=joints, bag=bag
+        )
+        for chunk in chunks:
             spill.notes += chunk.notes
             spill.append(chunk)
             # copies: a view would keep the chunk's whole block of values alive

@@ -16,6 +16,7 @@ from kinergy.io.formats import iter_log
 from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
 from kinergy.io.motion_stream import iter_motion
+from kinergy.io.rosbag import BagOptions
 from kinergy.io.rtde import read_log
 from kinergy.model.robot import Robot
 from kinergy.predict import drive_state
@@ -48,13 +49,17 @@ _EXTRAS = ("joint_temperatures", "actual_robot_voltage", "actual_robot_current",
 
 
 def _signals_used(
-    path: str | os.PathLike[str], columns: str | None, source: str
+    path: str | os.PathLike[str],
+    columns: str | None,
+    source: str,
+    joints: list[str],
+    bag: BagOptions | None,
 ) -> list[str] | None:
     """The signals of the log at ``path`` its energy uses (the others are never converted):
     the motion of ``source`` (``auto`` as :func:`kinergy.io.motion.motion_from_log`) and
     :data:`_EXTRAS`, those the log has; None (all) when it has no joint positions, so the
     error lists what it has."""
-    first = next(iter_log(path, columns=columns, rows=2), None)
+    first = next(iter_log(path, columns=columns, rows=2, joints=joints, bag=bag), None)
     if first is None:
         return None
     names = first.signals
@@ -73,15 +78,17 @@ def energy_of_log(
     columns: str | None = None,
     source: str = "auto",
     recovery: bool = True,
+    bag: BagOptions | None = None,
 ) -> EnergyReport:
     """The energy of the motion in a log or motion file (:func:`kinergy.accounting.energy.energy`),
     with friction at the log's ``joint_temperatures`` where it has them, and the supply energy
     the log measured (``actual_robot_voltage`` x ``actual_robot_current``) beside the predicted
     one where it has both. A URScript program (``*.script``) is run as the controller would
-    (:func:`kinergy.workflows.logs.read_motion`)."""
+    (:func:`kinergy.workflows.logs.read_motion`); a ROS 2 bag is read with the robot's joint
+    names and ``bag``'s options (:mod:`kinergy.io.rosbag`)."""
     if os.fspath(path).endswith(".script"):
         return energy(robot, read_motion(path, n_joints=robot.n, robot=robot), recovery=recovery)
-    log = read_log(path, columns=columns)
+    log = read_log(path, columns=columns, joints=robot.joint_names, bag=bag)
     motion = motion_from_log(log, n_joints=robot.n, source=source)
     report = energy(robot, motion, recovery=recovery, temperature=_temperature(log, motion))
     if "actual_robot_voltage" in log and "actual_robot_current" in log:
@@ -98,19 +105,21 @@ def energy_figures_of_log(
     source: str = "auto",
     recovery: bool = True,
     rows: int = ENERGY_ROWS,
+    bag: BagOptions | None = None,
 ) -> EnergyFigures:
     """The figures of :func:`energy_of_log` (what ``kinergy energy`` prints), a log read in one
     pass: chunks of ``rows`` samples (:func:`kinergy.io.formats.iter_log`), their motion as the
     whole log's (:func:`kinergy.io.motion_stream.iter_motion`), predicted and accumulated
     (:class:`kinergy.accounting.energy_stream.EnergyAccumulator`); memory bounded by the chunk.
     Segments (a time gap or a ``segment`` change) are never integrated across. A URScript
-    program takes the in-memory path."""
+    program takes the in-memory path; ``bag`` as :func:`energy_of_log` takes it."""
     if os.fspath(path).endswith(".script"):
         return energy_of_log(robot, path, recovery=recovery).figures()
     acc = EnergyAccumulator(robot, recovery=recovery)
     measured = False
-    select = _signals_used(path, columns, source)
-    chunks = iter_log(path, columns=columns, rows=rows, select=select)
+    joints = robot.joint_names
+    select = _signals_used(path, columns, source, joints, bag)
+    chunks = iter_log(path, columns=columns, rows=rows, select=select, joints=joints, bag=bag)
     for part in iter_motion(chunks, n_joints=robot.n, source=source):
         m = part.motion
         state = drive_state(robot, m.q, m.qd, m.qdd, temperature=_temperature(part.log, m))

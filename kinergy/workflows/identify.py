@@ -247,7 +247,8 @@ def identify_logs(
     friction model) the logs are read in chunks of ``rows`` samples and never held whole
     (:func:`~kinergy.workflows.logs.chunked_logs`); other methods prepare them in memory.
     """
-    reading = reading or {}
+    reading = LogReading(**(reading or {}))
+    reading.setdefault("joints", robot.joint_names)
     method, friction = options.get("method", "sequential"), options.get("friction")
     if not streams(robot, method, friction):
         datas = prepared_logs(paths, n_joints=robot.n, **reading)

@@ -21,6 +21,7 @@ from kinergy.identify.streamed import Segment, WholeSegment
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
+from kinergy.io.rosbag import BagOptions
 from kinergy.io.rtde import read_log
 from kinergy.io.segments import segment_bounds
 from kinergy.io.urscript_reader import read_program
@@ -52,12 +53,19 @@ class LogReading(TypedDict, total=False):
         None: its default.
     note : callable or None
         Receives what reading changed (rows dropped by ``repair``, segments), one message each.
+    joints : sequence of str or None
+        The robot's joint names: a ROS 2 bag's joints are matched to them
+        (:mod:`kinergy.io.rosbag`); the workflows that know the robot fill it in.
+    bag : BagOptions or None
+        A ROS 2 bag's topic and what its ``effort`` holds (``--topic``, ``--effort``).
     """
 
     columns: str | None
     repair: bool
     cutoff: float | None
     note: Callable[[str], None] | None
+    joints: Sequence[str] | None
+    bag: BagOptions | None
 
 
 def _segments(
@@ -103,7 +111,13 @@ def prepared_logs(
     """
     datas: list[IdentData] = []
     for path in paths:
-        log = read_log(path, columns=reading.get("columns"), repair=reading.get("repair", False))
+        log = read_log(
+            path,
+            columns=reading.get("columns"),
+            repair=reading.get("repair", False),
+            joints=reading.get("joints"),
+            bag=reading.get("bag"),
+        )
         segment = log.signals.get("segment")
         for name, (a, b) in _segments(path, log.t, segment, log.notes, reading.get("note")):
             part = Log(
@@ -130,7 +144,12 @@ def chunked_logs(
         segments: list[Segment] = []
         for path in paths:
             spill = spill_log(
-                path, columns=reading.get("columns"), repair=reading.get("repair", False), rows=rows
+                path,
+                columns=reading.get("columns"),
+                repair=reading.get("repair", False),
+                rows=rows,
+                joints=reading.get("joints"),
+                bag=reading.get("bag"),
             )
             stack.callback(spill.close)
             t, segment = spill.state.t, spill.state.signals.get("segment")
@@ -153,14 +172,17 @@ def read_motion(
     repair: bool = False,
     source: str = "auto",
     robot: Robot | None = None,
+    bag: BagOptions | None = None,
 ) -> Motion:
     """The joint motion of a log or motion file (:func:`kinergy.io.motion.motion_from_log`), or
     of a URScript program (``*.script``) on ``robot`` as the controller runs it (one cycle,
-    starting where it ends, at 500 Hz)."""
+    starting where it ends, at 500 Hz). A ROS 2 bag is read with ``robot``'s joint names and
+    ``bag``'s options."""
     if os.fspath(path).endswith(".script"):
         if robot is None:
             raise KinergyError(f"{path}: a URScript program needs the robot it runs on")
         motion, _ = program_motion(robot, program_path(robot, read_program(path)))
         return motion
-    log = read_log(path, columns=columns, repair=repair)
+    joints = None if robot is None else robot.joint_names
+    log = read_log(path, columns=columns, repair=repair, joints=joints, bag=bag)
     return motion_from_log(log, n_joints=n_joints, source=source)

@@ -14,6 +14,7 @@ from kinergy.identify.metrics import fit_metrics
 from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IdentificationResult, predict
 from kinergy.identify.sequential import identify_sequential
+from kinergy.io.rosbag import BagOptions
 from kinergy.io.task import Task
 from kinergy.model.robot import Robot
 from kinergy.report.html import Section, Table, write_report
@@ -125,16 +126,24 @@ def study_report(
     model_name: str = "",
     progress: Progress | None = None,
     note: Callable[[str], None] | None = None,
+    bag: BagOptions | None = None,
 ) -> tuple[Path, dict[str, list[Table]]]:
     """``kinergy report``: identify (sequential method) on ``identify_logs`` if any, validate on
     ``validate_logs``, account the energy of ``energy_logs``, and write ``out/report.html``.
+    ROS 2 bags among the logs are read with ``bag``'s options (:mod:`kinergy.io.rosbag`).
 
     The folder is built beside ``out`` and renamed into place at the end
     (:func:`kinergy.files.atomic_folder`); ``out`` None: a new folder ``kinergy-report-*`` in the
     system's temporary folder. Returns the path of ``report.html`` and the tables.
     """
     say = progress or (lambda _msg: None)
-    reading: LogReading = {"columns": columns, "repair": repair, "note": note}
+    reading: LogReading = {
+        "columns": columns,
+        "repair": repair,
+        "note": note,
+        "joints": robot.joint_names,
+        "bag": bag,
+    }
     result = None
     if identify_logs:
         say("identifying")
@@ -150,7 +159,9 @@ def study_report(
         )
     )
     motions = {
-        Path(p).name: read_motion(p, n_joints=robot.n, columns=columns, repair=repair)
+        Path(p).name: read_motion(
+            p, n_joints=robot.n, columns=columns, repair=repair, robot=robot, bag=bag
+        )
         for p in energy_logs
     }
     study = run_study(
