@@ -272,3 +272,30 @@ def test_a_bag_needs_the_robots_joints_and_no_columns(bag: Path, tmp_path: Path)
     csv.write_text("timestamp actual_q_0\n0 1\n0.1 2\n")
     _refused(csv, "a rtde log, not a ROS 2 bag: the bag options .* apply to bags only",
              bag=BagOptions())  # fmt: skip
+
+
+def test_a_fleet_manifest_names_how_its_robots_bags_are_read(tmp_path: Path) -> None:
+    from kinergy.fleet.analysis import analyse_log
+    from kinergy.fleet.manifest import fleet_logs, read_manifest
+
+    t, q, qd, effort = _motion(300)
+    write_bag(tmp_path / "cell-1" / "2024-05-06-run", t, q, qd, effort)
+    write_bag(tmp_path / "cell-2" / "2024-05-07-run", t, q, qd, effort, topic="/arm/joint_states")
+    manifest = tmp_path / "fleet.toml"
+    manifest.write_text(
+        '[[robot]]\nname = "cell-1"\nmodel = "ur10e"\nlogs = "cell-1/*"\neffort = "torque"\n'
+        '[[robot]]\nname = "cell-2"\nmodel = "ur10e"\nlogs = "cell-2/*"\n'
+    )
+    one, two = fleet_logs(read_manifest(manifest), bag=BagOptions("/arm/joint_states"))
+    assert one.bag == BagOptions("/arm/joint_states", Effort.TORQUE)  # the entry's effort wins
+    assert two.bag == BagOptions("/arm/joint_states")
+    result = analyse_log(two)
+    assert result.error is None and result.samples == 300
+    assert result.cycles and result.cycles[0].motor_work is not None  # effort read as currents
+    wrong = analyse_log(fleet_logs(read_manifest(manifest))[1])  # the default topic
+    assert wrong.error is not None and "no topic /joint_states in the bag" in wrong.error
+    manifest.write_text('[[robot]]\nname = "c"\nmodel = "ur10e"\nlogs = "cell-1/*"\neffort = "A"\n')
+    with pytest.raises(
+        KinergyError, match=r"robot 'c': effort: 'A' is not one of current, torque$"
+    ):
+        read_manifest(manifest)

@@ -28,7 +28,7 @@ from pathlib import Path
 
 from kinergy.errors import KinergyError
 from kinergy.files import read_toml
-from kinergy.io.rosbag import BagOptions, bag_options, is_bag
+from kinergy.io.rosbag import BagOptions, Effort, bag_options, is_bag
 
 __all__ = ["FleetLog", "Manifest", "RobotEntry", "fleet_logs", "log_date", "read_manifest"]
 
@@ -46,14 +46,17 @@ class RobotEntry:
         A built-in robot name or a robot file's path (made absolute against the manifest).
     globs : tuple of str
         Absolute glob patterns of its logs.
-    bag : BagOptions or None
-        How its ROS 2 bags are read (``topic``, ``effort``); None: the defaults.
+    topic : str or None
+        Its ROS 2 bags' ``JointState`` topic; None: ``--topic``, else ``/joint_states``.
+    effort : Effort or None
+        What its bags' ``effort`` holds; None: ``--effort``, else the robot's default.
     """
 
     name: str
     model: str
     globs: tuple[str, ...]
-    bag: BagOptions | None = None
+    topic: str | None = None
+    effort: Effort | None = None
 
 
 @dataclass(frozen=True)
@@ -103,15 +106,19 @@ def _entry(table: object, k: int, folder: Path, path: Path) -> RobotEntry:
         or not all(isinstance(p, str) and p.strip() for p in patterns)
     ):
         raise KinergyError(f"{where}: 'logs' must be a glob or a list of globs")
-    topic, effort = table.get("topic"), table.get("effort")
+    topic = None if table.get("topic") is None else _text(table, "topic", where)
+    effort = None if table.get("effort") is None else _text(table, "effort", where)
     try:
-        bag = bag_options(
-            None if topic is None else _text(table, "topic", where),
-            None if effort is None else _text(table, "effort", where),
-        )
+        bag = bag_options(topic, effort)  # checked here, merged with the flags in fleet_logs
     except KinergyError as exc:
-        raise KinergyError(f"{where}: {str(exc).replace('--', '', 1)}") from None
-    return RobotEntry(name, model, tuple(str(folder / p.strip()) for p in patterns), bag)
+        raise KinergyError(f"{where}: {str(exc).removeprefix('--')}") from None
+    return RobotEntry(
+        name,
+        model,
+        tuple(str(folder / p.strip()) for p in patterns),
+        None if topic is None or bag is None else bag.topic,
+        None if bag is None else bag.effort,
+    )
 
 
 def read_manifest(path: str | os.PathLike[str]) -> Manifest:
@@ -167,8 +174,20 @@ def _robot_of(log: Path, manifest: Manifest) -> RobotEntry:
     raise KinergyError(f"{log}: belongs to no robot of the manifest (no glob names it)")
 
 
-def fleet_logs(manifest: Manifest, extra: Sequence[str | os.PathLike[str]] = ()) -> list[FleetLog]:
-    """Every log the manifest's globs and ``extra`` name, each once, with robot and date.
+def _bag(robot: RobotEntry, given: BagOptions | None) -> BagOptions | None:
+    """How ``robot``'s bags are read: its entry's topic and effort, else the ``given`` ones."""
+    topic = robot.topic or (None if given is None else given.topic)
+    return bag_options(topic, robot.effort or (None if given is None else given.effort))
+
+
+def fleet_logs(
+    manifest: Manifest,
+    extra: Sequence[str | os.PathLike[str]] = (),
+    bag: BagOptions | None = None,
+) -> list[FleetLog]:
+    """Every log the manifest's globs and ``extra`` name, each once, with robot and date, and
+    how to read it if it is a ROS 2 bag (the robot entry's ``topic`` and ``effort``, else
+    ``bag``'s: ``--topic``, ``--effort``).
 
     Raises
     ------
@@ -196,6 +215,6 @@ def fleet_logs(manifest: Manifest, extra: Sequence[str | os.PathLike[str]] = ())
             raise KinergyError(f"{given}: no such log file")
         owner.setdefault(log, _robot_of(log, manifest))
     return [
-        FleetLog(robot.name, robot.model, str(log), log_date(log), robot.bag)
+        FleetLog(robot.name, robot.model, str(log), log_date(log), _bag(robot, bag))
         for log, robot in sorted(owner.items(), key=lambda item: (item[1].name, str(item[0])))
     ]
