@@ -17,11 +17,14 @@ from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElaps
 from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_output, check_outputs
+from kinergy.io.rosbag import bag_options
 from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
+    "bag_options",
     "columns_option",
     "cutoff_option",
+    "effort_option",
     "fmt",
     "fmt_vector",
     "load",
@@ -34,6 +37,7 @@ __all__ = [
     "report_folder_option",
     "seed_option",
     "table",
+    "topic_option",
     "writes",
 ]
 
@@ -106,6 +110,19 @@ columns_option = click.option(
     "--columns",
     metavar="SPEC",
     help='Layout of a headerless log, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6".',
+)
+topic_option = click.option(
+    "--topic",
+    metavar="TOPIC",
+    default=None,
+    help="ROS 2 bags: the sensor_msgs/JointState topic [/joint_states].",
+)
+effort_option = click.option(
+    "--effort",
+    type=click.Choice(["current", "torque"]),
+    default=None,
+    help="ROS 2 bags: what JointState effort holds, motor currents (A) or joint torques (N m) "
+    "[current for UR arms, as UR's driver publishes by default; torque for others].",
 )
 cutoff_option = click.option(
     "--cutoff",

@@ -8,7 +8,15 @@ from typing import Any
 import click
 
 from kinergy.accounting.supply import MEASURED_INCLUDES, PREDICTED_INCLUDES
-from kinergy.cli.common import columns_option, load, payload_option, table
+from kinergy.cli.common import (
+    bag_options,
+    columns_option,
+    effort_option,
+    load,
+    payload_option,
+    table,
+    topic_option,
+)
 from kinergy.jsonable import dumps
 from kinergy.workflows.energy import energy_figures_of_log
 
@@ -81,7 +89,7 @@ def energy_text(report: dict[str, Any]) -> str:
 
 @click.command()
 @click.argument("model", metavar="MODEL")
-@click.argument("motion_path", metavar="LOG_OR_MOTION", type=click.Path(dir_okay=False))
+@click.argument("motion_path", metavar="LOG_OR_MOTION", type=click.Path())
 @columns_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (DESIGN.md shape).")
 @click.option(
@@ -95,6 +103,8 @@ def energy_text(report: dict[str, Any]) -> str:
     help="Which motion of a log: commanded (target_*) or measured (actual_*).",
 )
 @payload_option
+@topic_option
+@effort_option
 def energy(
     model: str,
     motion_path: str,
@@ -103,15 +113,22 @@ def energy(
     no_recovery: bool,
     source: str,
     payload: str | None,
+    topic: str | None,
+    effort: str | None,
 ) -> None:
     """What a logged or planned motion draws from the arm's supply, and per-joint mechanical and
     electrical energy; a log's measured supply energy beside the prediction.
 
     MODEL is a built-in name or a model file; LOG_OR_MOTION a log (record.py layout, or headerless
-    with --columns) or a motion file.
+    with --columns, or a ROS 2 bag) or a motion file.
     """
     r = load(model, payload)
     report = energy_figures_of_log(
-        r, motion_path, columns=columns, source=source, recovery=not no_recovery
+        r,
+        motion_path,
+        columns=columns,
+        source=source,
+        recovery=not no_recovery,
+        bag=bag_options(topic, effort),
     ).to_dict()
     click.echo(dumps(report) if as_json else energy_text(report))

@@ -5,13 +5,16 @@ from __future__ import annotations
 import click
 
 from kinergy.cli.common import (
+    bag_options,
     columns_option,
     cutoff_option,
+    effort_option,
     note,
     output_file_option,
     progress,
     repair_option,
     table,
+    topic_option,
     writes,
 )
 from kinergy.cli.validate import validation_text
@@ -199,6 +202,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 )
 @cutoff_option
 @repair_option
+@topic_option
+@effort_option
 @writes(files=("out",), inputs=("logs", "robot_name"))
 def identify(
     logs: tuple[str, ...],
@@ -214,6 +219,8 @@ def identify(
     payload_only: bool,
     cutoff: float | None,
     repair: bool,
+    topic: str | None,
+    effort: str | None,
 ) -> None:
     """Identify a model from controller logs and write it as a robot file.
 
@@ -222,7 +229,14 @@ def identify(
     actual_current; the full method regresses the base inertial parameters too.
     """
     r = load_robot(robot_name)
-    reading: LogReading = {"columns": columns, "repair": repair, "cutoff": cutoff, "note": note}
+    reading: LogReading = {
+        "columns": columns,
+        "repair": repair,
+        "cutoff": cutoff,
+        "note": note,
+        "joints": r.joint_names,
+        "bag": bag_options(topic, effort),
+    }
     with progress() as say:
         if payload_only:
             say(f"reading {len(logs)} log(s)")

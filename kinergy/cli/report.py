@@ -5,7 +5,9 @@ from __future__ import annotations
 import click
 
 from kinergy.cli.common import (
+    bag_options,
     columns_option,
+    effort_option,
     load,
     note,
     payload_option,
@@ -13,6 +15,7 @@ from kinergy.cli.common import (
     progress,
     repair_option,
     report_folder_option,
+    topic_option,
     writes,
 )
 from kinergy.errors import KinergyError
@@ -48,6 +51,8 @@ __all__ = ["report"]
 @columns_option
 @payload_option
 @repair_option
+@topic_option
+@effort_option
 @writes(folders=("out",), inputs=("model", "identify_logs", "validate_logs", "energy_logs"))
 def report(
     model: str,
@@ -58,6 +63,8 @@ def report(
     columns: str | None,
     payload: str | None,
     repair: bool,
+    topic: str | None,
+    effort: str | None,
 ) -> None:
     """Build the study report (tables, figures, report.html) from your own model and logs."""
     if not (identify_logs or validate_logs or energy_logs):
@@ -74,6 +81,7 @@ def report(
             model_name=model,
             progress=say,
             note=note,
+            bag=bag_options(topic, effort),
         )
     print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown"])
     click.echo(f"\nreport: {path}")

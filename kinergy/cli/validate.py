@@ -9,13 +9,16 @@ import click
 import numpy as np
 
 from kinergy.cli.common import (
+    bag_options,
     columns_option,
     cutoff_option,
+    effort_option,
     load,
     note,
     payload_option,
     repair_option,
     table,
+    topic_option,
     writes,
 )
 from kinergy.identify.metrics import JointMetrics
@@ -126,6 +129,8 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
 @cutoff_option
 @payload_option
 @repair_option
+@topic_option
+@effort_option
 @writes(into=("plots",), inputs=("model", "logs"))
 def validate(
     model: str,
@@ -136,11 +141,20 @@ def validate(
     cutoff: float | None,
     payload: str | None,
     repair: bool,
+    topic: str | None,
+    effort: str | None,
 ) -> None:
     """How well a model predicts logs: torque (UR5e Table V) and current (Table VII) errors and R^2."""
     r = load(model, payload)
     datas = prepared_logs(
-        logs, n_joints=r.n, columns=columns, repair=repair, cutoff=cutoff, note=note
+        logs,
+        n_joints=r.n,
+        columns=columns,
+        repair=repair,
+        cutoff=cutoff,
+        note=note,
+        joints=r.joint_names,
+        bag=bag_options(topic, effort),
     )
     report = validate_logs(r, datas, plots=plots)
     if as_json:
