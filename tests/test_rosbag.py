@@ -300,3 +300,58 @@ def test_a_fleet_manifest_names_how_its_robots_bags_are_read(tmp_path: Path) -> 
         KinergyError, match=r"robot 'c': effort: 'A' is not one of current, torque$"
     ):
         read_manifest(manifest)
+
+
+FOURIER = [
+    DATASETS / "identification_data" / f"ur-20_02_{name}.csv"
+    for name in ("19_14harm50sec", "12-50sec_12harm")
+]
+
+
+@pytest.mark.skipif(not PTP.exists(), reason="shared datasets not available")
+def test_identify_and_validate_from_bags_print_what_the_csv_logs_give(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 27's acceptance: bags written from the UR10e Fourier runs and the held-out ptp run
+    (UR's joint names, shuffled, a gripper joint; effort = the logged actual_current) give the
+    same model file values and the same printed R^2 as the CSV logs read with the same fields."""
+    import tomllib
+
+    from kinergy.cli import main
+
+    bags = []
+    for k, path in enumerate([*FOURIER, PTP]):
+        csv = read_log(path, columns=COLUMNS)
+        q, qd, current = csv["actual_q"], csv["actual_qd"], csv["actual_current"]
+        bags.append(write_bag(tmp_path / path.stem, csv.t, q, qd, current, shuffle=k))
+    models = {route: tmp_path / f"{route}.toml" for route in ("csv", "bag")}
+    out = {}
+    for route, logs, extra in (
+        ("csv", [*FOURIER, PTP], ["--columns", COLUMNS]),
+        ("bag", bags, []),
+    ):
+        args = ["identify", *map(str, logs[:2]), "--robot", "ur10e", "--out", str(models[route])]
+        assert main([*args, *extra]) == 0
+        identified = capsys.readouterr().out
+        assert main(["validate", str(models[route]), str(logs[2]), *extra]) == 0
+        validated = capsys.readouterr().out
+        # the paths of the logs and the model are the only difference
+        out[route] = [
+            line
+            for line in (identified + validated).splitlines()
+            if str(tmp_path) not in line and str(DATASETS) not in line
+        ]
+    assert out["bag"] == out["csv"]
+    assert any("R^2" in line for line in out["bag"])
+    held_out = out["bag"][out["bag"].index("Current against actual_current (UR5e Table VII)", 20) :]
+    assert len(held_out) > 6
+    values = {route: tomllib.loads(models[route].read_text()) for route in models}
+    assert values["bag"] == values["csv"]
+    # a bag without the topic, a bag whose joints are not the robot's: one line each
+    assert main(["validate", str(models["bag"]), str(bags[2]), "--topic", "/js"]) == 1
+    err = capsys.readouterr().err
+    assert "no topic /js in the bag; its JointState topics: /joint_states" in err
+    assert err.count("\n") == 1
+    assert main(["validate", "panda", str(bags[2])]) == 1
+    err = capsys.readouterr().err
+    assert "the robot's joint(s) joint1, joint2" in err and err.count("\n") == 1
