@@ -67,8 +67,10 @@ def test_select_reads_only_the_named_signals(tmp_path: Path) -> None:
 
 
 def test_the_registry_names_its_formats() -> None:
-    assert [f.name for f in formats()] == ["rtde"]
-    with pytest.raises(KinergyError, match="unknown log format 'parquet'; known: rtde"):
+    assert [f.name for f in formats()] == ["rosbag", "panda", "rtde"]
+    with pytest.raises(
+        KinergyError, match="unknown log format 'parquet'; known: rosbag, panda, rtde"
+    ):
         read_log("x.csv", format="parquet")
 
 

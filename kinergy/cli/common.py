@@ -18,14 +18,17 @@ from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_output, check_outputs
 from kinergy.io.columns import parse_columns
+from kinergy.io.rosbag import bag_options
 from kinergy.logs.checks import Check, parse_accept
 from kinergy.logs.reading import LogReading
 from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
     "accept_option",
+    "bag_options",
     "columns_option",
     "cutoff_option",
+    "effort_option",
     "fmt",
     "fmt_vector",
     "load",
@@ -40,6 +43,7 @@ __all__ = [
     "seed_option",
     "table",
     "tell",
+    "topic_option",
     "warn",
     "writes",
 ]
@@ -73,11 +77,19 @@ def log_reading(
     repair: bool = False,
     cutoff: float | None = None,
     accept: Sequence[str] = (),
+    topic: str | None = None,
+    effort: str | None = None,
 ) -> LogReading:
     """The log-reading options of a command, parsed for ``robot`` (its joint count checks the
     ``--columns`` spec)."""
     names = None if columns is None else tuple(parse_columns(columns, robot.n))
-    return LogReading(columns=names, repair=repair, cutoff=cutoff, accept=parse_accept(accept))
+    return LogReading(
+        columns=names,
+        repair=repair,
+        cutoff=cutoff,
+        accept=parse_accept(accept),
+        bag=bag_options(topic, effort),
+    )
 
 
 def load(robot_name: str, payload: str | None) -> Robot:
@@ -128,6 +140,19 @@ columns_option = click.option(
     metavar="SPEC",
     help="Layout of a headerless log: UR's RTDE field names, NAME:N for an N-vector, _ (or _:N) "
     'for columns to skip, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6".',
+)
+topic_option = click.option(
+    "--topic",
+    metavar="TOPIC",
+    default=None,
+    help="ROS 2 bags: the sensor_msgs/JointState topic [/joint_states].",
+)
+effort_option = click.option(
+    "--effort",
+    type=click.Choice(["current", "torque"]),
+    default=None,
+    help="ROS 2 bags: what JointState effort holds, motor currents (A) or joint torques (N m) "
+    "[current for UR arms, as UR's driver publishes by default; torque for others].",
 )
 accept_option = click.option(
     "--accept",

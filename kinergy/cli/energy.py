@@ -11,11 +11,13 @@ from kinergy.accounting.supply import MEASURED_INCLUDES, PREDICTED_INCLUDES
 from kinergy.cli.common import (
     accept_option,
     columns_option,
+    effort_option,
     load,
     log_reading,
     payload_option,
     table,
     tell,
+    topic_option,
 )
 from kinergy.jsonable import dumps
 from kinergy.workflows.energy import energy_figures_of_log
@@ -89,9 +91,11 @@ def energy_text(report: dict[str, Any]) -> str:
 
 @click.command()
 @click.argument("model", metavar="MODEL")
-@click.argument("motion_path", metavar="LOG_OR_MOTION", type=click.Path(dir_okay=False))
+@click.argument("motion_path", metavar="LOG_OR_MOTION", type=click.Path())
 @columns_option
 @accept_option
+@topic_option
+@effort_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option(
     "--no-recovery", is_flag=True, help="Clip negative power: the supply takes no energy back."
@@ -113,6 +117,8 @@ def energy(
     source: str,
     payload: str | None,
     accept: tuple[str, ...],
+    topic: str | None,
+    effort: str | None,
 ) -> None:
     """What a logged or planned motion draws from the arm's supply, and per-joint mechanical and
     electrical energy; a log's measured supply energy beside the prediction.
@@ -122,7 +128,7 @@ def energy(
     test-b: the UR5e doc's tests A and B planned for MODEL).
     """
     r = load(model, payload)
-    reading = log_reading(r, columns=columns, accept=accept)
+    reading = log_reading(r, columns=columns, accept=accept, topic=topic, effort=effort)
     figures, inputs = energy_figures_of_log(
         r, motion_path, reading, source=source, recovery=not no_recovery
     )

@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import note, output_file_option, progress, table
+from kinergy.cli.common import (
+    bag_options,
+    effort_option,
+    note,
+    output_file_option,
+    progress,
+    table,
+    topic_option,
+)
 from kinergy.fleet.analysis import LogResult
 from kinergy.jsonable import dumps
 from kinergy.workflows.fleet import fleet_energy
@@ -18,7 +26,7 @@ def fleet() -> None:
 
 
 @fleet.command("energy")
-@click.argument("logs", nargs=-1, metavar="LOGS...", type=click.Path(dir_okay=False))
+@click.argument("logs", nargs=-1, metavar="LOGS...", type=click.Path())
 @click.option("--manifest", required=True, type=click.Path(dir_okay=False), help="FLEET.toml.")
 @output_file_option("--out", "FLEET.parquet.", required=True)
 @click.option("--report", type=click.Path(file_okay=False), help="Write the HTML report here.")
@@ -28,6 +36,8 @@ def fleet() -> None:
     "--min-rise", type=float, default=0.05, show_default=True, help="Smallest rise called drift."
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the robots as JSON.")
+@topic_option
+@effort_option
 def energy(
     logs: tuple[str, ...],
     manifest: str,
@@ -37,12 +47,15 @@ def energy(
     workers: int | None,
     min_rise: float,
     as_json: bool,
+    topic: str | None,
+    effort: str | None,
 ) -> None:
     """Energy per cycle of every log (LOGS and the manifest's globs), by robot and by day.
 
     Writes one row per cycle to --out (Parquet) and flags each robot whose energy or friction
     per cycle, for the same program, rises beyond its own spread; a step (a new payload) is
-    reported as a change, not as drift.
+    reported as a change, not as drift. A log may be a ROS 2 bag (folder or .mcap/.db3 file); a
+    robot entry's topic and effort win over --topic and --effort for its bags.
     """
 
     def tick(done: int, total: int, result: LogResult) -> None:
@@ -54,7 +67,7 @@ def energy(
     with progress() as say:
         result = fleet_energy(
             logs, manifest, out, report=report, scheduler=scheduler, workers=workers,
-            min_rise=min_rise, progress=tick,
+            min_rise=min_rise, progress=tick, bag=bag_options(topic, effort),
         )  # fmt: skip
     if as_json:
         click.echo(dumps(result))

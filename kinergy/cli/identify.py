@@ -8,12 +8,14 @@ from kinergy.cli.common import (
     accept_option,
     columns_option,
     cutoff_option,
+    effort_option,
     log_reading,
     output_file_option,
     progress,
     repair_option,
     table,
     tell,
+    topic_option,
     writes,
 )
 from kinergy.cli.validate import validation_text
@@ -162,6 +164,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 @output_file_option("--out", "Model file to write (TOML).", required=True)
 @columns_option
 @accept_option
+@topic_option
+@effort_option
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @click.option(
     "--friction",
@@ -217,6 +221,8 @@ def identify(
     cutoff: float | None,
     repair: bool,
     accept: tuple[str, ...],
+    topic: str | None,
+    effort: str | None,
 ) -> None:
     """Identify a model from controller logs and write it as a robot file.
 
@@ -225,7 +231,9 @@ def identify(
     actual_current; the full method regresses the base inertial parameters too.
     """
     r = load_robot(robot_name)
-    reading = log_reading(r, columns=columns, repair=repair, cutoff=cutoff, accept=accept)
+    reading = log_reading(
+        r, columns=columns, repair=repair, cutoff=cutoff, accept=accept, topic=topic, effort=effort
+    )
     options = IdentifyOptions(
         method=Method(method),
         friction=friction,

@@ -7,6 +7,7 @@ import click
 from kinergy.cli.common import (
     accept_option,
     columns_option,
+    effort_option,
     load,
     log_reading,
     payload_option,
@@ -15,6 +16,7 @@ from kinergy.cli.common import (
     repair_option,
     report_folder_option,
     tell,
+    topic_option,
     writes,
 )
 from kinergy.errors import KinergyError
@@ -49,6 +51,8 @@ __all__ = ["report"]
 @report_folder_option()
 @columns_option
 @accept_option
+@topic_option
+@effort_option
 @payload_option
 @repair_option
 @writes(folders=("out",), inputs=("model", "identify_logs", "validate_logs", "energy_logs"))
@@ -62,12 +66,16 @@ def report(
     payload: str | None,
     repair: bool,
     accept: tuple[str, ...],
+    topic: str | None,
+    effort: str | None,
 ) -> None:
     """Build the study report (tables, figures, report.html) from your own model and logs."""
     if not (identify_logs or validate_logs or energy_logs):
         raise KinergyError("report: give logs with --identify, --validate or --energy")
     robot = load(model, payload)
-    reading = log_reading(robot, columns=columns, repair=repair, accept=accept)
+    reading = log_reading(
+        robot, columns=columns, repair=repair, accept=accept, topic=topic, effort=effort
+    )
     with progress() as say:
         path, tables, said = study_report(
             robot,

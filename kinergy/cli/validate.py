@@ -12,12 +12,14 @@ from kinergy.cli.common import (
     accept_option,
     columns_option,
     cutoff_option,
+    effort_option,
     load,
     log_reading,
     payload_option,
     repair_option,
     table,
     tell,
+    topic_option,
     writes,
 )
 from kinergy.identify.metrics import JointMetrics
@@ -117,6 +119,8 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
 @click.argument("logs", metavar="LOG...", nargs=-1, required=True)
 @columns_option
 @accept_option
+@topic_option
+@effort_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option(
     "--plots",
@@ -139,10 +143,14 @@ def validate(
     payload: str | None,
     repair: bool,
     accept: tuple[str, ...],
+    topic: str | None,
+    effort: str | None,
 ) -> None:
     """How well a model predicts logs: torque (UR5e Table V) and current (Table VII) errors and R^2."""
     r = load(model, payload)
-    reading = log_reading(r, columns=columns, repair=repair, cutoff=cutoff, accept=accept)
+    reading = log_reading(
+        r, columns=columns, repair=repair, cutoff=cutoff, accept=accept, topic=topic, effort=effort
+    )
     report = validate_logs(r, logs, reading, plots=plots)
     tell(report.notes, report.warnings)
     if as_json:

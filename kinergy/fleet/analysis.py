@@ -196,7 +196,7 @@ def analyse_log(item: FleetLog) -> LogResult:
     try:
         with kernel_threads(1):  # the workers are the parallelism
             robot = _robot(item.model)
-            log = read_log(item.path)
+            log = read_log(item.path, joints=robot.joint_names, bag=item.bag)
             samples = len(log)
             for k, part in enumerate(split_segments(log)):
                 rows, found, span = _segment_cycles(robot, part, k)

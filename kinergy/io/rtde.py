@@ -16,6 +16,7 @@ Every problem is one line naming the file and, where it applies, the line and co
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import IO
@@ -39,6 +40,8 @@ def _selection(layout: LogLayout, select: Sequence[str] | None) -> dict[str, lis
     """Signal name -> indices of its columns in the file (``timestamp`` first), for the
     signals ``select`` names (default all)."""
     groups = group_columns(layout.names, str(layout.path))
+    # columns a spec skips (``_`` -> ``_0``, ``_1``, ...) are never read
+    groups = {name: cols for name, cols in groups.items() if not re.fullmatch(r"_\d*", name)}
     if select is not None:
         missing = [name for name in select if name not in groups]
         if missing:

@@ -22,6 +22,7 @@ import numpy as np
 from kinergy.errors import KinergyError
 from kinergy.io.formats import CHUNK_ROWS, iter_log
 from kinergy.io.log import Log
+from kinergy.io.rosbag import BagOptions
 from kinergy.logs.checks import Check, LogCheck, LogChecks
 from kinergy.model.robot import Robot
 
@@ -61,12 +62,16 @@ class LogReading:
         Low-pass cutoff for measured speeds, Hz; None: min(10 Hz, a fifth of the sample rate).
     accept : frozenset of Check
         Checks whose failure the user accepts (``--accept``); the results record them.
+    bag : BagOptions or None
+        How to read a ROS 2 bag (``--topic``, ``--effort``); None: its defaults. Refused for a
+        log that is not a bag.
     """
 
     columns: tuple[str, ...] | None = None
     repair: bool = False
     cutoff: float | None = None
     accept: frozenset[Check] = frozenset()
+    bag: BagOptions | None = None
 
 
 @dataclass(frozen=True)
@@ -177,6 +182,8 @@ class CheckedLog:
             repair=self.reading.repair,
             select=select,
             rows=self.rows,
+            joints=self.robot.joint_names,
+            bag=self.reading.bag,
         )
 
     def names(self) -> set[str]:
@@ -187,10 +194,16 @@ class CheckedLog:
     def _head(self) -> Log | None:
         if isinstance(self.source, Log):
             return self.source
-        return next(
-            iter_log(self.source, columns=self.reading.columns, repair=self.reading.repair, rows=2),
-            None,
+        reading = self.reading
+        chunks = iter_log(
+            self.source,
+            columns=reading.columns,
+            repair=reading.repair,
+            rows=2,
+            joints=self.robot.joint_names,
+            bag=reading.bag,
         )
+        return next(chunks, None)
 
     def _wanted(self) -> list[str] | None:
         """The signals to read: those selected and those the checks use, of the log's."""

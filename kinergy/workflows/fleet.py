@@ -14,6 +14,7 @@ from kinergy.fleet.manifest import fleet_logs, read_manifest
 from kinergy.fleet.parquet import write_cycles
 from kinergy.fleet.run import run_on_dask
 from kinergy.fleet.summary import FleetResult, summarise
+from kinergy.io.rosbag import BagOptions
 from kinergy.model.library import load_robot
 from kinergy.report.fleet import write_fleet_report
 
@@ -30,9 +31,11 @@ def fleet_energy(
     workers: int | None = None,
     min_rise: float = 0.05,
     progress: Callable[[int, int, LogResult], None] | None = None,
+    bag: BagOptions | None = None,
 ) -> FleetResult:
     """Analyse every log the manifest and ``logs`` name, write the cycles to ``out`` (Parquet)
-    and, with ``report``, the HTML fleet report into that folder.
+    and, with ``report``, the HTML fleet report into that folder. ROS 2 bags are read with their
+    robot entry's ``topic`` and ``effort``, else ``bag``'s.
 
     Raises
     ------
@@ -41,7 +44,7 @@ def fleet_energy(
         output that is an input, an unreachable scheduler, or no log that could be analysed.
     """
     fleet = read_manifest(manifest)
-    items = fleet_logs(fleet, logs)
+    items = fleet_logs(fleet, logs, bag)
     inputs = [Path(manifest), *(Path(i.path) for i in items)]
     inputs += [Path(m) for m in {i.model for i in items} if Path(m).is_file()]
     check_outputs([("--out", out), ("--report", report)], inputs)
