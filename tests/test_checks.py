@@ -223,3 +223,28 @@ def test_the_command_line_refuses_and_accepts(tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     assert any(a.startswith("speeds:") for a in result["inputs"][0]["checks"]["accepted"])
     assert "accepted" in out.read_text()
+
+
+def test_a_payload_the_model_lacks_is_named_not_refused():
+    """The twin of a UR5e carrying 3 kg: read for the bare ur5e, the log passes with a warning
+    that names the payload the torques fit (within 10 %)."""
+    from kinergy.model import Payload
+    from kinergy.simulate import TwinSettings, simulate
+    from kinergy.trajectory.programs import paper_trajectory
+
+    ur5e = load_robot("ur5e")
+    loaded = ur5e.with_payload(Payload(mass=3.0, com=[0.0, 0.0, 0.08]))
+    log = simulate(loaded, paper_trajectory(ur5e, "test-a", dt=0.004), TwinSettings(seed=4))
+    result = check_log(ur5e, log)
+    assert "robot" in result.passed
+    (text,) = [w for w in result.warnings if "that the model lacks" in w]
+    mass = float(text.split("carrying about ")[1].split(" kg")[0])
+    assert mass == pytest.approx(3.0, rel=0.1)
+
+
+@needs_data
+def test_joint_torques_read_as_currents_are_named():
+    """A ROS 2 bag's effort read as currents though it holds joint torques."""
+    log = _fourier()
+    wrong = _changed(log, actual_current=log["target_moment"])
+    assert "joint torques in N m logged as currents?" in _fails("ur10e", wrong, Check.RATINGS)

@@ -279,8 +279,11 @@ def test_a_bag_needs_the_robots_joints_and_no_columns(bag: Path, tmp_path: Path)
 def test_a_fleet_manifest_names_how_its_robots_bags_are_read(tmp_path: Path) -> None:
     from kinergy.fleet.analysis import analyse_log
     from kinergy.fleet.manifest import fleet_logs, read_manifest
+    from kinergy.predict import drive_state
 
-    t, q, qd, effort = _motion(300)
+    t, q, qd, _ = _motion(300)
+    qdd = np.gradient(qd, t, axis=0)
+    effort = drive_state(load_robot("ur10e"), q, qd, qdd).current  # currents a UR10e would draw
     write_bag(tmp_path / "cell-1" / "2024-05-06-run", t, q, qd, effort)
     write_bag(tmp_path / "cell-2" / "2024-05-07-run", t, q, qd, effort, topic="/arm/joint_states")
     manifest = tmp_path / "fleet.toml"

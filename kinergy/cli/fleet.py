@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from kinergy.cli.common import (
+    accept_option,
     bag_options,
     effort_option,
     note,
@@ -15,6 +16,7 @@ from kinergy.cli.common import (
 )
 from kinergy.fleet.analysis import LogResult
 from kinergy.jsonable import dumps
+from kinergy.logs.checks import parse_accept
 from kinergy.workflows.fleet import fleet_energy
 
 __all__ = ["fleet"]
@@ -38,6 +40,7 @@ def fleet() -> None:
 @click.option("--json", "as_json", is_flag=True, help="Print the robots as JSON.")
 @topic_option
 @effort_option
+@accept_option
 def energy(
     logs: tuple[str, ...],
     manifest: str,
@@ -49,6 +52,7 @@ def energy(
     as_json: bool,
     topic: str | None,
     effort: str | None,
+    accept: tuple[str, ...],
 ) -> None:
     """Energy per cycle of every log (LOGS and the manifest's globs), by robot and by day.
 
@@ -68,6 +72,7 @@ def energy(
         result = fleet_energy(
             logs, manifest, out, report=report, scheduler=scheduler, workers=workers,
             min_rise=min_rise, progress=tick, bag=bag_options(topic, effort),
+            accept=parse_accept(accept),
         )  # fmt: skip
     if as_json:
         click.echo(dumps(result))

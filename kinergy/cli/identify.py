@@ -249,14 +249,18 @@ def identify(
             say(f"reading and identifying {len(logs)} log(s) ({method} method)")
             result = identify_logs(r, logs, out, reading=reading, options=options)
     if payload_only:
-        tell([*inputs.notes, *report.notes], inputs.warnings)
+        # the checks' "a payload the model lacks" is what this identifies: routine here
+        lacks = [w for w in inputs.warnings if "that the model lacks" in w]
+        notes = [*inputs.notes, *lacks, *report.notes]
+        warnings = [w for w in inputs.warnings if w not in lacks]
+        tell(notes, warnings)
         summary = {
             "robot": r.name,
             "method": "payload",
             "payload": report,
             "inputs": inputs.records(),
-            "notes": [*inputs.notes, *report.notes],
-            "warnings": inputs.warnings,
+            "notes": notes,
+            "warnings": warnings,
         }
         click.echo(dumps(summary) if as_json else _payload_text(report, out))
         return

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import fmt, load, progress
+from kinergy.cli.common import accept_option, fmt, load, progress
 from kinergy.jsonable import dumps
 from kinergy.live.monitor import CycleEnergy
+from kinergy.logs.checks import parse_accept
 from kinergy.workflows.monitor import monitor_cycles
 
 __all__ = ["monitor"]
@@ -31,8 +32,14 @@ def _line(c: CycleEnergy) -> str:
 @click.option("--frequency", type=float, default=500.0, show_default=True, help="Hz.")
 @click.option("--duration", type=float, help="Stop after this many seconds of controller time.")
 @click.option("--json", "as_json", is_flag=True, help="At the end, print the cycles as JSON.")
+@accept_option
 def monitor(
-    address: str, model: str, frequency: float, duration: float | None, as_json: bool
+    address: str,
+    model: str,
+    frequency: float,
+    duration: float | None,
+    as_json: bool,
+    accept: tuple[str, ...],
 ) -> None:
     """Energy of every program cycle, live: the supply's (voltage x current) against the model's.
 
@@ -50,7 +57,13 @@ def monitor(
 
     with progress() as say:
         tracker = monitor_cycles(
-            address, robot, frequency=frequency, duration=duration, on_cycle=show, status=say
+            address,
+            robot,
+            frequency=frequency,
+            duration=duration,
+            on_cycle=show,
+            status=say,
+            accept=parse_accept(accept),
         )
     period = "not found" if tracker.period is None else f"{fmt(tracker.period)} s"
     if as_json:

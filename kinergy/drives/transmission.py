@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kinergy.arrays import Array
-from kinergy.model.robot import Robot
+from kinergy.model.robot import Robot, transmission_matrix
 
 __all__ = [
     "joint_torque",
@@ -34,13 +34,6 @@ __all__ = [
     "rotor_inertia",
     "transmission_matrix",
 ]
-
-
-def transmission_matrix(robot: Robot) -> Array:
-    """``N = diag(gear_ratio) @ coupling``, shape (n, n): motor speeds = ``N @ qd``."""
-    ratios = np.array([j.drive.gear_ratio for j in robot.joints])
-    assert robot.coupling is not None
-    return ratios[:, None] * robot.coupling
 
 
 def rotor_inertia(robot: Robot) -> Array:

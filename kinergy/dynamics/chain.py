@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
+from kinergy.model.frames import robot_transforms
 from kinergy.model.robot import Robot, inertia_matrix
 
 __all__ = [
@@ -39,23 +40,6 @@ __all__ = [
     "output_array",
     "z_first",
 ]
-
-
-def _rot_x(angle: float) -> Array:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
-def _rot_z(angle: float) -> Array:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def _hom(rot: ArrayLike, pos: ArrayLike) -> Array:
-    out = np.eye(4)
-    out[:3, :3] = rot
-    out[:3, 3] = pos
-    return out
 
 
 @dataclass(frozen=True)
@@ -86,25 +70,9 @@ class Chain:
 
 
 def make_chain(robot: Robot) -> Chain:
-    """Constant geometry of ``robot`` (a few 4x4 products; cheap)."""
-    n = robot.n
-    pre = np.tile(np.eye(4), (n, 1, 1))
-    post = np.tile(np.eye(4), (n, 1, 1))
-    for i, j in enumerate(robot.joints):
-        if robot.convention == "dh":
-            post[i] = (
-                _hom(_rot_z(j.offset), np.zeros(3))
-                @ _hom(np.eye(3), [0.0, 0.0, j.d])
-                @ _hom(np.eye(3), [j.a, 0.0, 0.0])
-                @ _hom(_rot_x(j.alpha), np.zeros(3))
-            )
-        else:
-            pre[i] = (
-                _hom(_rot_x(j.alpha), np.zeros(3))
-                @ _hom(np.eye(3), [j.a, 0.0, 0.0])
-                @ _hom(_rot_z(j.offset), np.zeros(3))
-                @ _hom(np.eye(3), [0.0, 0.0, j.d])
-            )
+    """Constant geometry of ``robot`` (a few 4x4 products; cheap): ``P_i`` and ``C_i`` of
+    :func:`kinergy.model.frames.robot_transforms`."""
+    pre, post = robot_transforms(robot)
     rc = post[:, :3, :3]
     pc = post[:, :3, 3]
     axis = rc[:, 2, :]  # R_C^T e_z = third row of R_C

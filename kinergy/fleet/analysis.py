@@ -43,8 +43,8 @@ from kinergy.fleet.manifest import FleetLog
 from kinergy.identify.cycles import find_period
 from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
-from kinergy.io.rtde import read_log
 from kinergy.io.segments import split_segments
+from kinergy.logs.reading import CheckedLog, LogReading
 from kinergy.model.library import load_robot
 from kinergy.model.robot import Robot
 
@@ -196,7 +196,8 @@ def analyse_log(item: FleetLog) -> LogResult:
     try:
         with kernel_threads(1):  # the workers are the parallelism
             robot = _robot(item.model)
-            log = read_log(item.path, joints=robot.joint_names, bag=item.bag)
+            reading = LogReading(bag=item.bag, accept=item.accept)
+            log = CheckedLog(item.path, robot, reading).read()  # the checks decide first
             samples = len(log)
             for k, part in enumerate(split_segments(log)):
                 rows, found, span = _segment_cycles(robot, part, k)

@@ -29,6 +29,7 @@ from pathlib import Path
 from kinergy.errors import KinergyError
 from kinergy.files import read_toml
 from kinergy.io.rosbag import BagOptions, Effort, bag_options, is_bag
+from kinergy.logs.checks import Check
 
 __all__ = ["FleetLog", "Manifest", "RobotEntry", "fleet_logs", "log_date", "read_manifest"]
 
@@ -75,6 +76,7 @@ class FleetLog:
     path: str
     date: dt.date
     bag: BagOptions | None = None
+    accept: frozenset[Check] = frozenset()
 
 
 def _text(table: dict[str, object], key: str, where: str) -> str:

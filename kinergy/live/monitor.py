@@ -30,13 +30,30 @@ from scipy.integrate import trapezoid
 from kinergy.accounting.energy import energy
 from kinergy.arrays import Array
 from kinergy.identify.cycles import find_period
+from kinergy.io.log import Log
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion
 
-__all__ = ["MONITOR_FIELDS", "CycleEnergy", "CycleTracker"]
+__all__ = ["MONITOR_FIELDS", "CycleEnergy", "CycleTracker", "rows_log"]
 
 
-#: what the monitor subscribes to
+def rows_log(path: str, names: Sequence[str], rows: Sequence[Sequence[float]], n: int) -> Log:
+    """Stream packages (flat values in the recipe's order of ``names``) as a :class:`Log`: the
+    supply's two values scalars, every other field one value per joint (``n``)."""
+    values = np.asarray(rows, dtype=float)
+    signals: dict[str, Array] = {}
+    k = 1
+    for name in names[1:]:
+        width = 1 if name in ("actual_robot_voltage", "actual_robot_current") else n
+        block = values[:, k : k + width]
+        signals[name] = block[:, 0] if width == 1 else block
+        k += width
+    return Log(path, values[:, 0], signals)
+
+
+#: what the monitor subscribes to (from the third on, where the controller has them; the
+#: measured motion and the reference torques and currents let the plausibility checks compare
+#: the stream with the model, :mod:`kinergy.logs.checks`)
 MONITOR_FIELDS = (
     "timestamp",
     "target_q",
@@ -44,6 +61,10 @@ MONITOR_FIELDS = (
     "target_qdd",
     "actual_robot_voltage",
     "actual_robot_current",
+    "actual_q",
+    "actual_qd",
+    "target_moment",
+    "actual_current",
 )
 
 

@@ -3,7 +3,7 @@ and the comments every exported file carries.
 
 The exports (:mod:`kinergy.model.urdf_export`, :mod:`kinergy.model.mjcf`) lay a robot out the
 same way: body i is the frame joint i turns in, ``F_{i-1} · P_i``
-(:func:`~kinergy.model.urdf.joint_transforms`), placed in body i-1 by ``C_{i-1} · P_i`` (``C_0``
+(:func:`~kinergy.model.frames.joint_transforms`), placed in body i-1 by ``C_{i-1} · P_i`` (``C_0``
 = the robot's base pose),
 with joint i about its z axis; link i's frame is ``C_i`` in body i, so its inertial sits at
 ``C_i · com`` with the axes of ``C_i``. The flange is ``C_n · flange`` in body n, the payload a
@@ -11,7 +11,7 @@ body rigidly fixed there.
 
 Drives referred to the joints (:class:`~kinergy.model.friction_line.JointSide`), with
 ``N = diag(gear_ratio) @ coupling``
-(:func:`~kinergy.model.friction_line.transmission`; motor speeds ``wm = N qd``, joint torques
+(:func:`~kinergy.model.robot.transmission_matrix`; motor speeds ``wm = N qd``, joint torques
 ``tau = N^T tau_m``):
 
 - reflected rotor and reducer inertia ``N^T diag(J_m + J_r) N`` (UR5e eq 2): its diagonal is a
@@ -34,10 +34,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinergy.arrays import Array
+from kinergy.model.frames import joint_transforms
 from kinergy.model.friction_line import LOADS, SPEED_FLOOR, SPEEDS, JointSide
 from kinergy.model.robot import Robot
 from kinergy.model.toml import matrix_rpy
-from kinergy.model.urdf import joint_transforms
 
 __all__ = [
     "COMPLETION_NOTE",

@@ -48,7 +48,7 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import get_model
-from kinergy.model.robot import Friction, Robot
+from kinergy.model.robot import Friction, Robot, transmission_matrix
 
 __all__ = [
     "LOADS",
@@ -60,7 +60,6 @@ __all__ = [
     "friction_lines",
     "joint_side",
     "motor_ranges",
-    "transmission",
 ]
 
 #: speeds per direction of the grid
@@ -114,18 +113,6 @@ class FrictionLine:
         return self.rms_error / self.rms_friction if self.rms_friction > 0.0 else 0.0
 
 
-def transmission(robot: Robot) -> Array:
-    """``N = diag(gear_ratio) @ coupling``, shape (n, n): motor speeds ``wm = N @ qd``.
-
-    The same matrix as :func:`kinergy.drives.transmission.transmission_matrix` (``model/`` sits
-    below ``drives/`` and cannot import it; the export tests check the two against each other
-    through MuJoCo).
-    """
-    ratios = np.array([j.drive.gear_ratio for j in robot.joints])
-    assert robot.coupling is not None
-    return ratios[:, None] * robot.coupling
-
-
 def motor_ranges(robot: Robot) -> tuple[Array, Array]:
     """The grid's range per motor: fastest speed and largest load, motor side.
 
@@ -138,7 +125,7 @@ def motor_ranges(robot: Robot) -> tuple[Array, Array]:
         ``L_max_k = sum_j |(N^-T)_kj| T_j`` (N m), ``T_j`` joint j's torque limit: the largest motor
         torque ``tau_m = N^-T tau`` for joint torques within their limits.
     """
-    n_mat = transmission(robot)
+    n_mat = transmission_matrix(robot)
     speed_limits = np.array([j.limits.speed for j in robot.joints])
     torque_limits = np.array([j.limits.torque for j in robot.joints])
     speed = np.abs(n_mat) @ speed_limits
@@ -256,7 +243,7 @@ class JointSide:
 def joint_side(robot: Robot, ranges: tuple[Array, Array] | None = None) -> JointSide:
     """The drives of ``robot`` referred to its joints (the friction lines over ``ranges``, see
     :func:`friction_lines`)."""
-    n_mat = transmission(robot)
+    n_mat = transmission_matrix(robot)
     lines = friction_lines(robot, ranges)
     rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
     b = np.array([line.viscous for line in lines])

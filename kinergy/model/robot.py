@@ -41,6 +41,7 @@ __all__ = [
     "Source",
     "Thermal",
     "inertia_matrix",
+    "transmission_matrix",
 ]
 
 
@@ -512,7 +513,10 @@ class Robot:
         object.__setattr__(self, "flange", _transform(self.flange, "flange"))
         object.__setattr__(self, "base", _transform(self.base, "base"))
         n = len(joints)
-        coupling = np.eye(n) if self.coupling is None else np.array(self.coupling, dtype=float)
+        try:
+            coupling = np.eye(n) if self.coupling is None else np.array(self.coupling, dtype=float)
+        except (TypeError, ValueError):  # ragged rows, text
+            raise KinergyError(f"coupling must be a finite {n}x{n} matrix of numbers") from None
         if coupling.shape != (n, n) or not np.all(np.isfinite(coupling)):
             raise KinergyError(
                 f"coupling must be a finite {n}x{n} matrix, got shape {coupling.shape}"
@@ -550,3 +554,11 @@ class Robot:
         if len(joints) != self.n:
             raise KinergyError(f"expected {self.n} joints, got {len(joints)}")
         return dataclasses.replace(self, joints=tuple(joints))
+
+
+def transmission_matrix(robot: Robot) -> Array:
+    """``N = diag(gear_ratio) @ coupling``, shape (n, n): motor speeds = ``N @ qd`` (nursing eq 3
+    for coupled joints; ``diag(gear_ratio)`` for independent ones)."""
+    ratios = np.array([j.drive.gear_ratio for j in robot.joints])
+    assert robot.coupling is not None
+    return ratios[:, None] * robot.coupling

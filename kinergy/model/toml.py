@@ -79,6 +79,7 @@ from kinergy.model.robot import (
 )
 
 __all__ = [
+    "identified_to_dict",
     "parse_payload",
     "read_robot_file",
     "robot_from_dict",
@@ -352,6 +353,20 @@ def _identified(data: Any) -> Identified:
     )
 
 
+def identified_to_dict(ident: Identified) -> dict[str, Any]:
+    """The ``[identified]`` table of a robot file (:class:`~kinergy.model.robot.Identified`)."""
+    return {
+        "kinergy": ident.kinergy,
+        "command": ident.command,
+        "options": dict(ident.options),
+        "accepted": list(ident.accepted),
+        "inputs": [
+            {"path": i.path, "sha256": i.sha256, "size": i.size, "rows": i.rows}
+            for i in ident.inputs
+        ],
+    }
+
+
 def _floats(arr: Any) -> Any:
     return np.asarray(arr, dtype=float).tolist()
 
@@ -388,17 +403,7 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         for cat in SOURCE_CATEGORIES
     }
     if robot.identified is not None:
-        ident = robot.identified
-        out["identified"] = {
-            "kinergy": ident.kinergy,
-            "command": ident.command,
-            "options": dict(ident.options),
-            "accepted": list(ident.accepted),
-            "inputs": [
-                {"path": i.path, "sha256": i.sha256, "size": i.size, "rows": i.rows}
-                for i in ident.inputs
-            ],
-        }
+        out["identified"] = identified_to_dict(robot.identified)
     joints = []
     for j in robot.joints:
         drive: dict[str, Any] = {key: getattr(j.drive, key) for key in _DRIVE_NUMBERS}

@@ -51,6 +51,7 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction.model import SMOOTHING
+from kinergy.model.frames import joint_transforms, mdh_transform
 from kinergy.model.friction_line import joint_side, motor_ranges
 from kinergy.model.robot import (
     CONVENTIONS,
@@ -74,12 +75,9 @@ from kinergy.model.urdf_extras import (
 
 __all__ = [
     "UrdfImport",
-    "dh_transform",
     "import_urdf",
-    "joint_transforms",
     "mdh_frames",
     "mdh_parameters",
-    "mdh_transform",
     "robot_from_urdf",
 ]
 
@@ -99,80 +97,8 @@ def _fail(where: str, message: str) -> KinergyError:
 
 
 # --------------------------------------------------------------------------------------------
-# MDH geometry: plain functions over arrays
+# MDH geometry: plain functions over arrays (the DH and MDH transforms: kinergy.model.frames)
 # --------------------------------------------------------------------------------------------
-
-
-def mdh_transform(a: float, alpha: float, offset: float, d: float) -> Array:
-    """``Rx(alpha) · Tx(a) · Rz(offset) · Tz(d)``, shape (4, 4): frame i in frame i-1 at q_i = 0.
-
-    Parameters
-    ----------
-    a, d : float
-        a_{i-1} and d_i, m.
-    alpha, offset : float
-        alpha_{i-1} and offset_i, rad.
-    """
-    ca, sa, ct, st = np.cos(alpha), np.sin(alpha), np.cos(offset), np.sin(offset)
-    return np.array(
-        [
-            [ct, -st, 0.0, a],
-            [ca * st, ca * ct, -sa, -sa * d],
-            [sa * st, sa * ct, ca, ca * d],
-            [0.0, 0.0, 0.0, 1.0],
-        ]
-    )
-
-
-def dh_transform(a: float, alpha: float, offset: float, d: float) -> Array:
-    """``Rz(offset) · Tz(d) · Tx(a) · Rx(alpha)``, shape (4, 4): standard DH frame i in frame i-1
-    at q_i = 0.
-
-    Parameters
-    ----------
-    a, d : float
-        a_i and d_i, m.
-    alpha, offset : float
-        alpha_i and offset_i, rad.
-    """
-    ca, sa, ct, st = np.cos(alpha), np.sin(alpha), np.cos(offset), np.sin(offset)
-    return np.array(
-        [
-            [ct, -st * ca, st * sa, a * ct],
-            [st, ct * ca, -ct * sa, a * st],
-            [0.0, sa, ca, d],
-            [0.0, 0.0, 0.0, 1.0],
-        ]
-    )
-
-
-def joint_transforms(convention: str, rows: Array) -> tuple[Array, Array]:
-    """The constant transforms of a chain: link frame i is ``F_{i-1} · P_i · Rz(q_i) · C_i``.
-
-    ``dh``: ``P_i = I``, ``C_i`` = :func:`dh_transform`; ``mdh``: ``P_i`` = :func:`mdh_transform`,
-    ``C_i = I`` (the chain of :mod:`kinergy.dynamics.chain`, which ``model/`` cannot import).
-    Joint i turns about the z axis of ``F_{i-1} · P_i``.
-
-    Parameters
-    ----------
-    convention : {'dh', 'mdh'}
-    rows : ndarray, shape (n, 4)
-        ``(a, alpha, offset, d)`` of each joint as the robot stores them (m, rad).
-
-    Returns
-    -------
-    pre, post : ndarray, shape (n, 4, 4)
-        ``P_i`` and ``C_i``.
-    """
-    n = len(rows)
-    pre = np.tile(np.eye(4), (n, 1, 1))
-    post = np.tile(np.eye(4), (n, 1, 1))
-    for i, (a, alpha, offset, d) in enumerate(rows):
-        if convention == "dh":
-            post[i] = dh_transform(a, alpha, offset, d)
-        else:
-            pre[i] = mdh_transform(a, alpha, offset, d)
-    return pre, post
 
 
 def _closest_points(p1: Array, z1: Array, p2: Array, z2: Array) -> tuple[Array, Array]:
@@ -908,6 +834,8 @@ def _restored(
     }
     if coupled:
         data["coupling"] = model.coupling
+    if model.identified is not None:
+        data["identified"] = model.identified
     payload = _payload(tree, model, where)
     if payload is not None:
         data["payload"] = payload

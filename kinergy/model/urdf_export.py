@@ -34,6 +34,7 @@ what a file leaves out: the rotor inertia (no URDF element), a friction family t
 
 from __future__ import annotations
 
+import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -54,6 +55,7 @@ from kinergy.model.export import (
 )
 from kinergy.model.friction_line import JointSide, joint_side
 from kinergy.model.robot import SOURCE_CATEGORIES, Robot
+from kinergy.model.toml import identified_to_dict
 from kinergy.model.urdf_extras import FORMAT_VERSION, NAMESPACE
 
 __all__ = ["robot_to_urdf"]
@@ -132,6 +134,9 @@ def _kinergy_element(robot: Robot, side: JointSide, names: tuple[str, str, str])
     if robot.payload is not None:
         model.set("payload", payload)
     ET.SubElement(model, _tag("description")).text = robot.description
+    if robot.identified is not None:  # where the model came from, as the robot file says it
+        record = identified_to_dict(robot.identified)
+        ET.SubElement(model, _tag("identified")).text = json.dumps(record, sort_keys=True)
     for cat in SOURCE_CATEGORIES:
         source = robot.sources[cat]
         ET.SubElement(model, _tag("source"), category=cat, status=source.status, ref=source.ref)

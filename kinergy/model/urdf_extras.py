@@ -15,6 +15,7 @@ Every problem is a one-line KinergyError naming the file, the element and the at
 
 from __future__ import annotations
 
+import json
 import math
 import xml.etree.ElementTree as ET
 from collections.abc import Collection, Mapping
@@ -135,6 +136,7 @@ class KinergyModel:
     sources: dict[str, dict[str, str]]
     coupling: list[list[float]] | None
     joints: tuple[KinergyJoint, ...]
+    identified: dict[str, Any] | None = None
 
 
 def _number(text: str | None, where: str) -> float:
@@ -318,7 +320,17 @@ def read_kinergy(root: ET.Element, where: str) -> KinergyModel | None:
             f"{mwhere} <kinergy:coupling>: must be {len(joints)} rows of {len(joints)} numbers "
             "(one per <kinergy:joint>)"
         )
+    identified = None
+    text = model.findtext(_tag("identified"))
+    if text is not None:
+        try:
+            identified = json.loads(text)
+        except ValueError:
+            raise KinergyError(f"{mwhere} <kinergy:identified>: not valid JSON") from None
+        if not isinstance(identified, dict):
+            raise KinergyError(f"{mwhere} <kinergy:identified>: must be a JSON object")
     return KinergyModel(
+        identified=identified,
         convention=_required(model, "convention", mwhere),
         gravity=poses["gravity"],
         standby_power=_number(model.get("standby_power", "0"), f"{mwhere} standby_power"),

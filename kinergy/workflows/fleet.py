@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from collections.abc import Callable, Sequence
@@ -15,6 +16,7 @@ from kinergy.fleet.parquet import write_cycles
 from kinergy.fleet.run import run_on_dask
 from kinergy.fleet.summary import FleetResult, summarise
 from kinergy.io.rosbag import BagOptions
+from kinergy.logs.checks import Check
 from kinergy.model.library import load_robot
 from kinergy.report.fleet import write_fleet_report
 
@@ -32,10 +34,13 @@ def fleet_energy(
     min_rise: float = 0.05,
     progress: Callable[[int, int, LogResult], None] | None = None,
     bag: BagOptions | None = None,
+    accept: frozenset[Check] = frozenset(),
 ) -> FleetResult:
     """Analyse every log the manifest and ``logs`` name, write the cycles to ``out`` (Parquet)
     and, with ``report``, the HTML fleet report into that folder. ROS 2 bags are read with their
-    robot entry's ``topic`` and ``effort``, else ``bag``'s.
+    robot entry's ``topic`` and ``effort``, else ``bag``'s. Every log passes the plausibility
+    checks (:mod:`kinergy.logs.checks`) but those in ``accept``; a log that fails one is
+    reported with the check's line as its error.
 
     Raises
     ------
@@ -44,7 +49,7 @@ def fleet_energy(
         output that is an input, an unreachable scheduler, or no log that could be analysed.
     """
     fleet = read_manifest(manifest)
-    items = fleet_logs(fleet, logs, bag)
+    items = [dataclasses.replace(i, accept=accept) for i in fleet_logs(fleet, logs, bag)]
     inputs = [Path(manifest), *(Path(i.path) for i in items)]
     inputs += [Path(m) for m in {i.model for i in items} if Path(m).is_file()]
     check_outputs([("--out", out), ("--report", report)], inputs)

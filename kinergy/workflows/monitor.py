@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from kinergy.errors import KinergyError
-from kinergy.live.monitor import MONITOR_FIELDS, CycleEnergy, CycleTracker
+from kinergy.live.monitor import MONITOR_FIELDS, CycleEnergy, CycleTracker, rows_log
 from kinergy.live.rtde import parse_address
 from kinergy.live.stream import Gap, Stream, stop_on_signals
+from kinergy.logs.checks import Check, LogCheck
 from kinergy.model.robot import Robot
 
 __all__ = ["monitor_cycles"]
@@ -23,9 +24,14 @@ def monitor_cycles(
     duration: float | None = None,
     on_cycle: Callable[[CycleEnergy], None] | None = None,
     status: Callable[[str], None] | None = None,
+    accept: frozenset[Check] = frozenset(),
 ) -> CycleTracker:
     """Follow the controller at ``address`` (``HOST[:PORT]``) until ``duration`` s of
     controller time, SIGINT or SIGTERM; ``on_cycle`` receives each cycle as it ends.
+
+    The stream is folded into the plausibility checks (:mod:`kinergy.logs.checks`) as it comes;
+    before the first cycle is reported their verdict is taken on what has been seen (a check
+    that fails, unless in ``accept``, stops the monitor with its line), and again at the end.
 
     Returns the tracker (its ``period`` and ``cycles``).
     """
@@ -37,11 +43,28 @@ def monitor_cycles(
         stream = Stream(
             host, port, MONITOR_FIELDS, frequency, optional=MONITOR_FIELDS[2:], status=status
         )
-        tracker = CycleTracker(robot, stream.recipe.names)
+        names = stream.recipe.names
+        tracker = CycleTracker(robot, names)
         if status is not None and not tracker.supply:
             status("the controller does not log its supply: predicted energy only")
+        check = LogCheck(robot, address, accept)
+        pending: list[Sequence[float]] = []
+        judged = False
         first: float | None = None
         updated = time.monotonic()
+
+        def report(cycles: list[CycleEnergy]) -> None:
+            nonlocal judged, pending
+            if pending:
+                check.add(rows_log(address, names, pending, robot.n))
+                pending = []
+            if cycles and not judged:
+                check.finish()  # raises when the stream is not this robot's, in these units
+                judged = True
+            for cycle in cycles:
+                if on_cycle is not None:
+                    on_cycle(cycle)
+
         try:
             while not stop.is_set():
                 item = stream.get(timeout=0.1)
@@ -52,14 +75,11 @@ def monitor_cycles(
                     if duration is not None and item[0] - first > duration:
                         break
                     tracker.add(item)
+                    pending.append(item)
                 if time.monotonic() - updated >= 0.25 or item is None:
-                    for cycle in tracker.update():
-                        if on_cycle is not None:
-                            on_cycle(cycle)
+                    report(tracker.update())
                     updated = time.monotonic()
         finally:
             stream.close()
-    for cycle in tracker.update():
-        if on_cycle is not None:
-            on_cycle(cycle)
+    report(tracker.update())
     return tracker
