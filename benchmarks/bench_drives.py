@@ -36,10 +36,10 @@ from kinergy.drives.electrics import DQ_VOLTAGE_FACTOR, back_emf_constants, wind
 from kinergy.dynamics.regressor import base_parameters, inertial_parameters
 from kinergy.friction.registry import friction_torque
 from kinergy.identify.full import FullFit, identify_full
-from kinergy.identify.preprocess import IdentData, prepare
 from kinergy.identify.result import IdentificationResult, predict
 from kinergy.io.rtde import read_log, write_log
 from kinergy.io.ur_calibration import read_ur_calibration
+from kinergy.logs.prepare import IdentData, prepare
 from kinergy.model.robot import Robot
 from kinergy.predict import drive_state
 from kinergy.simulate import TwinSettings, realistic_truth, simulate

@@ -21,9 +21,9 @@ import numpy as np
 
 import kinergy
 from kinergy.identify.full import identify_full
-from kinergy.identify.preprocess import prepare
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.rtde import read_log, write_log
+from kinergy.logs.prepare import prepare
 from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_motion
 

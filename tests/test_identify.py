@@ -15,11 +15,11 @@ import kinergy
 from kinergy.cli import main
 from kinergy.errors import KinergyError
 from kinergy.identify.payload import identify_payload
-from kinergy.identify.preprocess import prepare
 from kinergy.identify.result import validation_metrics
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.log import Log
 from kinergy.io.rtde import read_log
+from kinergy.logs.prepare import prepare
 from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_motion
 from kinergy.trajectory.programs import paper_trajectory

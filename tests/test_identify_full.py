@@ -27,9 +27,9 @@ from kinergy.identify.physical import (
     pseudo_inertia,
     standard_from_base,
 )
-from kinergy.identify.preprocess import IdentData, lowpass, prepare
 from kinergy.identify.result import IdentificationResult, validation_metrics
 from kinergy.io.log import Log
+from kinergy.logs.prepare import IdentData, lowpass, prepare
 from kinergy.model.robot import Friction, inertia_matrix
 from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_motion

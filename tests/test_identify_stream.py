@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 import kinergy
-from kinergy.identify.log_chunks import spill_log
 from kinergy.identify.sequential import identify_sequential, sequential_from
 from kinergy.identify.streamed import LogsInChunks, WholeSegment, streams
 from kinergy.io.rtde import write_log
+from kinergy.logs.prepare import spill_log
 from kinergy.logs.reading import CheckedLog, LogReading
 from kinergy.model import Robot, load_robot
 from kinergy.simulate import TwinSettings, realistic_truth, simulate

@@ -11,8 +11,8 @@ import pytest
 import kinergy
 from kinergy.cli import main
 from kinergy.identify.options import IdentifyOptions
-from kinergy.identify.preprocess import prepare
 from kinergy.io.rtde import read_log, write_log
+from kinergy.logs.prepare import prepare
 from kinergy.simulate import TwinSettings, realistic_truth, simulate
 from kinergy.trajectory.fourier import fourier_motion
 from kinergy.workflows.identify import identify_model

@@ -34,10 +34,10 @@ from kinergy.identify import nursing as nu
 from kinergy.identify.cycles import cycle_average, find_period
 from kinergy.identify.friction_points import constant_speed_runs, friction_points, odd_even_friction
 from kinergy.identify.makkar_fit import fit_makkar_lsq, fit_makkar_pso
-from kinergy.identify.preprocess import prepare
 from kinergy.identify.pso import constriction, particle_swarm
 from kinergy.identify.ridge import ridge_minimal
 from kinergy.io.log import Log
+from kinergy.logs.prepare import prepare
 from kinergy.model import load_robot, save_robot
 from kinergy.model.robot import Limits
 from kinergy.simulate import TwinSettings, simulate

@@ -15,8 +15,15 @@ from scipy.signal import butter, find_peaks, sosfreqz
 
 import kinergy
 from kinergy.errors import KinergyError
-from kinergy.identify.preprocess import estimate_lag, lowpass, prepare, running, uniform
 from kinergy.io.log import Log
+from kinergy.logs.prepare import (
+    estimate_lag,
+    lowpass,
+    prepare,
+    resample,
+    running_range,
+    uniform_grid,
+)
 from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import paper_trajectory
@@ -26,6 +33,18 @@ DT = 0.002  # the twin's (and a UR controller's) 500 Hz
 
 def _log(t: np.ndarray, **signals: np.ndarray) -> Log:
     return Log("mem.csv", np.asarray(t, dtype=float), signals)
+
+
+def running(log: Log) -> Log:
+    """The samples the preparation keeps (:func:`running_range`)."""
+    sl = running_range(log)
+    return Log(log.path, log.t[sl], {k: v[sl] for k, v in log.signals.items()})
+
+
+def uniform(log: Log) -> Log:
+    """``log`` on the grid the preparation resamples it to (:func:`uniform_grid`)."""
+    spec = uniform_grid(log.t)
+    return log if spec is None else resample(log, log.t[0] + spec[0] * np.arange(spec[1]))
 
 
 # --- running ------------------------------------------------------------------------------------
@@ -98,7 +117,7 @@ def test_running_raises_when_the_program_never_runs() -> None:
 
 def test_running_without_mode_columns_is_the_identity() -> None:
     log = _log(np.arange(10) * DT, x=np.ones(10))
-    assert running(log) is log
+    assert running_range(log) == slice(0, 10)
 
 
 # --- uniform ------------------------------------------------------------------------------------
@@ -374,6 +393,6 @@ def test_prepare_cuts_measured_torques_with_the_log() -> None:
     state = np.r_[np.full(50, 1.0), np.full(150, 2.0)]
     log = _log(log.t, runtime_state=state, **log.signals)
     torque = np.random.default_rng(8).normal(size=(200, 6))
-    d = prepare(log, 6, torque=torque)
+    d = prepare(_log(log.t, actual_joint_torque=torque, **log.signals), 6)
     assert d.torque is not None
     np.testing.assert_array_equal(d.torque, torque[50:])

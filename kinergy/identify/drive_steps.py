@@ -32,13 +32,13 @@ from kinergy.friction.registry import (
 )
 from kinergy.identify.columns import rotor_columns
 from kinergy.identify.friction_curve import search_shape
-from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import (
     IDENTIFIED,
     KEPT,
 )
 from kinergy.jsonable import OPTIONAL
 from kinergy.linalg import Reduced, scaled_lstsq, scaled_solution
+from kinergy.logs.prepare import IdentData
 from kinergy.messages import Messages
 from kinergy.model.robot import Friction, Joint, Robot
 

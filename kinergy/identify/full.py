@@ -79,7 +79,6 @@ from kinergy.errors import KinergyError
 from kinergy.friction.registry import MODELS, get_model, linear_values, with_linear_parameters
 from kinergy.identify.columns import Stacked, columns, joint_frictions, scale_row, stack
 from kinergy.identify.metrics import JointMetrics, fit_metrics
-from kinergy.identify.preprocess import IdentData
 from kinergy.identify.regression import (
     MAX_CONDITION,
     FlowFit,
@@ -101,6 +100,7 @@ from kinergy.identify.result import (
 from kinergy.identify.sequential import DrivesFromCurrents, drives_from_currents
 from kinergy.identify.writeback import WriteBack, write_back
 from kinergy.jsonable import OPTIONAL
+from kinergy.logs.prepare import IdentData
 from kinergy.messages import Messages
 from kinergy.model.robot import Friction, Robot
 
@@ -547,7 +547,7 @@ def identify_full(
         as they are; its link data, rotor inertias, torque constants and friction levels are the
         priors (kept where the logs cannot identify them, shrunk toward by ridge).
     datas : sequence of IdentData
-        Prepared logs (:func:`kinergy.identify.preprocess.prepare`), arrays (N, n).
+        Prepared logs (:func:`kinergy.logs.prepare.prepare`), arrays (N, n).
     target : {"auto", "moment", "torque", "current"}
         The signal regressed against: ``target_moment`` (N m) on the commanded motion without
         friction, measured joint torques (N m) or ``actual_current`` (A) on the real motion with

@@ -55,7 +55,6 @@ from kinergy.identify.physical import (
     parameter_scale,
     standard_from_base,
 )
-from kinergy.identify.preprocess import IdentData, lowpass
 from kinergy.identify.result import (
     DriveEstimate,
     Fit,
@@ -65,6 +64,7 @@ from kinergy.identify.result import (
 )
 from kinergy.identify.ridge import RidgeFit, ridge_minimal
 from kinergy.jsonable import OPTIONAL
+from kinergy.logs.prepare import IdentData, lowpass
 from kinergy.messages import Messages
 from kinergy.model.robot import Friction, Joint, Link, Robot, Source
 

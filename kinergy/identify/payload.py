@@ -35,8 +35,8 @@ from kinergy.drives.transmission import joint_torque
 from kinergy.dynamics.regressor import regressor
 from kinergy.errors import KinergyError
 from kinergy.identify.physical import inertia_vector, link_from_standard
-from kinergy.identify.preprocess import IdentData
 from kinergy.linalg import scaled_lstsq
+from kinergy.logs.prepare import IdentData
 from kinergy.model.robot import Payload, Robot
 from kinergy.predict import drive_state
 

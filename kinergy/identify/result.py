@@ -23,8 +23,8 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.drives.transmission import joint_torque
 from kinergy.identify.metrics import JointMetrics, fit_metrics
-from kinergy.identify.preprocess import IdentData
 from kinergy.jsonable import to_jsonable
+from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs
 from kinergy.messages import Messages
 from kinergy.model.robot import Joint, Robot

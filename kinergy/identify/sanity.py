@@ -8,7 +8,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from kinergy.errors import KinergyError
-from kinergy.identify.preprocess import IdentData
+from kinergy.logs.prepare import IdentData
 
 __all__ = ["LIMITS", "STILL_SPAN", "check_motion", "check_signals"]
 

@@ -48,7 +48,6 @@ from kinergy.identify.drive_steps import (
     stack,
     with_rotor_inertias,
 )
-from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import (
     AT_BOUND,
     IDENTIFIED,
@@ -62,6 +61,7 @@ from kinergy.identify.result import (
 )
 from kinergy.jsonable import OPTIONAL
 from kinergy.linalg import Reduced
+from kinergy.logs.prepare import IdentData
 from kinergy.messages import Messages
 from kinergy.model.robot import Joint, Robot, Source
 
@@ -247,7 +247,7 @@ def identify_sequential(
     robot : Robot
         The starting model: its link data are kept.
     datas : sequence of IdentData
-        Prepared logs (:func:`kinergy.identify.preprocess.prepare`). Rotor inertias need
+        Prepared logs (:func:`kinergy.logs.prepare.prepare`). Rotor inertias need
         ``target_moment``; torque constants and friction need ``actual_current``.
     friction : str, optional
         Friction model for every joint (default: each joint's model in ``robot``); it must be

@@ -21,7 +21,7 @@ folding the chunk into a small accumulator and dropping it:
    makes its own pass only when step 3 could not.
 
 Memory holds one chunk and these accumulators, whatever the logs' length; the temporary files
-(the log's spill, :mod:`kinergy.identify.log_chunks`, and the prepared chunks) hold the samples
+(the log's spill, :mod:`kinergy.logs.prepare`, and the prepared chunks) hold the samples
 on disk and are removed when closed.
 
 Friction held through standstill (:mod:`kinergy.friction.standstill`) is the one thing that
@@ -71,22 +71,16 @@ from kinergy.identify.drive_steps import (
 )
 from kinergy.identify.electrics import ElectricsFit, ElectricsSums
 from kinergy.identify.metrics import MetricSums
-from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import Validation, predict
 from kinergy.identify.sanity import STILL_SPAN, check_signals
 from kinergy.identify.sequential import MotionSummary
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.linalg import Reduced
+from kinergy.logs.prepare import SAMPLE_FIELDS, IdentData
 from kinergy.model.robot import Joint, Robot
 from kinergy.predict import drive_state
 
 __all__ = ["LogsInChunks", "Segment", "WholeSegment", "streams"]
-
-
-#: IdentData fields that hold samples, (N, ...) each
-_FIELDS = tuple(
-    f.name for f in dataclasses.fields(IdentData) if f.name not in ("path", "lag", "source")
-)
 
 
 class Segment(Protocol):
@@ -125,16 +119,6 @@ def streams(robot: Robot, method: str, friction: str | None) -> bool:
         return False
     models = {friction or j.drive.friction.model for j in robot.joints}
     return not any(get_model(m).search for m in models)
-
-
-def _join(parts: Sequence[IdentData]) -> IdentData:
-    """Samples of ``parts`` one after the other (a field is None when any part lacks it)."""
-    fields: dict[str, Array | None] = {}
-    for name in _FIELDS:
-        values = [getattr(p, name) for p in parts]
-        fields[name] = None if any(v is None for v in values) else np.concatenate(values)
-    last = parts[-1]
-    return IdentData(path=last.path, lag=last.lag, source=last.source, **fields)  # type: ignore[arg-type]
 
 
 class _History:
@@ -220,14 +204,16 @@ def _data_history(robot: Robot) -> _History:
 
     def take(x: IdentData, index: NDArray[np.int64]) -> IdentData:
         return (
-            _join([x.sliced(int(k), int(k) + 1) for k in index]) if index.size else x.sliced(0, 0)
+            IdentData.joined([x.sliced(int(k), int(k) + 1) for k in index])
+            if index.size
+            else x.sliced(0, 0)
         )
 
     def at_rest(x: IdentData) -> IdentData:
         zero = np.zeros_like(x.qd)
         return dataclasses.replace(x, qd=zero, qdd=zero, qd_cmd=zero, qdd_cmd=zero)
 
-    return _History(still, take, _join, at_rest, lambda x: x.qd @ n_mat.T)
+    return _History(still, take, IdentData.joined, at_rest, lambda x: x.qd @ n_mat.T)
 
 
 def _signal_history(still: float) -> _History:
@@ -301,7 +287,7 @@ class _Store:
 
     def put(self, segment: int, chunk: IdentData) -> None:
         """Append ``chunk`` of segment number ``segment``."""
-        present = [(n, getattr(chunk, n)) for n in _FIELDS if getattr(chunk, n) is not None]
+        present = [(n, getattr(chunk, n)) for n in SAMPLE_FIELDS if getattr(chunk, n) is not None]
         self.spool.put([a for _, a in present])
         # no sample, and no view of the chunk's arrays (which would keep them alive)
         empty: dict[str, Any] = {n: np.empty((0, *a.shape[1:])) for n, a in present}
@@ -348,7 +334,7 @@ class LogsInChunks:
                 check_signals([chunk])
                 self.store.put(k, chunk)
                 if first:
-                    self.has.append({f: getattr(chunk, f) is not None for f in _FIELDS})
+                    self.has.append({f: getattr(chunk, f) is not None for f in SAMPLE_FIELDS})
                     t0, first = float(chunk.t[0]), False
                 low = chunk.q.min(axis=0) if low is None else np.minimum(low, chunk.q.min(axis=0))
                 high = (

@@ -29,12 +29,12 @@ from kinergy.files import output_folder
 from kinergy.friction.model import SMOOTHING
 from kinergy.identify.metrics import fit_metrics
 from kinergy.identify.options import AUTO, IdentifyOptions
-from kinergy.identify.preprocess import IdentData, prepare
 from kinergy.identify.result import IdentificationResult, predict
 from kinergy.identify.sequential import identify_sequential
 from kinergy.io.motion import motion_from_log
 from kinergy.io.rtde import read_log, write_log
 from kinergy.io.task import load_task
+from kinergy.logs.prepare import IdentData, prepare
 from kinergy.model.library import load_robot
 from kinergy.model.robot import Friction, Robot
 from kinergy.report.html import Section, Table

@@ -19,7 +19,6 @@ from kinergy.identify.full import identify_full
 from kinergy.identify.nursing import identify_nursing
 from kinergy.identify.options import IdentifyOptions, Method
 from kinergy.identify.payload import PayloadEstimate, identify_payload
-from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import IDENTIFIED, IdentificationResult
 from kinergy.identify.sanity import check_motion, check_signals
 from kinergy.identify.sequential import identify_sequential, sequential_from
@@ -28,6 +27,7 @@ from kinergy.io.columns import compact_columns
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
 from kinergy.logs.checks import Check
+from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs, LogReading
 from kinergy.model import Payload, Robot, save_robot
 from kinergy.model.robot import Identified, InputRecord, Source

@@ -13,14 +13,19 @@ import os
 from collections.abc import Iterator, Sequence
 
 from kinergy.arrays import Array
-from kinergy.identify.log_chunks import SIGNALS, STATE, prepare_segment, spill_log, streamable
-from kinergy.identify.preprocess import IdentData, prepare
-from kinergy.identify.streamed import Segment, WholeSegment
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
 from kinergy.io.segments import segment_bounds
 from kinergy.io.urscript_reader import read_program
+from kinergy.logs.prepare import (
+    SIGNALS,
+    STATE,
+    IdentData,
+    PreparedSegment,
+    prepare_segment,
+    spill_log,
+)
 from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion
@@ -64,24 +69,14 @@ SPILLED = (*SIGNALS, *STATE)
 def prepared_logs(
     paths: Sequence[str | os.PathLike[str] | Log], robot: Robot, reading: LogReading
 ) -> tuple[list[IdentData], InputLogs]:
-    """Read (through the checks, :class:`~kinergy.logs.reading.CheckedLog`) and prepare every
-    log (:func:`kinergy.identify.preprocess.prepare`), each segment of a log on its own
-    (:func:`kinergy.io.segments.segment_bounds`: nothing is filtered or differentiated across a
+    """:func:`chunked_logs` with each segment prepared whole (one chunk): the logs read through
+    the checks, each segment of a log on its own (nothing is filtered or differentiated across a
     gap or a reconnection), as ``reading`` says.
 
     Segments shorter than :data:`MIN_SEGMENT` seconds are left out and counted in a note.
     """
-    datas: list[IdentData] = []
-    inputs = InputLogs()
-    for path in paths:
-        checked = CheckedLog(path, robot, reading)
-        log = checked.read()
-        inputs.add(checked)
-        segment = log.signals.get("segment")
-        for name, (a, b) in _segments(checked.path, log.t, segment, inputs.notes):
-            part = Log(name, log.t[a:b], {k: v[a:b] for k, v in log.signals.items()})
-            datas.append(prepare(part, robot.n, cutoff=reading.cutoff))
-    return datas, inputs
+    with chunked_logs(paths, robot, reading) as (segments, inputs):
+        return [s.whole() for s in segments], inputs
 
 
 @contextlib.contextmanager
@@ -91,15 +86,14 @@ def chunked_logs(
     reading: LogReading,
     *,
     rows: int = CHUNK_ROWS,
-) -> Iterator[tuple[list[Segment], InputLogs]]:
-    """:func:`prepared_logs` as segments that yield their samples in chunks of ``rows``
-    (:mod:`kinergy.identify.log_chunks`: each log read once, through the checks, into a
-    temporary spill, removed on leaving the context). A log without the commanded motion is
-    prepared whole (:class:`~kinergy.identify.streamed.WholeSegment`)."""
-    cutoff = reading.cutoff
+) -> Iterator[tuple[list[PreparedSegment], InputLogs]]:
+    """Every log read once, through the checks (:class:`~kinergy.logs.reading.CheckedLog`, in
+    chunks of ``rows``), into a temporary spill removed on leaving the context, and its segments
+    prepared (:func:`kinergy.logs.prepare.prepare_segment`): each yields its samples in chunks of
+    any size, equal to the whole segment's preparation."""
     inputs = InputLogs()
     with contextlib.ExitStack() as stack:
-        segments: list[Segment] = []
+        segments: list[PreparedSegment] = []
         for path in paths:
             checked = CheckedLog(path, robot, reading, select=SPILLED, rows=rows)
             spill = spill_log(checked)
@@ -107,13 +101,7 @@ def chunked_logs(
             inputs.add(checked)
             t, segment = spill.state.t, spill.state.signals.get("segment")
             for name, ab in _segments(checked.path, t, segment, inputs.notes):
-                if streamable(spill):
-                    segments.append(prepare_segment(spill, ab, name, robot.n, cutoff))
-                else:
-                    part = spill.read(*ab)
-                    state = {k: v[ab[0] : ab[1]] for k, v in spill.state.signals.items()}
-                    log = Log(name, part.t, {**part.signals, **state})
-                    segments.append(WholeSegment(prepare(log, robot.n, cutoff=cutoff)))
+                segments.append(prepare_segment(spill, ab, name, robot.n, reading.cutoff))
         yield segments, inputs
 
 

@@ -35,7 +35,7 @@ from kinergy.friction.makkar import makkar
 from kinergy.identify.friction_points import FrictionPoints, friction_points
 from kinergy.identify.makkar_fit import MakkarFit, fit_makkar_lsq, fit_makkar_pso
 from kinergy.identify.nursing import MotorFrictionFit, NursingFit, identify_nursing
-from kinergy.identify.preprocess import IdentData, prepare
+from kinergy.logs.prepare import IdentData, prepare
 from kinergy.model.robot import Robot
 from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.motion import Motion

@@ -8,11 +8,11 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from kinergy.identify.preprocess import IdentData
 from kinergy.identify.result import predict
 from kinergy.identify.sanity import check_signals
 from kinergy.identify.validation import ValidationReport, validation_report
 from kinergy.io.log import Log
+from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.report.plots import error_boxplot, save, time_series
