@@ -9,8 +9,8 @@ per joint with the four-way breakdown. Warm-up first (numba kernels), then min a
     python benchmarks/bench_energy.py [--repeats 15]
 
 ``--long``: the energy of a long UR log (issue 16 bar: a 60-minute 500 Hz log under 10 s and
-under 500 MB), the one-pass path (``energy_figures_of_log``: chunks of 50,000 rows) against the
-in-memory one (``energy_of_log``: the whole log read, then ``energy``), each in a fresh process
+under 500 MB), ``energy_of_log`` in chunks of 20,000 rows (``one-pass``) against the same with
+the whole log as one chunk (``in-memory``), each in a fresh process
 (so its peak resident memory is its own), on the log of ``benchmarks/bench_read.py`` (actual_q
 and actual_qd: accelerations from a spline of the speed). Prints the seconds of the call (after a
 numba warm-up), the process's peak RSS and the largest relative difference of the two results.
@@ -39,14 +39,12 @@ import json, resource, sys, time
 import numpy as np
 import kinergy
 from kinergy.predict import drive_state
-from kinergy.workflows.energy import energy_figures_of_log, energy_of_log
+from kinergy.workflows.energy import ENERGY_ROWS, energy_of_log
 robot = kinergy.load_robot("ur5e")
 drive_state(robot, np.zeros((8, 6)), np.ones((8, 6)), np.ones((8, 6)))  # numba warm-up
 start = time.perf_counter()
-if sys.argv[2] == "one-pass":
-    out = energy_figures_of_log(robot, sys.argv[1]).to_dict()
-else:
-    out = energy_of_log(robot, sys.argv[1]).to_dict()
+rows = ENERGY_ROWS if sys.argv[2] == "one-pass" else 10**9  # whole: one chunk
+out = energy_of_log(robot, sys.argv[1], rows=rows)[0].to_dict()
 seconds = time.perf_counter() - start
 rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 print(json.dumps({"seconds": seconds, "rss": rss, "report": out}))

@@ -248,3 +248,18 @@ def test_joint_torques_read_as_currents_are_named():
     log = _fourier()
     wrong = _changed(log, actual_current=log["target_moment"])
     assert "joint torques in N m logged as currents?" in _fails("ur10e", wrong, Check.RATINGS)
+
+
+def test_energy_and_validate_take_the_built_in_motions(capsys):
+    from kinergy.accounting.energy import energy
+    from kinergy.trajectory.programs import paper_trajectory
+
+    assert main(["energy", "ur5e", "test-a", "--json"]) == 0
+    got = json.loads(capsys.readouterr().out)
+    ur5e = load_robot("ur5e")
+    want = energy(ur5e, paper_trajectory(ur5e, "test-a")).total_e_elec
+    assert got["total"]["e_elec"] == pytest.approx(want, rel=1e-12)
+    assert main(["validate", "ur5e", "test-b"]) == 0
+    out, err = capsys.readouterr()
+    assert "Current against actual_current" in out
+    assert "test-b: the realistic twin of ur5e" in err

@@ -10,11 +10,13 @@ import numpy as np
 import pytest
 
 import kinergy
+from kinergy.accounting.energy import energy
 from kinergy.cli import main
-from kinergy.io.rtde import write_log
+from kinergy.io.rtde import read_log, write_log
 from kinergy.simulate import simulate
 from kinergy.trajectory.programs import paper_trajectory
-from kinergy.workflows.energy import energy_figures_of_log, energy_of_log
+from kinergy.workflows.energy import energy_of_log
+from kinergy.workflows.logs import read_motion
 
 RTOL = 1e-9
 
@@ -49,15 +51,21 @@ def long_log(tmp_path_factory: pytest.TempPathFactory, ur5e: kinergy.Robot) -> P
 
 @pytest.mark.parametrize("source", ["target", "actual"])
 @pytest.mark.parametrize("recovery", [True, False])
-def test_one_pass_equals_in_memory(
+def test_chunks_of_any_size_give_the_whole_logs_figures(
     ur5e: kinergy.Robot, long_log: Path, source: str, recovery: bool
 ) -> None:
     # actual: accelerations from a spline of the noisy speed, carried across chunk boundaries
-    want = energy_of_log(ur5e, long_log, source=source, recovery=recovery).to_dict()
-    got, _ = energy_figures_of_log(ur5e, long_log, source=source, recovery=recovery, rows=1000)
+    whole, _ = energy_of_log(ur5e, long_log, source=source, recovery=recovery, rows=10**7)
+    got, _ = energy_of_log(ur5e, long_log, source=source, recovery=recovery, rows=1000)
+    want = whole.to_dict()
     assert got.samples == want["samples"] >= 10_000 and got.segments == 1
     assert "measured" in want
     _assert_same(got.to_dict(), want)
+    # energy() of the log's motion held in memory: the same accounting as one chunk
+    motion, _ = read_motion(long_log, ur5e, source=source)
+    temperature = read_log(long_log)["joint_temperatures"]
+    held = energy(ur5e, motion, recovery=recovery, temperature=temperature).to_dict()
+    _assert_same(held, {k: v for k, v in want.items() if k != "measured"})
 
 
 def test_a_gap_is_never_integrated_across(
@@ -71,9 +79,7 @@ def test_a_gap_is_never_integrated_across(
     write_log(parts["b"], t_b, b.signals)
     joined = {k: np.concatenate([a[k], b[k]]) for k in a.signals}
     write_log(parts["ab"], np.concatenate([a.t, t_b]), joined)
-    one = {
-        k: energy_figures_of_log(ur5e, p, source="actual", rows=1000)[0] for k, p in parts.items()
-    }
+    one = {k: energy_of_log(ur5e, p, source="actual", rows=1000)[0] for k, p in parts.items()}
     ab, sa, sb = one["ab"], one["a"], one["b"]
     assert ab.segments == 2 and sa.segments == sb.segments == 1
     assert ab.duration == pytest.approx(sa.duration + sb.duration, rel=1e-12)
@@ -84,8 +90,9 @@ def test_a_gap_is_never_integrated_across(
     assert ab.supply.drawn == pytest.approx(sa.supply.drawn + sb.supply.drawn, rel=RTOL)
     assert ab.measured is not None and sa.measured is not None and sb.measured is not None
     assert ab.measured.drawn == pytest.approx(sa.measured.drawn + sb.measured.drawn, rel=RTOL)
-    # the in-memory path splits the same way
-    _assert_same(ab.to_dict(), energy_of_log(ur5e, parts["ab"], source="actual").to_dict())
+    # read whole, the log splits the same way
+    whole, _ = energy_of_log(ur5e, parts["ab"], source="actual", rows=10**7)
+    _assert_same(ab.to_dict(), whole.to_dict())
     assert main(["energy", "ur5e", str(parts["ab"])]) == 0
     text = capsys.readouterr().out
     assert "2 segments; gaps of 3600.000 s not integrated." in text

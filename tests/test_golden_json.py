@@ -40,8 +40,9 @@ NOISE_FREE: dict[str, Tolerance] = {
     "residual_std": (1e-2, 1e-8),
     "power_flow_mismatch": 2e-2,  # samples whose power-flow sign flips on noise near zero
 }
-#: keys whose values depend on the machine or the run (timings, temporary paths)
-VOLATILE = {"seconds", "time", "elapsed", "wall", "timings"}
+#: keys whose values depend on the machine or the run (timings, temporary paths; a model file
+#: written in the run records the temporary paths of its logs, so its hash and size vary)
+VOLATILE = {"seconds", "time", "elapsed", "wall", "timings", "sha256", "size"}
 
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")

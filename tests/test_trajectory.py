@@ -147,8 +147,8 @@ def test_fourier_series_derivatives_and_period() -> None:
         fourier_series(t, q0, a, b[:, :2], wf)
 
 
-def test_top_level_api_of_design_md() -> None:
-    # DESIGN.md: movej(waypoints, *, speed, acceleration, dt) returning a motion with .t .q .qd .qdd
+def test_top_level_movej_api() -> None:
+    # movej(waypoints, *, speed, acceleration, dt) returning a motion with .t .q .qd .qdd
     import kinergy
 
     m = kinergy.movej([[0.0, 0.0], [0.5, -0.2]], speed=1.0, acceleration=2.0, dt=0.01)

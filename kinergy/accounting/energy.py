@@ -25,125 +25,66 @@ What the arm draws from its supply -- the answer to "how much did it cost" -- is
 ``supply`` (:mod:`kinergy.accounting.supply`): the joints' powers shared on the DC bus, the
 surplus burnt in the shunt, plus standby. Where a log measured its supply, ``measured`` holds that
 figure beside it.
+
+One accounting serves every motion: :class:`EnergyAccumulator` folds chunks of a motion into
+running sums (every integral is a column of one matrix of integrands, integrated by the trapezoid
+rule; the last sample of a chunk is carried into the next, never across a segment boundary), so
+a long log is accounted in one pass in memory bounded by the chunk; :func:`energy` of a motion
+held in memory is the same fold over one chunk, and keeps the time series too.
 """
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from scipy.integrate import trapezoid
 
 from kinergy.accounting.figures import EnergyFigures
-from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy, supply_energy
+from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy
 from kinergy.arrays import Array
+from kinergy.drives.bus import supply_power
 from kinergy.drives.transmission import transmission_matrix
+from kinergy.errors import KinergyError
 from kinergy.io.segments import segment_bounds
 from kinergy.model.robot import Robot
 from kinergy.predict import DriveState, drive_state
 from kinergy.trajectory.motion import Motion
 
-__all__ = ["EnergyReport", "energy", "part_powers"]
+__all__ = ["BREAKDOWN", "EnergyAccumulator", "EnergyReport", "energy", "part_powers"]
 
 
 BREAKDOWN = ("inertial", "gravity", "friction", "copper")
 
 
-@dataclass(frozen=True, eq=False)
-class EnergyReport:
-    """Energy figures of one motion on one robot.
+@dataclass(frozen=True, eq=False, kw_only=True)
+class EnergyReport(EnergyFigures):
+    """:class:`~kinergy.accounting.figures.EnergyFigures` of one motion held in memory, with its
+    time series.
 
     Attributes
     ----------
-    robot : str
-    joints : list of str
     t : ndarray, shape (N,)
         s.
     p_mech, p_elec : ndarray, shape (N, n)
         Mechanical and electrical power per motor, W (clipped at 0 when ``recovery`` is False).
-    e_mech, e_elec : ndarray, shape (n,)
-        J, per joint.
-    breakdown : dict of str to ndarray, shape (n,)
-        ``inertial``, ``gravity``, ``friction``, ``copper`` parts of ``e_elec`` (signed integrals;
-        with ``recovery`` False they no longer add up to the clipped ``e_elec``).
     part_power : dict of str to ndarray, shape (N, n)
         The electrical power of each part over time, W (framework Fig. 4).
-    standby : float
-        Energy of the robot's constant standby power over the motion, J.
-    recovery : bool
-        Whether braking energy was counted as returned to the bus.
     drive : DriveState
         The drive model's torques, currents, voltages over the motion.
-    supply : SupplyEnergy
-        What the arm draws from its supply (bus model; module docstring).
-    measured : MeasuredSupply or None
-        The supply energy the log measured, where it did.
     """
 
-    robot: str
-    joints: list[str]
     t: Array
     p_mech: Array
     p_elec: Array
-    e_mech: Array
-    e_elec: Array
-    breakdown: dict[str, Array]
     part_power: dict[str, Array]
-    standby: float
-    total_e_mech: float
-    total_e_elec: float
-    recovery: bool
     drive: DriveState = field(repr=False)
-    supply: SupplyEnergy
-    measured: MeasuredSupply | None = None
-
-    @property
-    def duration(self) -> float:
-        """Seconds sampled: the sum of the segments' durations (gaps left out)."""
-        return float(sum(self.t[b - 1] - self.t[a] for a, b in segment_bounds(self.t)))
-
-    @property
-    def efficiency(self) -> Array:
-        """Per joint ``E_mech / E_elec`` (UR5e eq 24); NaN where ``E_elec`` is 0."""
-        return self.figures().efficiency
-
-    @property
-    def total_efficiency(self) -> float:
-        """``sum E_mech / sum E_elec`` over the joints (standby excluded), the seed's eta."""
-        return self.figures().total_efficiency
 
     def figures(self) -> EnergyFigures:
         """The report's figures without its time series (what ``energy`` prints)."""
-        return EnergyFigures(
-            robot=self.robot,
-            joints=self.joints,
-            duration=self.duration,
-            span=float(self.t[-1] - self.t[0]),
-            samples=int(self.t.size),
-            segments=len(segment_bounds(self.t)),
-            recovery=self.recovery,
-            e_mech=self.e_mech,
-            e_elec=self.e_elec,
-            breakdown=self.breakdown,
-            peak_power=np.max(self.p_elec, axis=0),
-            bus_peak=float(np.max(self.p_elec.sum(axis=1))),
-            rms_current=np.sqrt(np.mean(self.drive.current**2, axis=0)),
-            peak_current=np.max(np.abs(self.drive.current), axis=0),
-            standby=self.standby,
-            total_e_mech=self.total_e_mech,
-            total_e_elec=self.total_e_elec,
-            supply=self.supply,
-            measured=self.measured,
-        )
-
-    def to_dict(self) -> dict[str, Any]:
-        """The ``energy --json`` shape of DESIGN.md (:meth:`EnergyFigures.to_dict`)."""
-        return self.figures().to_dict()
-
-    def measured_dict(self) -> dict[str, Any]:
-        """The ``measured`` object of the JSON (:meth:`EnergyFigures.measured_dict`)."""
-        return self.figures().measured_dict()
+        names = EnergyFigures.__dataclass_fields__
+        return EnergyFigures(**{k: getattr(self, k) for k in names})
 
 
 def part_powers(robot: Robot, state: DriveState) -> dict[str, Array]:
@@ -162,6 +103,143 @@ def part_powers(robot: Robot, state: DriveState) -> dict[str, Array]:
     }
 
 
+class EnergyAccumulator:
+    """Running sums of an energy report over consecutive chunks of one motion.
+
+    Parameters
+    ----------
+    robot : Robot
+    recovery : bool
+        As :func:`energy`.
+
+    Examples
+    --------
+    ``acc.add(t, drive_state(robot, q, qd, qdd), starts=[0])`` per chunk, then
+    ``acc.figures()``.
+    """
+
+    def __init__(self, robot: Robot, *, recovery: bool = True) -> None:
+        self.robot = robot
+        self.recovery = recovery
+        n = robot.n
+        self._k = 6 * n + 4  # p_mech, p_elec, 4 parts (n each), totals, motors, shunt
+        self.sums: Array | None = None
+        self.last: tuple[float, Array] | None = None  # the previous sample, for the next chunk
+        self.first_t = float("nan")
+        self.duration = 0.0
+        self.samples = self.segments = 0
+        self.peak = np.full(n, -np.inf)
+        self.bus_peak = self.supply_peak = self.measured_peak = -np.inf
+        self.current_sq = np.zeros(n)
+        self.peak_current = np.zeros(n)
+
+    def _integrands(self, state: DriveState, measured: Array | None) -> Array:
+        """The chunk's integrands (N, K): every power the report integrates."""
+        p_mech, p_elec = state.p_mech, state.power
+        parts = part_powers(self.robot, state)
+        bus = supply_power(state.power, self.robot.standby_power)
+        tot_mech, tot_elec = p_mech.sum(axis=1), p_elec.sum(axis=1)
+        if not self.recovery:
+            p_mech, p_elec = np.maximum(p_mech, 0.0), np.maximum(p_elec, 0.0)
+            tot_mech, tot_elec = np.maximum(tot_mech, 0.0), np.maximum(tot_elec, 0.0)
+        self.peak = np.maximum(self.peak, p_elec.max(axis=0))
+        self.bus_peak = max(self.bus_peak, float(p_elec.sum(axis=1).max()))
+        self.supply_peak = max(self.supply_peak, float(bus.supply.max()))
+        cols = [p_mech, p_elec, *(parts[k] for k in BREAKDOWN)]
+        cols += [tot_mech[:, None], tot_elec[:, None], bus.motors[:, None], bus.shunt[:, None]]
+        if measured is not None:
+            self.measured_peak = max(self.measured_peak, float(measured.max()))
+            cols.append(measured[:, None])
+        return np.hstack(cols)
+
+    def add(
+        self,
+        t: Array,
+        state: DriveState,
+        *,
+        starts: list[int],
+        measured_power: Array | None = None,
+    ) -> None:
+        """Account the chunk at times ``t`` (s, (N,)) with drive state ``state``.
+
+        Parameters
+        ----------
+        t : ndarray, shape (N,)
+        state : DriveState
+            Of the chunk's motion.
+        starts : list of int
+            Indices into the chunk where a segment begins (``0`` when the chunk does not
+            continue the previous one's segment; the first chunk always begins one).
+        measured_power : ndarray, shape (N,), optional
+            The log's measured supply power (voltage x current), W; in every chunk or none.
+        """
+        y = self._integrands(state, measured_power)
+        if self.sums is None:
+            self.sums = np.zeros(y.shape[1])
+            self.first_t = float(t[0])
+            starts = sorted({0, *starts})
+        elif y.shape[1] != self.sums.size:
+            raise KinergyError("measured supply columns in some chunks of a log only")
+        cuts = sorted(starts)
+        tt, yy = t, y
+        if self.last is not None and (not cuts or cuts[0] != 0):
+            tt = np.concatenate([[self.last[0]], t])  # continue the previous chunk's segment
+            yy = np.vstack([self.last[1], y])
+            cuts = [c + 1 for c in cuts]
+        edges = [0, *(c for c in cuts if c > 0), tt.size]
+        for a, b in itertools.pairwise(edges):
+            self.sums += trapezoid(yy[a:b], tt[a:b], axis=0)
+            self.duration += float(tt[b - 1] - tt[a])
+        self.segments += len(starts)
+        self.samples += t.size
+        self.last = (float(t[-1]), y[-1].copy())
+        self.current_sq += np.sum(state.current**2, axis=0)
+        self.peak_current = np.maximum(self.peak_current, np.abs(state.current).max(axis=0))
+
+    def figures(self, measured: bool = False) -> EnergyFigures:
+        """The figures of everything added (:class:`EnergyFigures`), with the measured supply
+        when ``measured`` (chunks added with ``measured_power``)."""
+        if self.sums is None:
+            raise KinergyError("no samples to account")
+        n, s, d = self.robot.n, self.sums, self.duration
+        standby = self.robot.standby_power * d
+        motors, shunt = float(s[6 * n + 2]), float(s[6 * n + 3])
+        drawn = motors + standby
+        supply = SupplyEnergy(
+            drawn=drawn,
+            motors=motors,
+            standby=standby,
+            shunt=shunt,
+            mean_power=drawn / d if d else float("nan"),
+            peak_power=self.supply_peak,
+        )
+        meas = None
+        if measured:
+            used = float(s[6 * n + 4])
+            meas = MeasuredSupply(used, used / d if d else float("nan"), self.measured_peak)
+        return EnergyFigures(
+            robot=self.robot.name,
+            joints=self.robot.joint_names,
+            duration=d,
+            span=(self.last[0] if self.last else self.first_t) - self.first_t,
+            samples=self.samples,
+            segments=self.segments,
+            recovery=self.recovery,
+            e_mech=s[:n].copy(),
+            e_elec=s[n : 2 * n].copy(),
+            breakdown={k: s[(2 + i) * n : (3 + i) * n].copy() for i, k in enumerate(BREAKDOWN)},
+            peak_power=self.peak,
+            bus_peak=self.bus_peak,
+            rms_current=np.sqrt(self.current_sq / self.samples),
+            peak_current=self.peak_current,
+            standby=standby,
+            total_e_mech=float(s[6 * n]),
+            total_e_elec=float(s[6 * n + 1]),
+            supply=supply,
+            measured=meas,
+        )
+
+
 def energy(
     robot: Robot,
     motion: Motion,
@@ -169,14 +247,16 @@ def energy(
     recovery: bool = True,
     temperature: Array | None = None,
 ) -> EnergyReport:
-    """Per-joint and total mechanical and electrical energy of ``motion`` (UR5e eqs 23-26).
+    """Per-joint and total mechanical and electrical energy of ``motion`` (UR5e eqs 23-26): the
+    accumulation of :class:`EnergyAccumulator` over the motion as one chunk, with the time series.
 
     Parameters
     ----------
     robot : Robot
         The model (link data, payload, drives, friction, motor constants, standby power).
     motion : Motion
-        Joint angles, speeds and accelerations over time.
+        Joint angles, speeds and accelerations over time; a step longer than five sample periods
+        is a gap, never integrated across (:func:`kinergy.io.segments.segment_bounds`).
     recovery : bool
         True (default, as the seed): signed integrals, braking energy returns to the bus.
         False: negative power is clipped (see the module docstring).
@@ -189,41 +269,17 @@ def energy(
     EnergyReport
     """
     state = drive_state(robot, motion.q, motion.qd, motion.qdd, temperature=temperature)
-    t = motion.t
-    p_mech = state.p_mech
-    p_elec = state.power
-    pieces = segment_bounds(t)  # never integrate across a gap in the time stamps
-
-    def integral(power: Array) -> Array:
-        return np.asarray(
-            sum(trapezoid(power[a:b], t[a:b], axis=0) for a, b in pieces), dtype=float
-        )
-
-    part_power = part_powers(robot, state)
-    breakdown = {name: integral(power) for name, power in part_power.items()}
-    if recovery:
-        total_mech = float(integral(p_mech.sum(axis=1)[:, None])[0])
-        total_elec = float(integral(p_elec.sum(axis=1)[:, None])[0])
-    else:
-        total_mech = float(integral(np.maximum(p_mech.sum(axis=1), 0.0)[:, None])[0])
-        total_elec = float(integral(np.maximum(p_elec.sum(axis=1), 0.0)[:, None])[0])
-        p_mech = np.maximum(p_mech, 0.0)
-        p_elec = np.maximum(p_elec, 0.0)
-    recorded = float(sum(t[b - 1] - t[a] for a, b in pieces))  # gaps excluded
+    acc = EnergyAccumulator(robot, recovery=recovery)
+    acc.add(motion.t, state, starts=[a for a, _ in segment_bounds(motion.t)])
+    figures = acc.figures()
+    p_mech, p_elec = state.p_mech, state.power
+    if not recovery:
+        p_mech, p_elec = np.maximum(p_mech, 0.0), np.maximum(p_elec, 0.0)
     return EnergyReport(
-        robot=robot.name,
-        joints=robot.joint_names,
-        t=t,
+        **{k: getattr(figures, k) for k in EnergyFigures.__dataclass_fields__},
+        t=motion.t,
         p_mech=p_mech,
         p_elec=p_elec,
-        e_mech=integral(p_mech),
-        e_elec=integral(p_elec),
-        breakdown=breakdown,
-        part_power=part_power,
-        standby=robot.standby_power * recorded,
-        total_e_mech=total_mech,
-        total_e_elec=total_elec,
-        recovery=recovery,
+        part_power=part_powers(robot, state),
         drive=state,
-        supply=supply_energy(t, state.power, robot.standby_power),
     )

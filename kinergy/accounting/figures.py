@@ -1,8 +1,8 @@
 """The figures of an energy report: what ``energy`` prints and its ``--json`` holds.
 
-Both ways of accounting a motion end here: :func:`kinergy.accounting.energy.energy` (the whole
-motion in memory, :meth:`EnergyReport.figures`) and the one-pass accumulator of a long log
-(:mod:`kinergy.accounting.energy_stream`). Only scalars and per-joint vectors: no time series.
+What :class:`kinergy.accounting.energy.EnergyAccumulator` gives of a motion, however long (a
+motion held in memory adds its time series: :class:`kinergy.accounting.energy.EnergyReport`).
+Only scalars and per-joint vectors.
 """
 
 from __future__ import annotations
@@ -95,7 +95,7 @@ class EnergyFigures:
         }
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``energy --json`` shape of DESIGN.md (extra keys included); ``segments`` and
+        """The ``energy --json`` shape (its documented keys and more); ``segments`` and
         ``gaps`` (s not integrated) only when the log had gaps."""
         total_elec = self.total_e_elec + self.standby
         split = (

@@ -4,7 +4,9 @@ command writes (:func:`writes`), progress."""
 from __future__ import annotations
 
 import contextlib
+import enum
 import functools
+import hashlib
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
@@ -19,8 +21,9 @@ from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_output, check_outputs
 from kinergy.io.columns import parse_columns
 from kinergy.io.rosbag import bag_options
+from kinergy.jsonable import dumps, to_jsonable
 from kinergy.logs.checks import Check, parse_accept
-from kinergy.logs.reading import LogReading
+from kinergy.logs.reading import InputLogs, LogReading
 from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
@@ -31,6 +34,7 @@ __all__ = [
     "effort_option",
     "fmt",
     "fmt_vector",
+    "json_result",
     "load",
     "log_reading",
     "note",
@@ -243,6 +247,7 @@ def writes(
             check_outputs(outputs, sources)
             return command(**kwargs)
 
+        checked.kinergy_inputs = tuple(inputs)  # type: ignore[attr-defined]
         return checked  # type: ignore[return-value]
 
     return decorate
@@ -304,6 +309,51 @@ def tell(notes: Sequence[str], warnings: Sequence[str]) -> None:
         note(text)
     for text in warnings:
         warn(text)
+
+
+def _file_record(path: str) -> dict[str, Any]:
+    """``path``, ``sha256``, ``size`` (bytes) of an input file."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while block := fh.read(1 << 23):
+            digest.update(block)
+    return {"path": path, "sha256": digest.hexdigest(), "size": Path(path).stat().st_size}
+
+
+def _plain(value: Any) -> Any:
+    """An option's value as JSON holds it (enums as their names' values, tuples as lists)."""
+    if isinstance(value, enum.Enum):
+        return value.value
+    if isinstance(value, tuple | list):
+        return [_plain(v) for v in value]
+    return value
+
+
+def json_result(result: Any, inputs: InputLogs | None = None) -> str:
+    """``--json`` of a command: ``result`` (a typed result or a dict) with where it came from:
+    ``kinergy`` (``version``, ``command``, the command's ``options`` as given) and ``inputs``
+    (every input file by content: ``path``, ``sha256``, ``size``; a log also ``rows`` and its
+    ``checks``, from ``inputs``). A result that is a list is printed as it is."""
+    from kinergy import __version__
+
+    out = to_jsonable(result)
+    if not isinstance(out, dict):  # a list (robot list): nothing to record beside it
+        return dumps(out)
+    ctx = click.get_current_context()
+    logs = {r["path"]: r for r in (inputs.records() if inputs is not None else [])}
+    files: list[dict[str, Any]] = []
+    declared = getattr(ctx.command.callback, "kinergy_inputs", ())
+    for name in declared:
+        for path in _given(ctx.params.get(name)):
+            if path in logs:
+                files.append(logs.pop(path))
+            elif Path(path).is_file():
+                files.append(_file_record(path))
+    files += logs.values()
+    options = {k: _plain(v) for k, v in ctx.params.items() if k != "as_json"}
+    out["kinergy"] = {"version": __version__, "command": ctx.command_path, "options": options}
+    out["inputs"] = files
+    return dumps(out)
 
 
 def print_tables(tables: Mapping[str, Sequence[Any]], keys: Sequence[str]) -> None:

@@ -12,15 +12,16 @@ from kinergy.cli.common import (
     accept_option,
     columns_option,
     effort_option,
+    json_result,
     load,
     log_reading,
     payload_option,
     table,
     tell,
     topic_option,
+    writes,
 )
-from kinergy.jsonable import dumps
-from kinergy.workflows.energy import energy_figures_of_log
+from kinergy.workflows.energy import energy_of_log
 
 __all__ = ["energy", "energy_text"]
 
@@ -108,6 +109,7 @@ def energy_text(report: dict[str, Any]) -> str:
     help="Which motion of a log: commanded (target_*) or measured (actual_*).",
 )
 @payload_option
+@writes(inputs=("model", "motion_path"))
 def energy(
     model: str,
     motion_path: str,
@@ -129,7 +131,7 @@ def energy(
     """
     r = load(model, payload)
     reading = log_reading(r, columns=columns, accept=accept, topic=topic, effort=effort)
-    figures, inputs = energy_figures_of_log(
+    figures, inputs = energy_of_log(
         r, motion_path, reading, source=source, recovery=not no_recovery
     )
     report = {
@@ -139,4 +141,4 @@ def energy(
         "warnings": inputs.warnings,
     }
     tell(inputs.notes, inputs.warnings)
-    click.echo(dumps(report) if as_json else energy_text(report))
+    click.echo(json_result(report, inputs) if as_json else energy_text(report))

@@ -18,10 +18,9 @@ from typing import Any
 import click
 import numpy as np
 
-from kinergy.cli.common import output_file_option, progress, seed_option, writes
+from kinergy.cli.common import json_result, output_file_option, progress, seed_option, writes
 from kinergy.errors import KinergyError
 from kinergy.experiments.excitation_regression import CRITERIA
-from kinergy.jsonable import dumps
 from kinergy.model import Robot, load_robot
 from kinergy.workflows.excite import ExciteOptions, ExciteRun, run_excite
 
@@ -249,4 +248,4 @@ def excite(robot_name: str, as_json: bool, quiet: bool, **flags: Any) -> None:
     options = excite_options(robot, flags)
     with progress(quiet=quiet) as say:
         run = run_excite(robot, options, progress=say)
-    click.echo(dumps(run.to_dict()) if as_json else excite_text(run))
+    click.echo(json_result(run.to_dict()) if as_json else excite_text(run))

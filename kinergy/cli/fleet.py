@@ -8,6 +8,7 @@ from kinergy.cli.common import (
     accept_option,
     bag_options,
     effort_option,
+    json_result,
     note,
     output_file_option,
     progress,
@@ -15,7 +16,6 @@ from kinergy.cli.common import (
     topic_option,
 )
 from kinergy.fleet.analysis import LogResult
-from kinergy.jsonable import dumps
 from kinergy.logs.checks import parse_accept
 from kinergy.workflows.fleet import fleet_energy
 
@@ -75,7 +75,7 @@ def energy(
             accept=parse_accept(accept),
         )  # fmt: skip
     if as_json:
-        click.echo(dumps(result))
+        click.echo(json_result(result))
         return
     rows = [
         [r.name, str(r.logs), str(r.cycles), f"{r.energy_J / 1e3:.2f}",

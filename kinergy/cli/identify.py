@@ -9,6 +9,7 @@ from kinergy.cli.common import (
     columns_option,
     cutoff_option,
     effort_option,
+    json_result,
     log_reading,
     output_file_option,
     progress,
@@ -24,7 +25,6 @@ from kinergy.identify.full import FullFit
 from kinergy.identify.options import IdentifyOptions, Method, Solver, Target
 from kinergy.identify.payload import PayloadEstimate
 from kinergy.identify.result import FLAGS, IDENTIFIED, DriveEstimate, IdentificationResult
-from kinergy.jsonable import dumps
 from kinergy.model import load_robot
 from kinergy.workflows.identify import METHODS, identify_logs, identify_payload_model
 
@@ -262,7 +262,11 @@ def identify(
             "notes": notes,
             "warnings": warnings,
         }
-        click.echo(dumps(summary) if as_json else _payload_text(report, out))
+        click.echo(json_result(summary, inputs) if as_json else _payload_text(report, out))
         return
     tell(result.notes, result.warnings)
-    click.echo(dumps(result.to_dict()) if as_json else _result_text(result, len(logs), out))
+    click.echo(
+        json_result(result.to_dict(), result.inputs)
+        if as_json
+        else _result_text(result, len(logs), out)
+    )

@@ -10,7 +10,7 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from kinergy.cli.common import output_file_option, progress, seed_option, table, writes
+from kinergy.cli.common import json_result, output_file_option, progress, seed_option, table, writes
 from kinergy.files import atomic_write
 from kinergy.jsonable import dumps
 from kinergy.model import load_robot
@@ -141,6 +141,6 @@ def nursing(robot_name: str, as_json: bool, noise: bool, seed: int, out: str | N
         study = nursing_study(robot, noise=noise, seed=seed, progress=say)
     if out is not None:
         atomic_write(out, lambda fh: fh.write(dumps(study) + "\n"))
-    click.echo(dumps(study) if as_json else study_text(study))
+    click.echo(json_result(study) if as_json else study_text(study))
     if out is not None and not as_json:
         click.echo(f"wrote {out}")

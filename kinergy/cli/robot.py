@@ -13,6 +13,7 @@ import numpy as np
 from kinergy.cli.common import (
     fmt,
     fmt_vector,
+    json_result,
     load,
     note,
     output_file_option,
@@ -22,7 +23,6 @@ from kinergy.cli.common import (
 )
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write, check_outputs
-from kinergy.jsonable import dumps
 from kinergy.model import (
     SOURCE_CATEGORIES,
     Robot,
@@ -83,7 +83,7 @@ def robot_list(as_json: bool) -> None:
             }
             for r in robots
         ]
-        click.echo(dumps(out))
+        click.echo(json_result(out))
         return
     headers = ["name", "joints", "conv", *_PROVENANCE_COLUMNS, "description"]
     rows = [
@@ -206,12 +206,13 @@ def show_text(r: Robot) -> str:
 
 @robot.command("show")
 @click.argument("robot_name", metavar="ROBOT")
-@click.option("--json", "as_json", is_flag=True, help="Print the model as JSON (DESIGN.md shape).")
+@click.option("--json", "as_json", is_flag=True, help="Print the model as JSON.")
 @payload_option
+@writes(inputs=("robot_name",))
 def robot_show(robot_name: str, as_json: bool, payload: str | None) -> None:
     """Show a robot model: a built-in name (ur5e) or a robot file (.toml, .urdf)."""
     r = load(robot_name, payload)
-    click.echo(dumps(robot_to_dict(r)) if as_json else show_text(r))
+    click.echo(json_result(robot_to_dict(r)) if as_json else show_text(r))
 
 
 def _calibration_text(result: CalibrationImport, out: str, points: bool) -> str:
@@ -298,7 +299,7 @@ def robot_import_calibration(
     inputs = [calibration] + ([robot_name] if os.path.exists(robot_name) else [])
     check_outputs([("--out", out)], inputs)
     result = import_calibration(load_robot(robot_name), calibration, friction=friction, out=out)
-    click.echo(dumps(result) if as_json else _calibration_text(result, out, points))
+    click.echo(json_result(result) if as_json else _calibration_text(result, out, points))
 
 
 #: ``--format`` of ``robot export``: the writer of each format

@@ -13,6 +13,7 @@ from kinergy.cli.common import (
     columns_option,
     cutoff_option,
     effort_option,
+    json_result,
     load,
     log_reading,
     payload_option,
@@ -30,7 +31,6 @@ from kinergy.identify.validation import (
     SignalMetrics,
     ValidationReport,
 )
-from kinergy.jsonable import dumps
 from kinergy.workflows.validate import validate_logs
 
 __all__ = ["report_text", "validate", "validation_text"]
@@ -146,7 +146,11 @@ def validate(
     topic: str | None,
     effort: str | None,
 ) -> None:
-    """How well a model predicts logs: torque (UR5e Table V) and current (Table VII) errors and R^2."""
+    """How well a model predicts logs: torque (UR5e Table V) and current (Table VII) errors and R^2.
+
+    A LOG may also be a built-in motion (test-a, test-b): the log the realistic twin of MODEL
+    writes running it (a simulated robot that differs from the model as a real arm does).
+    """
     r = load(model, payload)
     reading = log_reading(
         r, columns=columns, repair=repair, cutoff=cutoff, accept=accept, topic=topic, effort=effort
@@ -154,7 +158,7 @@ def validate(
     report = validate_logs(r, logs, reading, plots=plots)
     tell(report.notes, report.warnings)
     if as_json:
-        click.echo(dumps(report))
+        click.echo(json_result(report, report.inputs))
         return
     click.echo(f"{r.name} on {', '.join(logs)}\n")
     click.echo(report_text(report, r.joint_names))

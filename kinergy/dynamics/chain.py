@@ -7,7 +7,7 @@ Both DH conventions are written as one chain: link frame i is
 - ``dh``:  ``P_i = I``,  ``C_i = Rz(offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i)``
 - ``mdh``: ``P_i = Rx(alpha_{i-1}) · Tx(a_{i-1}) · Rz(offset_i) · Tz(d_i)``,  ``C_i = I``
 
-(see DESIGN.md; for ``mdh`` Rz(q) commutes with Rz(offset) Tz(d)). Joint i turns about the z axis
+(:mod:`kinergy.model.frames`; for ``mdh`` Rz(q) commutes with Rz(offset) Tz(d)). Joint i turns about the z axis
 of ``F_{i-1} · P_i``. Frame 0 sits at ``robot.base`` in the base frame.
 """
 

@@ -18,7 +18,7 @@ Velocities are also clamped to the box's width per dimension, and a particle tha
 box stops at its wall with that velocity component set to zero (absorbing walls).
 
 The objective takes every particle at once: ``f(X)`` with ``X`` of shape (P, d) returns (P,).
-Optimisers take callables, not robots (DESIGN.md): the friction fit builds its objective and
+Optimisers take callables, not robots: the friction fit builds its objective and
 calls :func:`particle_swarm`.
 """
 

@@ -33,7 +33,7 @@ What reaches across chunk edges, and the pad that makes each chunk equal the who
 - the real motion is the commanded one delayed by the lag through a cubic spline
   (:func:`delay`). A spline's value at one knot depends on a knot ``k`` samples away with a
   weight that falls as ``(2 - sqrt(3))^k`` (0.27 per knot), so each chunk is splined with
-  :data:`~kinergy.io.motion_stream.HALO` (48) samples of its neighbours on each side (1e-27 at
+  :data:`~kinergy.io.motion.HALO` (48) samples of its neighbours on each side (1e-27 at
   the far end: the whole segment's spline to round-off), plus the lag in samples; at the
   segment's ends the window ends with the segment, as the whole-segment spline does;
 - the lag itself (:func:`estimate_lag`) compares the spline of the commanded speed with the
@@ -65,7 +65,7 @@ from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
-from kinergy.io.motion_stream import HALO
+from kinergy.io.motion import HALO
 from kinergy.io.segments import segment_bounds
 from kinergy.logs.reading import CheckedLog
 

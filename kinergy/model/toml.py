@@ -1,7 +1,7 @@
 """Robot files: TOML in and out, and the plain-dict form used for JSON.
 
 A robot file is TOML with the same structure as :func:`robot_to_dict` (which is also the
-``robot show --json`` shape of DESIGN.md)::
+``robot show --json`` shape)::
 
     name = "ur5e"
     convention = "dh"                 # or "mdh"

@@ -4,8 +4,8 @@ For each move from waypoint ``w_k`` to ``w_{k+1}`` the joint with the longest tr
 ``D = max_j |w_{k+1,j} - w_{k,j}|`` runs a trapezoidal speed profile with the given speed ``v``
 and acceleration ``a`` (a triangle when ``D < v^2 / a``); every other joint follows the same
 profile scaled by its own travel, so all joints start and stop together. This is what the UR
-controller plans (checked against its logged target profile in the tests:
-``../shared/datasets/ur3e-aurt/AllJoints_MoveJ_Target.csv``) and the "linear interpolation with
+controller plans (checked in the tests against the target profile a UR3e controller logged for
+one movej, the AURT project's ``AllJoints_MoveJ_Target.csv``) and the "linear interpolation with
 continuous acceleration blend" named in the UR5e doc, section 2.
 
 Blending: with a blend radius ``r`` (rad, on the leading joint; UR specifies a TCP radius in m,

@@ -2,26 +2,24 @@
 
 from __future__ import annotations
 
-import dataclasses
 import os
 
 import numpy as np
 
-from kinergy.accounting.energy import EnergyReport, energy
-from kinergy.accounting.energy_stream import EnergyAccumulator
+from kinergy.accounting.energy import EnergyAccumulator, energy
 from kinergy.accounting.figures import EnergyFigures
-from kinergy.accounting.supply import measured_supply
 from kinergy.arrays import Array
 from kinergy.io.log import Log
-from kinergy.io.motion import motion_from_log
-from kinergy.io.motion_stream import iter_motion
+from kinergy.io.motion import iter_motion
 from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.predict import drive_state
 from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.programs import paper_trajectory
 from kinergy.workflows.logs import read_motion
+from kinergy.workflows.twin import is_builtin
 
-__all__ = ["ENERGY_ROWS", "energy_figures_of_log", "energy_of_log"]
+__all__ = ["ENERGY_ROWS", "energy_of_log"]
 
 #: samples per chunk of the one-pass energy: 40 s at 500 Hz; the drive state of a chunk holds
 #: about 40 arrays of (rows, n) (60-minute log: peak 400 MB against 530 MB at 50,000 rows)
@@ -67,42 +65,27 @@ def energy_of_log(
     *,
     source: str = "auto",
     recovery: bool = True,
-) -> EnergyReport:
-    """The energy of the motion in a log or motion file (:func:`kinergy.accounting.energy.energy`),
-    with friction at the log's ``joint_temperatures`` where it has them, and the supply energy
-    the log measured (``actual_robot_voltage`` x ``actual_robot_current``) beside the predicted
-    one where it has both. A URScript program (``*.script``) is run as the controller would
-    (:func:`kinergy.workflows.logs.read_motion`)."""
-    if os.fspath(path).endswith(".script"):
-        motion, _ = read_motion(path, robot)
-        return energy(robot, motion, recovery=recovery)
-    log = CheckedLog(path, robot, reading or LogReading()).read()
-    motion = motion_from_log(log, n_joints=robot.n, source=source)
-    report = energy(robot, motion, recovery=recovery, temperature=_temperature(log, motion))
-    if "actual_robot_voltage" in log and "actual_robot_current" in log:
-        measured = measured_supply(log.t, log["actual_robot_voltage"], log["actual_robot_current"])
-        report = dataclasses.replace(report, measured=measured)
-    return report
-
-
-def energy_figures_of_log(
-    robot: Robot,
-    path: str | os.PathLike[str],
-    reading: LogReading | None = None,
-    *,
-    source: str = "auto",
-    recovery: bool = True,
     rows: int = ENERGY_ROWS,
 ) -> tuple[EnergyFigures, InputLogs]:
-    """The figures of :func:`energy_of_log` (what ``kinergy energy`` prints), a log read in one
-    pass through its checks: chunks of ``rows`` samples (:class:`~kinergy.logs.reading.CheckedLog`),
-    their motion as the whole log's (:func:`kinergy.io.motion_stream.iter_motion`), predicted
-    and accumulated (:class:`kinergy.accounting.energy_stream.EnergyAccumulator`); memory
-    bounded by the chunk. Segments (a time gap or a ``segment`` change) are never integrated
-    across. A URScript program takes the in-memory path. Also returns what the log was."""
+    """The energy of the motion in a log or motion file (what ``kinergy energy`` prints:
+    :class:`~kinergy.accounting.figures.EnergyFigures`) and what the log was: the log read in one
+    pass through its checks, in chunks of ``rows`` samples
+    (:class:`~kinergy.logs.reading.CheckedLog`), their motion as the whole log's
+    (:func:`kinergy.io.motion.iter_motion`), predicted (friction at the log's
+    ``joint_temperatures`` where it has them) and accumulated
+    (:class:`kinergy.accounting.energy.EnergyAccumulator`, with the supply energy the log
+    measured, ``actual_robot_voltage`` x ``actual_robot_current``, beside the predicted one);
+    memory bounded by the chunk. Segments (a time gap or a ``segment`` change) are never
+    integrated across. A URScript program (``*.script``) is run as the controller would
+    (:func:`kinergy.workflows.logs.read_motion`)."""
     inputs = InputLogs()
+    if is_builtin(path):  # test-a, test-b: the motion as planned for the robot
+        motion = paper_trajectory(robot, os.fspath(path))
+        inputs.notes.append(f"{path}: the built-in motion {path} planned for {robot.name}")
+        return energy(robot, motion, recovery=recovery).figures(), inputs
     if os.fspath(path).endswith(".script"):
-        return energy_of_log(robot, path, recovery=recovery).figures(), inputs
+        motion, _ = read_motion(path, robot)
+        return energy(robot, motion, recovery=recovery).figures(), inputs
     acc = EnergyAccumulator(robot, recovery=recovery)
     measured = False
     log = CheckedLog(path, robot, reading or LogReading(), rows=rows)

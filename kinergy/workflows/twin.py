@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from typing import TypeGuard
 
 from kinergy.io.log import Log
 from kinergy.io.rtde import write_log
@@ -14,13 +15,26 @@ from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import TEST_TRAJECTORIES, paper_trajectory
 from kinergy.workflows.logs import read_motion
 
-__all__ = ["simulate_to_file", "twin_truth"]
+__all__ = ["builtin_log", "is_builtin", "simulate_to_file", "twin_truth"]
 
 
 def twin_truth(robot: Robot, mismatch: str, seed: int) -> Robot:
     """The twin's true robot for ``--mismatch``: the model itself (``none``) or
     :func:`kinergy.simulate.realistic_truth` of it, seeded (``realistic``)."""
     return realistic_truth(robot, seed) if mismatch == "realistic" else robot
+
+
+def is_builtin(name: object) -> TypeGuard[str]:
+    """Whether ``name`` names a built-in motion (``test-a``, ``test-b``) rather than a file."""
+    return isinstance(name, str) and name in TEST_TRAJECTORIES and not os.path.exists(name)
+
+
+def builtin_log(robot: Robot, name: str, seed: int = 0) -> Log:
+    """The log the realistic twin of ``robot`` (:func:`twin_truth`, seeded) writes running the
+    built-in motion ``name`` planned on ``robot``: what a real arm's log of it looks like."""
+    truth = twin_truth(robot, "realistic", seed)
+    motion = paper_trajectory(robot, name)
+    return simulate(truth, motion, TwinSettings.realistic(seed), name=name)
 
 
 def _target(robot: Robot, trajectory: str, reading: LogReading) -> Motion:

@@ -17,6 +17,7 @@ from kinergy.logs.reading import InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.report.plots import error_boxplot, save, time_series
 from kinergy.workflows.logs import prepared_logs
+from kinergy.workflows.twin import builtin_log, is_builtin
 
 __all__ = ["identified_from", "validate_logs", "write_validation_plots"]
 
@@ -46,7 +47,14 @@ def validate_logs(
     and holding apart (:func:`~kinergy.identify.validation.validation_report`); with ``plots``,
     also write the measured-against-predicted figures to that folder. A log the model was
     identified from is named in a warning."""
-    datas, inputs = prepared_logs(logs, robot, reading or LogReading())
+    sources = [builtin_log(robot, str(log)) if is_builtin(log) else log for log in logs]
+    datas, inputs = prepared_logs(sources, robot, reading or LogReading())
+    inputs.notes += [
+        f"{log}: the realistic twin of {robot.name} (seed 0) running the built-in motion {log}: "
+        "a simulated log, not a real robot's"
+        for log in logs
+        if is_builtin(log)
+    ]
     check_signals(datas)
     report = validation_report(robot, list(datas))
     if plots is not None:
