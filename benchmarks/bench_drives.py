@@ -368,7 +368,7 @@ def supply(folder: Path, identified: Robot) -> None:
     path = folder / "test-a.csv"
     log = simulate(truth, paper_trajectory(model, "test-a"), TwinSettings.realistic(SEED + 1))
     write_log(path, log.t, log.signals)
-    report, _ = energy_of_log(identified, path)
+    report = energy_of_log(identified, path)
     assert report.measured is not None
     err = _pct(report.supply.drawn, report.measured.drawn)
     print(
@@ -376,7 +376,7 @@ def supply(folder: Path, identified: Robot) -> None:
         f"+ standby {report.supply.standby:.1f}), logged {report.measured.drawn:.1f} J: "
         f"{err:+.2f} % (bar 3 %)"
     )
-    plain, _ = energy_of_log(model, path)
+    plain = energy_of_log(model, path)
     print(
         f"the un-identified ur5e model on the same log: {plain.supply.drawn:.1f} J "
         f"({_pct(plain.supply.drawn, report.measured.drawn):+.1f} %)"

@@ -44,7 +44,7 @@ robot = kinergy.load_robot("ur5e")
 drive_state(robot, np.zeros((8, 6)), np.ones((8, 6)), np.ones((8, 6)))  # numba warm-up
 start = time.perf_counter()
 rows = ENERGY_ROWS if sys.argv[2] == "one-pass" else 10**9  # whole: one chunk
-out = energy_of_log(robot, sys.argv[1], rows=rows)[0].to_dict()
+out = energy_of_log(robot, sys.argv[1], rows=rows).to_dict()
 seconds = time.perf_counter() - start
 rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 print(json.dumps({"seconds": seconds, "rss": rss, "report": out}))

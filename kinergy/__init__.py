@@ -1,8 +1,15 @@
 """kinergy: electro-mechanical models of robot arms from the logs their controllers write.
 
-The public API at the top level::
+The public API at the top level mirrors the commands (:mod:`kinergy.api`)::
 
-    robot = kinergy.load_robot("ur5e")             # a built-in model, or a path to a file
+    robot = kinergy.load_robot("ur10e")             # a built-in model, or a path to a file
+    log = kinergy.read_log("run.csv", columns="timestamp,actual_q:6,...", robot=robot)
+    result = kinergy.identify(["run.csv"], robot, columns=..., out="my-ur10e.toml")
+    report = kinergy.validate(result.robot, ["held-out.csv"], columns=...)
+    kinergy.energy(result.robot, "held-out.csv", columns=...).supply.drawn   # J
+
+and the dynamics underneath::
+
     tau = kinergy.rnea(robot, q, qd, qdd)           # (N, n) joint torques, batched
     Y = kinergy.regressor(robot, q, qd, qdd)        # (N, n, 10 n)
     Y @ kinergy.inertial_parameters(robot)          # == tau
@@ -35,7 +42,15 @@ _API = {
     "mass_matrix": "kinergy.dynamics.rnea",
     "rnea": "kinergy.dynamics.rnea",
     "EnergyReport": "kinergy.accounting.energy",
-    "energy": "kinergy.accounting.energy",
+    "energy": "kinergy.api",
+    "identify": "kinergy.api",
+    "read_log": "kinergy.api",
+    "simulate": "kinergy.api",
+    "validate": "kinergy.api",
+    "IdentificationResult": "kinergy.identify.result",
+    "ValidationReport": "kinergy.identify.validation",
+    "LogEnergy": "kinergy.workflows.energy",
+    "Log": "kinergy.io.log",
     "KinergyError": "kinergy.errors",
     "Payload": "kinergy.model.robot",
     "Robot": "kinergy.model.robot",
@@ -49,16 +64,21 @@ _API = {
 __all__ = [
     "BaseParameters",
     "EnergyReport",
+    "IdentificationResult",
     "KinergyError",
+    "Log",
+    "LogEnergy",
     "Motion",
     "Payload",
     "Robot",
+    "ValidationReport",
     "__version__",
     "base_parameters",
     "energy",
     "flange_pose",
     "forward_dynamics",
     "gravity_torque",
+    "identify",
     "inertial_parameters",
     "jacobian",
     "library_names",
@@ -67,13 +87,17 @@ __all__ = [
     "mass_matrix",
     "movej",
     "parameter_names",
+    "read_log",
     "regressor",
     "rnea",
     "save_robot",
+    "simulate",
+    "validate",
 ]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from kinergy.accounting.energy import EnergyReport, energy
+    from kinergy.accounting.energy import EnergyReport
+    from kinergy.api import energy, identify, read_log, simulate, validate
     from kinergy.dynamics.kinematics import flange_pose, jacobian, link_poses
     from kinergy.dynamics.regressor import (
         BaseParameters,
@@ -84,11 +108,15 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     )
     from kinergy.dynamics.rnea import forward_dynamics, gravity_torque, mass_matrix, rnea
     from kinergy.errors import KinergyError
+    from kinergy.identify.result import IdentificationResult
+    from kinergy.identify.validation import ValidationReport
+    from kinergy.io.log import Log
     from kinergy.model.library import library_names, load_robot
     from kinergy.model.robot import Payload, Robot
     from kinergy.model.toml import save_robot
     from kinergy.trajectory.motion import Motion
     from kinergy.trajectory.movej import movej
+    from kinergy.workflows.energy import LogEnergy
 
 
 def __getattr__(name: str) -> Any:

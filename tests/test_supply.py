@@ -56,7 +56,7 @@ def exact_log(tmp_path_factory: pytest.TempPathFactory, ur5e: kinergy.Robot) -> 
 
 
 def test_exact_twin_supply_is_predicted_exactly(ur5e: kinergy.Robot, exact_log: Path) -> None:
-    report, _ = energy_of_log(ur5e, exact_log)
+    report = energy_of_log(ur5e, exact_log)
     assert report.measured is not None
     assert report.supply.drawn == pytest.approx(report.measured.drawn, rel=1e-6)
     # with braking surplus in the shunt the supply draws more than the signed bus integral

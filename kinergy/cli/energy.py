@@ -131,14 +131,7 @@ def energy(
     """
     r = load(model, payload)
     reading = log_reading(r, columns=columns, accept=accept, topic=topic, effort=effort)
-    figures, inputs = energy_of_log(
-        r, motion_path, reading, source=source, recovery=not no_recovery
-    )
-    report = {
-        **figures.to_dict(),
-        "inputs": inputs.records(),
-        "notes": inputs.notes,
-        "warnings": inputs.warnings,
-    }
-    tell(inputs.notes, inputs.warnings)
-    click.echo(json_result(report, inputs) if as_json else energy_text(report))
+    result = energy_of_log(r, motion_path, reading, source=source, recovery=not no_recovery)
+    tell(result.notes, result.warnings)
+    report = result.to_dict()
+    click.echo(json_result(report, result.inputs) if as_json else energy_text(report))

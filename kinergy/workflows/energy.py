@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -19,7 +21,36 @@ from kinergy.trajectory.programs import paper_trajectory
 from kinergy.workflows.logs import read_motion
 from kinergy.workflows.twin import is_builtin
 
-__all__ = ["ENERGY_ROWS", "energy_of_log"]
+__all__ = ["ENERGY_ROWS", "LogEnergy", "energy_of_log"]
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class LogEnergy(EnergyFigures):
+    """The energy of a log or motion file (:class:`~kinergy.accounting.figures.EnergyFigures`)
+    and what it was: the log by content with its checks, the notes and warnings of reading it.
+    :meth:`to_dict` is ``kinergy energy --json`` (without where the command came from)."""
+
+    inputs: InputLogs = field(default_factory=InputLogs)
+
+    @property
+    def notes(self) -> list[str]:
+        return list(self.inputs.notes)
+
+    @property
+    def warnings(self) -> list[str]:
+        return list(self.inputs.warnings)
+
+    def to_dict(self) -> dict[str, Any]:
+        out = super().to_dict()
+        out.update(inputs=self.inputs.records(), notes=self.notes, warnings=self.warnings)
+        return out
+
+
+def _with(figures: EnergyFigures, inputs: InputLogs) -> LogEnergy:
+    return LogEnergy(
+        **{k: getattr(figures, k) for k in EnergyFigures.__dataclass_fields__}, inputs=inputs
+    )
+
 
 #: samples per chunk of the one-pass energy: 40 s at 500 Hz; the drive state of a chunk holds
 #: about 40 arrays of (rows, n) (60-minute log: peak 400 MB against 530 MB at 50,000 rows)
@@ -66,9 +97,9 @@ def energy_of_log(
     source: str = "auto",
     recovery: bool = True,
     rows: int = ENERGY_ROWS,
-) -> tuple[EnergyFigures, InputLogs]:
-    """The energy of the motion in a log or motion file (what ``kinergy energy`` prints:
-    :class:`~kinergy.accounting.figures.EnergyFigures`) and what the log was: the log read in one
+) -> LogEnergy:
+    """The energy of the motion in a log or motion file and what the log was (what ``kinergy
+    energy`` prints: :class:`LogEnergy`): the log read in one
     pass through its checks, in chunks of ``rows`` samples
     (:class:`~kinergy.logs.reading.CheckedLog`), their motion as the whole log's
     (:func:`kinergy.io.motion.iter_motion`), predicted (friction at the log's
@@ -82,10 +113,10 @@ def energy_of_log(
     if is_builtin(path):  # test-a, test-b: the motion as planned for the robot
         motion = paper_trajectory(robot, os.fspath(path))
         inputs.notes.append(f"{path}: the built-in motion {path} planned for {robot.name}")
-        return energy(robot, motion, recovery=recovery).figures(), inputs
+        return _with(energy(robot, motion, recovery=recovery).figures(), inputs)
     if os.fspath(path).endswith(".script"):
         motion, _ = read_motion(path, robot)
-        return energy(robot, motion, recovery=recovery).figures(), inputs
+        return _with(energy(robot, motion, recovery=recovery).figures(), inputs)
     acc = EnergyAccumulator(robot, recovery=recovery)
     measured = False
     log = CheckedLog(path, robot, reading or LogReading(), rows=rows)
@@ -97,4 +128,4 @@ def energy_of_log(
         measured = power is not None
         acc.add(m.t, state, starts=part.starts, measured_power=power)
     inputs.add(log)
-    return acc.figures(measured=measured), inputs
+    return _with(acc.figures(measured=measured), inputs)

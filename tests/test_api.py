@@ -1,0 +1,99 @@
+"""The Python API mirrors the commands: the same results, whose ``to_dict()`` is the command's
+``--json`` but for the record of the command line (``kinergy``: version, command, options).
+Checked on the real UR10e logs (skipped when ../shared/datasets is absent) and on the twin."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import kinergy
+from kinergy.cli import main
+
+UR10E = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "ur10e-innopolis"
+SPEC = "timestamp,actual_q:6,actual_qd:6,actual_current:6,target_current:6,target_moment:6"
+FOURIER = [
+    UR10E / "identification_data" / f"ur-20_02_{n}.csv"
+    for n in ("12-50sec_12harm", "19_14harm50sec")
+]
+HELD_OUT = UR10E / "validation_data" / "ur-20_01_17-ptp_10_points.csv"
+
+
+def _cli(argv: list[str], capsys: pytest.CaptureFixture[str]) -> dict[str, Any]:
+    capsys.readouterr()
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out.pop("kinergy")["command"].startswith("kinergy ")
+    return out
+
+
+def _plain(x: Any) -> Any:
+    """JSON as the command prints it (NaN as null)."""
+    return json.loads(json.dumps(x, default=str).replace("NaN", "null"))
+
+
+def _same(api: Any, cli: Any, where: str = "") -> None:
+    if isinstance(cli, dict):
+        assert set(api) == set(cli), (where, set(api) ^ set(cli))
+        for k in cli:
+            _same(api[k], cli[k], f"{where}.{k}")
+    elif isinstance(cli, list):
+        assert len(api) == len(cli), where
+        for k, (a, c) in enumerate(zip(api, cli, strict=True)):
+            _same(a, c, f"{where}[{k}]")
+    elif isinstance(cli, float) and isinstance(api, float) and not math.isnan(cli):
+        assert api == pytest.approx(cli, rel=1e-12, abs=1e-15), where
+    else:
+        assert api == cli, where
+
+
+@pytest.mark.skipif(not UR10E.exists(), reason="shared datasets not available")
+def test_identify_validate_energy_equal_the_commands(tmp_path, capsys) -> None:
+    robot = kinergy.load_robot("ur10e")
+    result = kinergy.identify(FOURIER, robot, columns=SPEC, out=tmp_path / "api.toml")
+    argv = ["identify", *map(str, FOURIER), "--robot", "ur10e", "--columns", SPEC]
+    cli = _cli([*argv, "--out", str(tmp_path / "cli.toml"), "--json"], capsys)
+    _same(_plain(result.to_dict()), cli)
+    model = kinergy.load_robot(tmp_path / "api.toml")
+    assert model.identified is not None and len(model.identified.inputs) == 2
+
+    report = kinergy.validate(model, [HELD_OUT], columns=SPEC)
+    cli = _cli(
+        ["validate", str(tmp_path / "api.toml"), str(HELD_OUT), "--columns", SPEC, "--json"], capsys
+    )
+    cli["inputs"] = [i for i in cli["inputs"] if not i["path"].endswith(".toml")]  # the model file
+    _same(_plain(kinergy.jsonable.to_jsonable(report)), cli)
+
+    energy = kinergy.energy(model, HELD_OUT, columns=SPEC)
+    cli = _cli(
+        ["energy", str(tmp_path / "api.toml"), str(HELD_OUT), "--columns", SPEC, "--json"], capsys
+    )
+    cli["inputs"] = [i for i in cli["inputs"] if not i["path"].endswith(".toml")]
+    _same(_plain(energy.to_dict()), cli)
+
+
+def test_read_log_checks_with_a_robot_and_simulate_writes_the_twin() -> None:
+    from kinergy.api import simulate
+
+    log = simulate("ur5e", "test-b", mismatch="realistic", seed=2)
+    assert len(log) > 1000 and "actual_current" in log
+    with pytest.raises(kinergy.KinergyError, match="trajectory must be"):
+        simulate("ur5e", "test-c")
+    motion_energy = kinergy.energy(
+        "ur5e", kinergy.movej([[0] * 6, [1, -1, 1, 0, 1, 0]], speed=1.0, acceleration=2.0, dt=0.002)
+    )
+    assert motion_energy.total_e_elec > 0 and motion_energy.t.size > 100
+
+
+@pytest.mark.skipif(not UR10E.exists(), reason="shared datasets not available")
+def test_read_log_through_the_checks() -> None:
+    log = kinergy.read_log(HELD_OUT, columns=SPEC, robot="ur10e")
+    assert log["actual_q"].shape == (len(log), 6)
+    swapped = SPEC.replace("actual_q:6,actual_qd:6", "actual_qd:6,actual_q:6")
+    with pytest.raises(kinergy.KinergyError, match="speeds check failed"):
+        kinergy.read_log(HELD_OUT, columns=swapped, robot="ur10e")
+    assert len(kinergy.read_log(HELD_OUT, columns=swapped)) == len(log)  # unchecked without a robot
