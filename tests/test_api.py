@@ -53,8 +53,10 @@ def _same(api: Any, cli: Any, where: str = "") -> None:
 
 @pytest.mark.skipif(not UR10E.exists(), reason="shared datasets not available")
 def test_identify_validate_energy_equal_the_commands(tmp_path, capsys) -> None:
+    from kinergy.api import identify
+
     robot = kinergy.load_robot("ur10e")
-    result = kinergy.identify(FOURIER, robot, columns=SPEC, out=tmp_path / "api.toml")
+    result = identify(FOURIER, robot, columns=SPEC, out=tmp_path / "api.toml")
     argv = ["identify", *map(str, FOURIER), "--robot", "ur10e", "--columns", SPEC]
     cli = _cli([*argv, "--out", str(tmp_path / "cli.toml"), "--json"], capsys)
     _same(_plain(result.to_dict()), cli)

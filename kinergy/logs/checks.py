@@ -226,9 +226,9 @@ class _Moments:
         self.n += x.shape[0]
         self.sx += x.sum(axis=0)
         self.sy += y.sum(axis=0)
-        self.sxx += (x * x).sum(axis=0)
-        self.syy += (y * y).sum(axis=0)
-        self.sxy += (x * y).sum(axis=0)
+        self.sxx += np.einsum("ij,ij->j", x, x)
+        self.syy += np.einsum("ij,ij->j", y, y)
+        self.sxy += np.einsum("ij,ij->j", x, y)
 
     def slope(self) -> Array:
         """Least-squares slope of y on x through the origin."""
@@ -257,14 +257,19 @@ class _Thinned:
         self.index: list[NDArray[np.intp]] = []
         self.count = 0
 
-    def add(self, start: int, rows: dict[str, Array], valid: Array) -> None:
-        """Rows numbered ``start + k``; ``valid`` (k,) marks those that may be kept."""
-        k = np.flatnonzero(valid & ((start + np.arange(valid.size)) % self.stride == 0))
-        if k.size:
-            self.index.append(start + k)
+    def candidates(self, start: int, lo: int, hi: int) -> NDArray[np.intp]:
+        """The rows ``lo <= k < hi`` of a chunk starting at sample ``start`` that fall on the
+        stride."""
+        first = lo + (-(start + lo)) % self.stride
+        return np.arange(first, hi, self.stride)
+
+    def add(self, numbers: NDArray[np.intp], rows: dict[str, Array]) -> None:
+        """Rows of samples ``numbers`` (on the stride)."""
+        if numbers.size:
+            self.index.append(numbers)
             for name, x in rows.items():
-                self.rows.setdefault(name, []).append(x[k])
-            self.count += k.size
+                self.rows.setdefault(name, []).append(x)
+            self.count += numbers.size
         while self.count > self.size:
             self._halve()
 
@@ -352,18 +357,12 @@ class LogCheck:
                 self.period = float(np.median(steps))
                 stride = max(1, round(DIFF_SPAN / 2 / self.period)) if self.period > 0 else 1
                 self.thinned = _Thinned(ROBOT_ROWS, stride)
-        window = chunk if self.last is None else Log.concatenate([self.last, chunk])
-        skip = len(window) - len(chunk)
         self._extremes(chunk)
-        self._speeds(window, skip)
-        self._robot_rows(window, skip)
+        self._speeds(chunk)
+        self._robot_rows(chunk)
         self.samples += len(chunk)
-        keep = min(len(window), self._halo())
-        self.last = Log(
-            self.path,
-            window.t[-keep:],
-            {name: x[-keep:] for name, x in window.signals.items()},
-        )
+        last = slice(len(chunk) - 1, len(chunk))
+        self.last = Log(self.path, chunk.t[last], {k: x[last] for k, x in chunk.signals.items()})
 
     def _check_widths(self, chunk: Log) -> None:
         n = self.robot.n
@@ -371,12 +370,6 @@ class LogCheck:
             if FIELDS.get(name) == JOINTS and (x.ndim != 2 or x.shape[1] != n):
                 width = 1 if x.ndim == 1 else x.shape[1]
                 raise KinergyError(f"{self.path}: {name} has {width} joints but the robot has {n}")
-
-    def _halo(self) -> int:
-        """Samples of the previous chunk each chunk is checked with (a difference's reach)."""
-        if not self.period > 0:
-            return 1
-        return max(1, round(DIFF_SPAN / 2 / self.period)) + 1
 
     def _extremes(self, chunk: Log) -> None:
         for name, x in chunk.signals.items():
@@ -391,58 +384,58 @@ class LogCheck:
         step = np.diff(t)
         return (step > 0) & (step <= 5.0 * self.period)
 
-    def _speeds(self, window: Log, skip: int) -> None:
-        """Fold the steps that end in the new chunk (the first ``skip`` samples were folded
-        with the chunk before)."""
-        if len(window) < 2:
+    def _speeds(self, chunk: Log) -> None:
+        """Fold the chunk's steps, and the one from the previous chunk's last sample."""
+        t = chunk.t if self.last is None else np.concatenate([self.last.t, chunk.t])
+        if t.size < 2:
             return
-        ok = self._steps(window.t)
-        ok[: max(skip - 1, 0)] = False
-        dt = np.diff(window.t)[ok]
+        ok = self._steps(t)
+        every = bool(ok.all())
+        dt = np.diff(t) if every else np.diff(t)[ok]
         for (q_name, qd_name), moments in self.speeds.items():
-            if q_name not in window or qd_name not in window:
+            if q_name not in chunk or qd_name not in chunk or chunk[q_name].ndim != 2:
                 continue
-            q, qd = window[q_name], window[qd_name]
-            if q.ndim != 2 or qd.shape != q.shape:
-                continue
-            derivative = (np.diff(q, axis=0)[ok]) / dt[:, None]
-            logged = 0.5 * (qd[1:] + qd[:-1])[ok]
-            moments.add(logged, derivative)
+            q, qd = chunk[q_name], chunk[qd_name]
+            if self.last is not None:
+                q = np.concatenate([self.last[q_name], q])
+                qd = np.concatenate([self.last[qd_name], qd])
+            step, mean = np.diff(q, axis=0), 0.5 * (qd[1:] + qd[:-1])
+            if not every:
+                step, mean = step[ok], mean[ok]
+            moments.add(mean, step / dt[:, None])
 
-    def _robot_rows(self, window: Log, skip: int) -> None:
+    def _robot_rows(self, chunk: Log) -> None:
         """Keep evenly thinned rows of the motion and the logged torques and currents, with an
-        acceleration from the speed's central difference (rows without neighbours are not
-        kept)."""
+        acceleration from the speed's central difference (a chunk's first and last few rows,
+        which lack neighbours, are not kept)."""
         thinned = self.thinned
-        if thinned is None or len(window) < 3:
+        h = max(1, round(DIFF_SPAN / 2 / self.period)) if self.period > 0 else 1
+        if thinned is None or len(chunk) <= 2 * h:
             return
-        h = max(1, round(DIFF_SPAN / 2 / self.period))
+        k = thinned.candidates(self.samples, h, len(chunk) - h)
+        if not k.size:
+            return
+        t = chunk.t
         rows: dict[str, Array] = {}
-        valid = np.zeros(len(window), dtype=bool)
-        valid[h : len(window) - h] = True
-        valid[:skip] = False
-        t = window.t
+        valid = np.ones(k.size, dtype=bool)
         for prefix in ("target", "actual"):
             q_name, qd_name = f"{prefix}_q", f"{prefix}_qd"
-            if q_name not in window or qd_name not in window or window[q_name].ndim != 2:
+            if q_name not in chunk or qd_name not in chunk or chunk[q_name].ndim != 2:
                 continue
-            qd = window[qd_name]
-            if f"{prefix}_qdd" in window:
-                qdd = window[f"{prefix}_qdd"]
+            qd = chunk[qd_name]
+            if f"{prefix}_qdd" in chunk:
+                qdd = chunk[f"{prefix}_qdd"][k]
             else:
-                qdd = np.zeros_like(qd)
-                span = t[2 * h :] - t[: -2 * h]
-                qdd[h:-h] = (qd[2 * h :] - qd[: -2 * h]) / span[:, None]
+                span = t[k + h] - t[k - h]
+                qdd = (qd[k + h] - qd[k - h]) / span[:, None]
                 # a difference across a gap is no acceleration
-                ok = (span > 0) & (span <= 5.0 * 2 * h * self.period)
-                valid[h:-h] &= ok
-            rows[q_name], rows[qd_name], rows[f"{prefix}_qdd"] = window[q_name], qd, qdd
+                valid &= (span > 0) & (span <= 5.0 * 2 * h * self.period)
+            rows[q_name], rows[qd_name], rows[f"{prefix}_qdd"] = chunk[q_name][k], qd[k], qdd
         for name in (*_TORQUES, *_CURRENTS):
-            if name in window and window[name].ndim == 2:
-                rows[name] = window[name]
+            if name in chunk and chunk[name].ndim == 2:
+                rows[name] = chunk[name][k]
         if rows:
-            start = self.samples - skip
-            thinned.add(start, {k: v for k, v in rows.items()}, valid)
+            thinned.add(self.samples + k[valid], {n: x[valid] for n, x in rows.items()})
 
     # -- the verdict ---------------------------------------------------------------------------
 

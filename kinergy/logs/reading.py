@@ -20,6 +20,8 @@ from pathlib import Path
 import numpy as np
 
 from kinergy.errors import KinergyError
+from kinergy.io.columns import printable
+from kinergy.io.fields import closest, is_known
 from kinergy.io.formats import CHUNK_ROWS, iter_log
 from kinergy.io.log import Log
 from kinergy.io.rosbag import BagOptions
@@ -205,6 +207,22 @@ class CheckedLog:
         )
         return next(chunks, None)
 
+    def _check_names(self) -> None:
+        """Refuse a column whose name is not a known field but a misspelling of one the log
+        lacks (``actual_curent`` for ``actual_current``): a command needing it would otherwise
+        find nothing, or quietly do without. Names that resemble nothing known pass (a recorder
+        may log fields kinergy does not read)."""
+        have = self.names()
+        for name in sorted(have):
+            if is_known(name) or name.startswith("_"):
+                continue
+            guess = closest(name)
+            if guess is not None and guess not in have:
+                raise KinergyError(
+                    f"{self.path}: column {printable(name)} is not a field kinergy knows (did you "
+                    f"mean {guess}?): name it as UR's RTDE does"
+                )
+
     def _wanted(self) -> list[str] | None:
         """The signals to read: those selected and those the checks use, of the log's."""
         if self.select is None:
@@ -222,6 +240,7 @@ class CheckedLog:
             When the file cannot be read, and after the last chunk when a check failed that
             the user did not accept (:meth:`kinergy.logs.checks.LogCheck.finish`).
         """
+        self._check_names()
         check = LogCheck(self.robot, self.path, self.reading.accept)
         hashed: list[str] = []
         stop = threading.Event()
