@@ -10,7 +10,15 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from kinergy.cli.common import json_result, output_file_option, progress, seed_option, table, writes
+from kinergy.cli.common import (
+    json_result,
+    output_file_option,
+    progress,
+    seed_option,
+    table,
+    tell,
+    writes,
+)
 from kinergy.files import atomic_write
 from kinergy.jsonable import dumps
 from kinergy.model import load_robot
@@ -107,8 +115,6 @@ def study_text(study: NursingStudy) -> str:
         *_friction_text(study),
         "",
         *_ridge_text(study),
-        *[f"note: {note}" for note in study.excitation_notes],
-        *[f"warning: {warning}" for warning in study.warnings],
         f"time: friction runs {t.friction:.1f} s, excitation {t.excitation:.1f} s, "
         f"identification {t.identify:.1f} s",
     ]
@@ -141,6 +147,7 @@ def nursing(robot_name: str, as_json: bool, noise: bool, seed: int, out: str | N
         study = nursing_study(robot, noise=noise, seed=seed, progress=say)
     if out is not None:
         atomic_write(out, lambda fh: fh.write(dumps(study) + "\n"))
+    tell(study.excitation_notes, study.warnings)
     click.echo(json_result(study) if as_json else study_text(study))
     if out is not None and not as_json:
         click.echo(f"wrote {out}")

@@ -144,6 +144,8 @@ class LogChecks:
 # --------------------------------------------------------------------------------------------
 # thresholds
 
+#: a magnitude no signal of a robot's log reaches in any unit (kinergy refuses it outright)
+ABSURD = 1e9
 #: s: the plausible sample periods of a controller log
 PERIOD_RANGE = (5e-4, 0.1)
 #: rad: a joint whose position spans less than this does not move (nothing to compare)
@@ -452,6 +454,7 @@ class LogCheck:
             return self._finish()
 
     def _finish(self) -> LogChecks:
+        self._check_magnitudes()
         found = _Findings()
         moving = self._moving()
         self._check_time(found)
@@ -477,6 +480,17 @@ class LogCheck:
             not_checked=tuple(f"{c.value}: {why}" for c, why in found.skipped.items()),
             warnings=tuple(f"{self.path}: {w}" for w in found.warnings),
         )
+
+    def _check_magnitudes(self) -> None:
+        """Refuse values no robot logs in any unit (beyond :data:`ABSURD`): a corrupted log,
+        whatever is accepted (computing on them would only overflow)."""
+        for name in sorted(self.lo):
+            peak = float(np.max(np.maximum(np.abs(self.lo[name]), np.abs(self.hi[name]))))
+            if not peak <= ABSURD:
+                raise KinergyError(
+                    f"{self.path}: {name} holds {peak:.3g}: not a value a robot logs in any unit "
+                    "(a corrupted log; no --accept lets it through)"
+                )
 
     def _moving(self) -> Array:
         """Per joint, whether it moves in the log (its position spans :data:`MOVE_SPAN`)."""
