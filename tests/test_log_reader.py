@@ -154,3 +154,28 @@ def test_the_19_column_ur10e_files_say_both_counts() -> None:
     path = DATASETS / "ur10e-innopolis" / "identification_data" / "ur-19_09_27-11_28_22.csv"
     with pytest.raises(KinergyError, match="rows have 19 fields but the --columns spec names 31"):
         read_log(path, columns=spec)
+
+
+def test_leading_comment_lines_are_skipped_and_named_in_line_numbers(tmp_path: Path) -> None:
+    path = tmp_path / "commented.csv"
+    path.write_text("# recorded on cell 3\n# 500 Hz\ntimestamp actual_q_0\n0 1\n0.002 2\n0.004 x\n")
+    with pytest.raises(KinergyError, match=r"line 6, column 2 \(actual_q_0\): not a finite number"):
+        read_log(path)
+    path.write_text("# recorded on cell 3\ntimestamp actual_q_0\n0 1\n0.002 2\n")
+    np.testing.assert_array_equal(read_log(path)["actual_q"], [[1], [2]])
+
+
+def test_a_header_read_as_a_headerless_file_and_a_missing_timestamp_are_named(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "h.csv"
+    path.write_text("timestamp actual_q_0\n0 1\n0.002 2\n")
+    with pytest.raises(
+        KinergyError, match="names its columns in a header line .*leave out --columns"
+    ):
+        read_log(path, columns="timestamp,actual_q:1")
+    path.write_text("time actual_q_0\n0 1\n0.002 2\n")
+    with pytest.raises(
+        KinergyError, match="no 'timestamp' column; the header names time, actual_q_0"
+    ):
+        read_log(path)

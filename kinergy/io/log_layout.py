@@ -12,10 +12,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from kinergy.errors import KinergyError
-from kinergy.io.columns import MAX_COLUMNS
+from kinergy.io.columns import MAX_COLUMNS, printable
+from kinergy.io.fields import closest
 
 __all__ = ["LogLayout", "first_lines", "log_layout"]
 
+#: the most comment lines (starting with ``#``) a log may begin with
+_MAX_COMMENTS = 100
 #: the longest first line read to find a layout: MAX_COLUMNS columns of 64 characters each
 _MAX_LINE = MAX_COLUMNS * 64
 
@@ -32,7 +35,7 @@ class LogLayout:
     sep : str
         ``","``, ``";"`` or ``" "`` (any run of white space when not :attr:`plain`).
     skip : int
-        Header lines before the data (0 or 1).
+        Lines before the data: comments (starting with ``#``) and the header line.
     source : str
         What named the columns, for messages: ``"header"`` or ``"--columns spec"``.
     plain : bool
@@ -121,26 +124,45 @@ def log_layout(path: Path, columns: Sequence[str] | None) -> LogLayout:
         Empty file; no header line and no spec; more than :data:`MAX_COLUMNS` columns; no
         ``timestamp`` column.
     """
-    head, data = first_lines(path, 2)
+    lines = first_lines(path, _MAX_COMMENTS + 2)
+    comments = 0
+    while comments < len(lines) and lines[comments].lstrip().startswith("#"):
+        comments += 1
+    head, data = [*lines[comments:], "", ""][:2]
     if not head.strip():
-        raise KinergyError(f"{path}: empty log")
+        raise KinergyError(
+            f"{path}: empty log" if not comments else f"{path}: no data after its comments"
+        )
     sep = _separator(path, head, data)
+    fields = head.strip().replace(sep if sep != " " else ",", " ").split()
+    first = fields[0] if fields else ""
+    numeric = bool(first) and (first[:1].isdigit() or first[:1] in "+-.")
     if columns is None:
-        fields = head.strip().replace(sep if sep != " " else ",", " ").split()
         if len(fields) > MAX_COLUMNS:
             raise KinergyError(
                 f"{path}: the header names {len(fields)} columns; at most {MAX_COLUMNS}"
             )
-        first = fields[0] if fields else ""
-        if not first or first[:1].isdigit() or first[:1] in "+-.":
+        if not first or numeric:
             raise KinergyError(
                 f"{path}: no header line (record.py layout); give the layout with --columns"
             )
-        names, skip, source = fields, 1, "header"
+        names, skip, source = fields, comments + 1, "header"
     else:
-        names, skip, source, data = list(columns), 0, "--columns spec", head
+        if not numeric and "timestamp" in fields:
+            shown = ", ".join(fields[:3])
+            raise KinergyError(
+                f"{path}: the file names its columns in a header line ({shown}, ...): leave out "
+                "--columns"
+            )
+        names, skip, source, data = list(columns), comments, "--columns spec", head
     if "timestamp" not in names:
-        raise KinergyError(f"{path}: no 'timestamp' column")
+        guess = closest("timestamp", [n for n in names if not n.startswith("_")])
+        hint = f" ({guess!r} is not the name kinergy reads)" if guess else ""
+        shown = ", ".join(printable(n, 20) for n in names[:4])
+        raise KinergyError(
+            f"{path}: no 'timestamp' column{hint}; the {source} names {shown}, ...: kinergy reads "
+            "UR's RTDE names (timestamp, actual_q_0, ...)"
+        )
     if len(set(names)) != len(names):
         raise KinergyError(f"{path}: the {source} repeats a column name")
     cells = data.rstrip("\r\n").split(sep)
