@@ -35,7 +35,8 @@ MIN_BYTES = 32 * 2**20
 KEEP_BYTES = 256 * 2**20
 
 _free: list[Array] = []
-_lock = threading.Lock()
+#: re-entrant: a garbage collection inside :func:`_take` may run a finaliser, :func:`_release`
+_lock = threading.RLock()
 
 
 class _Holder:
