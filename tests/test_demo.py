@@ -67,17 +67,17 @@ def test_demo_identifies_within_the_issue_tolerances(demo_run) -> None:
     (friction,) = tables["VI"]  # one friction model, the doc's: one table
     assert friction.headers == [
         "joint",
+        "k_t [N m/A]",
         "viscous [N m s/rad]",
         "coulomb_direct [N m]",
         "coulomb_reverse [N m]",
         "smoothing [rad/s]",
         "standstill [rad/s]",
         "holding [1]",
-        "k_t [N m/A]",
     ]
     for j, row in enumerate(friction.rows):
         t = truth.joints[j].drive
-        kv, tdir, trev, kt = (float(row[k].split()[0]) for k in (1, 2, 3, -1))
+        kt, kv, tdir, trev = (float(row[k].split()[0]) for k in (1, 2, 3, 4))
         assert kt == pytest.approx(t.torque_constant, rel=0.02)
         assert kv == pytest.approx(t.friction.params["viscous"], rel=0.10)
         assert abs(tdir - t.friction.params["coulomb_direct"]) <= max(

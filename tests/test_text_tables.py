@@ -86,16 +86,16 @@ def test_friction_tables_one_per_model_with_its_parameters_and_units() -> None:
     assert [r[0] for r in power.rows] == ["shoulder_lift", "wrist_2"]
     assert power.headers == [
         "joint",
+        "k_t [N m/A]",
         "coulomb [N m]",
         "viscous [N m (s/rad)^exponent]",
         "exponent [1]",
         "smoothing [rad/s]",
-        "k_t [N m/A]",
     ]
-    assert power.rows[0][1:4] == ["0.1", "0.004", "0.55"]
-    assert makkar.headers[1:4] == ["gamma1 [N m]", "gamma2 [s/rad]", "gamma3 [s/rad]"]
+    assert power.rows[0][2:5] == ["0.1", "0.004", "0.55"]
+    assert makkar.headers[2:5] == ["gamma1 [N m]", "gamma2 [s/rad]", "gamma3 [s/rad]"]
     # the truth in brackets only where it has the same model: power_flow for the doc's joints
     viscous = robot.joints[0].drive.friction.params["viscous"]
-    assert doc.rows[0][1] == f"{viscous:.4g} ({viscous:.4g})"
-    assert "(" not in power.rows[0][1] and "(" in power.rows[0][-1]  # k_t has its truth
+    assert doc.rows[0][2] == f"{viscous:.4g} ({viscous:.4g})"
+    assert "(" not in power.rows[0][2] and "(" in power.rows[0][1]  # k_t has its truth
     assert "power_law:" in power.note and "nursing eq 13" in makkar.note

@@ -68,9 +68,10 @@ def parameter_tables(model: Robot, truth: Robot | None = None) -> list[Table]:
 
 
 def friction_table(model: Robot, family: str, truth: Robot | None = None) -> Table:
-    """UR5e Table VI for the joints of ``model`` whose friction model is ``family``: one column
-    per parameter of the model that any of them has (units from the friction registry), then
-    the torque constant; a joint of ``truth`` with the same friction model in brackets."""
+    """UR5e Table VI for the joints of ``model`` whose friction model is ``family``: the torque
+    constant, then one column per parameter of the model that any of them has (units from the
+    friction registry; "-" where a joint lacks an optional one); a joint of ``truth`` with the
+    same friction model in brackets."""
     joints = [j for j, joint in enumerate(model.joints) if joint.drive.friction.model == family]
     units = parameter_units(family)
     used = {p for j in joints for p in model.joints[j].drive.friction.params}
@@ -88,11 +89,11 @@ def friction_table(model: Robot, family: str, truth: Robot | None = None) -> Tab
         rows.append(
             [
                 model.joint_names[j],
-                *(cell(d.friction.params.get(p), twin.get(p)) for p in params),
                 cell(d.torque_constant, None if t is None else t.torque_constant),
+                *(cell(d.friction.params.get(p), twin.get(p)) for p in params),
             ]
         )
-    headers = ["joint", *(f"{p} [{units[p]}]" for p in params), "k_t [N m/A]"]
+    headers = ["joint", "k_t [N m/A]", *(f"{p} [{units[p]}]" for p in params)]
     note = f"Motor side. {family}: {get_model(family).citation}."
     if truth is not None:
         note += " In brackets: the value the twin was built with (its true robot)."
