@@ -10,7 +10,9 @@ A missing figure is a KinergyError naming it, and no report (nor temporary file)
 Checked in headless Chromium (Debian's ``chromium``; skipped when absent): every image of the
 report decodes (``naturalWidth`` equals the PNG's width), read by a small test-only script in a
 copy of the page whose result ``--dump-dom`` prints; a corrupted image is reported as broken
-(the probe can fail); a screenshot shows the page, with a test figure's solid colour in it.
+(the probe can fail); a screenshot shows the page, with a test figure's solid colour in it; in a
+1280 px window every table fits its card, however long its headers (a second probe, which sees a
+table forced wider: ``tests/chromium.py``).
 """
 
 from __future__ import annotations
