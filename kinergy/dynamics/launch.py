@@ -132,8 +132,9 @@ def _launch(
 ) -> None:
     """``kernel(lo, hi, *args)`` over rows 0:rows: on the calling thread for batches up to
     :data:`SERIAL_ROWS` (or one ``chunk``, if smaller) or one thread, else in blocks of ``chunk``
-    rows on as many pool threads as numba's thread count (or ``threads``) says. If the calling
-    thread is interrupted, the pool threads stop after the block they are on."""
+    rows on as many threads as numba's thread count (or ``threads``) says, the calling thread and
+    pool threads. If the calling thread is interrupted, the pool threads stop after the block
+    they are on."""
     if threads is not None:
         with kernel_threads(threads):
             _launch(kernel, rows, args, None, chunk)
@@ -153,8 +154,11 @@ def _launch(
                 return
             kernel(lo, min(rows, lo + chunk), *args)
 
-    futures = [_shared_pool().submit(work) for _ in range(workers)]
+    # the calling thread works too: the blocks start at once on the core it already has, and the
+    # pool's threads join as the system wakes them
+    futures = [_shared_pool().submit(work) for _ in range(workers - 1)]
     try:
+        work()
         for future in futures:
             future.result()
     finally:
