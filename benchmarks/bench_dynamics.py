@@ -15,7 +15,8 @@ UR5e and N = 15,000, i.e. 30 s of a controller log at 500 Hz):
   ``pinocchio.rnea(model, data, q[k], qd[k], qdd[k])`` called for every sample in a Python loop
   that writes into a preallocated ``(N, n)`` array.
 * **Joint-torque regressor** ``Y(q, qd, qdd)``, shape ``(N, n, 10 n)``:
-  ``kinergy.regressor(robot, q, qd, qdd)`` (which allocates its result) against
+  ``kinergy.regressor(robot, q, qd, qdd)`` (a fresh result of the caller's own, whose memory may
+  be that of an earlier result no longer referred to: ``kinergy.dynamics.blocks``) against
   ``pinocchio.computeJointTorqueRegressor(model, data, q[k], qd[k], qdd[k])`` in a Python loop
   writing into a freshly allocated ``np.empty((N, n, 10 n))`` each repeat.
 
@@ -63,11 +64,13 @@ BAR = 3.0  # kinergy must be at least this many times faster per sample than Pin
 
 @dataclass(frozen=True)
 class Timing:
-    """Wall-clock times (s) of the repeated calls of one operation on ``samples`` samples."""
+    """Wall-clock and processor times (s, all threads of the process) of the repeated calls of
+    one operation on ``samples`` samples."""
 
     name: str
     times: list[float]
     samples: int
+    cpu: list[float]
 
     @property
     def best(self) -> float:
@@ -107,13 +110,14 @@ def pinocchio_regressor(model, data, q, qd, qdd) -> np.ndarray:
 
 
 def time_call(name: str, fn: Callable[[], object], repeats: int, samples: int) -> Timing:
-    """Time ``fn()`` ``repeats`` times with ``time.perf_counter``."""
-    times = []
+    """Time ``fn()`` ``repeats`` times with ``time.perf_counter`` and ``time.process_time``."""
+    times, cpu = [], []
     for _ in range(repeats):
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         fn()
         times.append(time.perf_counter() - start)
-    return Timing(name, times, samples)
+        cpu.append(time.process_time() - start_cpu)
+    return Timing(name, times, samples, cpu)
 
 
 def max_relative_difference(a: np.ndarray, b: np.ndarray) -> float:
@@ -199,22 +203,23 @@ def main() -> None:
     if max(rel_rnea, rel_reg) > 1e-9:
         raise SystemExit("kinergy and Pinocchio disagree: timings would be meaningless")
 
-    # Warm-up: every timed call, at full size, --warmup times. Besides JIT and first-call costs,
-    # this matters for the (N, n, 10 n) results: the first few times freshly mapped memory is
-    # first touched by several numba threads at once, page faults cost ~10x their steady-state
-    # price on some (virtualised) machines; after a few rounds the process recycles its pages.
+    # Warm-up: every timed call, at full size, --warmup times (JIT and first-call costs). A fresh
+    # kinergy.regressor result reuses the memory of the previous one once that is dropped
+    # (kinergy.dynamics.blocks), as it is here and in a loop of a user's; Pinocchio's loop
+    # allocates np.empty each time (fresh pages: glibc maps anything over 32 MB anew).
     for _ in range(args.warmup):
         for _, fn in operations:
             fn()
 
     timings = [time_call(name, fn, args.repeats, N) for name, fn in operations]
 
-    print("\ntimings (min / median over repeats)")
-    print(f"  {'operation':<38} {'per call (ms)':>17} {'per sample (µs)':>19}")
+    print("\ntimings (min / median over repeats; processor time of all threads, median)")
+    print(f"  {'operation':<38} {'per call (ms)':>17} {'per sample (µs)':>19} {'cpu (ms)':>9}")
     for t in timings:
         print(
             f"  {t.name:<38} {t.best * 1e3:8.2f} /{t.median * 1e3:8.2f}"
             f" {t.per_sample_us(t.best):9.3f} /{t.per_sample_us(t.median):8.3f}"
+            f" {statistics.median(t.cpu) * 1e3:9.2f}"
         )
 
     rows = []

@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import re
+import shutil
 from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
+from chromium import find_chromium, table_overflow
 
 import kinergy
 from kinergy.cli import main
+from kinergy.cli.common import print_tables
+from kinergy.cli.demo import TABLES
 from kinergy.workflows.demo import nominal_drives, run_demo
 
 
@@ -60,9 +64,20 @@ def test_demo_identifies_within_the_issue_tolerances(demo_run) -> None:
     for j, row in enumerate(tables["IV"][0].rows):
         assert abs(float(row[-1])) < 3.0  # J_m + J_r error in %
         assert float(row[3]) == pytest.approx(truth.joints[j].drive.rotor_inertia, rel=0.03)
-    for j, row in enumerate(tables["VI"][0].rows):
+    (friction,) = tables["VI"]  # one friction model, the doc's: one table
+    assert friction.headers == [
+        "joint",
+        "k_t [N m/A]",
+        "viscous [N m s/rad]",
+        "coulomb_direct [N m]",
+        "coulomb_reverse [N m]",
+        "smoothing [rad/s]",
+        "standstill [rad/s]",
+        "holding [1]",
+    ]
+    for j, row in enumerate(friction.rows):
         t = truth.joints[j].drive
-        kv, tdir, trev, kt = (float(x.split()[0]) for x in row[2:6])
+        kt, kv, tdir, trev = (float(row[k].split()[0]) for k in (1, 2, 3, 4))
         assert kt == pytest.approx(t.torque_constant, rel=0.02)
         assert kv == pytest.approx(t.friction.params["viscous"], rel=0.10)
         assert abs(tdir - t.friction.params["coulomb_direct"]) <= max(
@@ -73,6 +88,22 @@ def test_demo_identifies_within_the_issue_tolerances(demo_run) -> None:
         )
     r2 = [float(row[4]) for table in tables["VII"] for row in table.rows]  # tests A and B
     assert min(r2) >= 0.98
+
+
+def test_demo_text_fits_120_characters(demo_run, capsys: pytest.CaptureFixture[str]) -> None:
+    """``kinergy demo --mismatch none`` prints its tables in lines of at most 120 characters
+    (what the command prints: :func:`print_tables` of these tables)."""
+    _out, (tables, _report, _seconds) = demo_run
+    print_tables(tables, TABLES)
+    text = capsys.readouterr().out
+    assert "UR5e Table VI" in text and "UR5e Table VIII" in text
+    assert max(len(line) for line in text.splitlines()) <= 120
+
+
+def test_demo_report_fits_1280_px(demo_run, tmp_path: Path) -> None:
+    """In a 1280 px browser window every table of the demo's report fits its card."""
+    _out, (_tables, report, _seconds) = demo_run
+    assert table_overflow(find_chromium(), report, tmp_path) == []
 
 
 def test_demo_starts_from_guessed_drives() -> None:
@@ -95,6 +126,11 @@ def test_cli_demo_and_report(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     ):
         assert caption in text
     assert re.search(r"report: .*report\.html \(\d+\.\d s\)", text)
+    # every line but the report's path (which names the user's folder) fits 120 characters
+    assert max(len(line) for line in text.splitlines() if "report: " not in line) <= 120
+    # friction per model: the realistic twin's joints get power-law models, one table each
+    for caption in re.findall(r"^Friction and torque constants.*$", text, re.M):
+        assert caption.endswith("power_law friction")
     # the default twin is not the model: truth against identified, an honest held-out R^2
     assert "The twin is not the model: truth against identified" in text
     assert "The held-out current R² is below 1 because" in text
@@ -102,6 +138,8 @@ def test_cli_demo_and_report(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     held_out_r2 = [float(row.split()[-1]) for row in truth_rows]
     assert all(0.9 < r2 < 1.0 for r2 in held_out_r2)
     assert "The twin is not the model" in (out / "report.html").read_text()
+    if shutil.which("chromium"):  # the report fits a 1280 px window (skipped without a browser)
+        assert table_overflow(find_chromium(), out / "report.html", tmp_path / "browser") == []
     model = tmp_path / "id.toml"
     logs = out / "logs"
     assert main(["identify", str(logs / "test-a.csv"), "--robot", "ur5e", "--out", str(model)]) == 0

@@ -4,6 +4,11 @@ the same bits."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -132,3 +137,23 @@ def test_read_only_and_writable_inputs_mix(ur5e: kinergy.Robot) -> None:
     np.testing.assert_array_equal(
         kinergy.regressor(ur5e, frozen, qd, qdd), kinergy.regressor(ur5e, q, qd, qdd)
     )
+
+
+def test_a_call_compiles_only_its_own_kernel() -> None:
+    """A fresh process that only simulates (the RNEA) compiles or loads no other kernel: the
+    regressor and the gradient stay uncompiled (issue 29: a quick first run)."""
+    code = (
+        "import numpy as np, kinergy\n"
+        "from kinergy.dynamics import _kernels, launch\n"
+        "kinergy.rnea(kinergy.load_robot('ur5e'), np.zeros((300, 6)))\n"
+        "print(sorted((k.value, z) for k, z in launch._compiled))\n"
+        "print([len(f.signatures) for f in (_kernels.rnea_rows_dh, _kernels.rnea_rows,\n"
+        "       _kernels.regressor_rows_dh, _kernels.regressor_rows,\n"
+        "       _kernels.regressor_gradient_rows)])\n"
+    )
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
+    )
+    assert proc.stdout.splitlines() == ["[('RNEA', True)]", "[1, 0, 0, 0, 0]"]

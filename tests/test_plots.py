@@ -160,6 +160,7 @@ def test_error_boxplot_two_sets(tmp_path: Path) -> None:
     axes = fig.axes
     assert [ax.get_title() for ax in axes] == ["test A", "test B"]
     assert axes[0].get_ylabel() == "Torque error [N m]"
+    assert fig.get_suptitle() == "Torque error per joint"
     assert axes[0].get_shared_y_axes().joined(axes[0], axes[1])
     for ax, err in zip(axes, sets.values(), strict=True):
         assert [lab.get_text() for lab in ax.get_xticklabels()] == NAMES
@@ -170,6 +171,14 @@ def test_error_boxplot_two_sets(tmp_path: Path) -> None:
             if line.get_linewidth() == 1.5
         ]
         assert np.allclose(medians, np.median(err, axis=0))
+
+
+def test_error_boxplot_title_reads_right() -> None:
+    """The report passes the signal's name ("current"): the title says "error" once."""
+    sets = {"test A": np.random.default_rng(5).normal(0.0, 1.0, (50, 6))}
+    fig = plots.error_boxplot(sets, joint_names=NAMES, quantity="current", unit="A")
+    assert fig.get_suptitle() == "Current error per joint"
+    assert fig.axes[0].get_ylabel() == "Current error [A]"
 
 
 @pytest.mark.parametrize(

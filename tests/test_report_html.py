@@ -10,17 +10,15 @@ A missing figure is a KinergyError naming it, and no report (nor temporary file)
 Checked in headless Chromium (Debian's ``chromium``; skipped when absent): every image of the
 report decodes (``naturalWidth`` equals the PNG's width), read by a small test-only script in a
 copy of the page whose result ``--dump-dom`` prints; a corrupted image is reported as broken
-(the probe can fail); a screenshot shows the page, with a test figure's solid colour in it.
+(the probe can fail); a screenshot shows the page, with a test figure's solid colour in it; in a
+1280 px window every table fits its card, however long its headers (a second probe, which sees a
+table forced wider: ``tests/chromium.py``).
 """
 
 from __future__ import annotations
 
-import json
-import os
 import re
-import shutil
 import struct
-import subprocess
 from html.parser import HTMLParser
 from pathlib import Path
 from typing import Any
@@ -28,6 +26,7 @@ from urllib.parse import unquote
 
 import numpy as np
 import pytest
+from chromium import find_chromium, probe, run_chromium, table_overflow
 from matplotlib.image import imread, imsave
 
 from kinergy.errors import KinergyError
@@ -350,52 +349,12 @@ window.addEventListener("load", function () {
 
 @pytest.fixture(scope="module")
 def chromium() -> str:
-    path = shutil.which("chromium") or shutil.which("chromium-browser")
-    if path is None:
-        pytest.skip("headless Chromium not installed (Debian: apt-get install chromium)")
-    return path
-
-
-def run_chromium(chromium: str, work: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    """Run headless Chromium offline, with a fresh profile in ``work``."""
-    profile = work / "profile"
-    profile.mkdir(parents=True, exist_ok=True)
-    flags = [
-        "--headless",
-        "--no-sandbox",  # needed as root, harmless otherwise
-        "--disable-gpu",
-        "--disable-dev-shm-usage",
-        "--disable-quic",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        "--hide-scrollbars",
-        f"--user-data-dir={profile}",
-    ]
-    env = {**os.environ, "HOME": str(work)}
-    proc = subprocess.run(
-        [chromium, *flags, *args],
-        capture_output=True,
-        text=True,
-        timeout=180,
-        env=env,
-        check=False,
-    )
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return proc
+    return find_chromium()
 
 
 def image_states(chromium: str, report: Path, work: Path) -> list[dict[str, Any]]:
     """Open a copy of ``report`` with the probe script in it; return what the browser saw."""
-    html = report.read_text(encoding="utf-8")
-    assert html.count("</body>") == 1
-    probe = report.with_name("probe.html")  # same folder: same relative image paths
-    probe.write_text(html.replace("</body>", PROBE + "</body>"), encoding="utf-8")
-    proc = run_chromium(chromium, work, "--virtual-time-budget=10000", "--dump-dom", probe.as_uri())
-    found = Page(proc.stdout).captured["pre"]
-    assert len(found) == 1, f"probe did not run; stderr: {proc.stderr[-3000:]}"
-    states: list[dict[str, Any]] = json.loads(found[0])
+    states: list[dict[str, Any]] = probe(chromium, report, work, PROBE, "image-states")
     return states
 
 
@@ -458,3 +417,59 @@ def test_browser_screenshot(
     assert rows.size > 0.8 * SOLID_SIZE[0] * SOLID_SIZE[1]
     assert cols.max() - cols.min() + 1 <= SOLID_SIZE[0]
     assert cols.max() < width
+
+
+def wide_sections() -> list[Section]:
+    """Tables as wide as kinergy writes them: long headers with units, long names with
+    underscores, cells of identified (truth, error) and a dense numeric table."""
+    params = [
+        "coulomb_positive [N m]",
+        "coulomb_negative [N m]",
+        "viscous_positive [N m (s/rad)^exponent]",
+        "viscous_negative [N m (s/rad)^exponent]",
+        "exponent [1]",
+        "smoothing [rad/s]",
+    ]
+    friction = Table(
+        "Friction and torque constants, directional_power_law friction",
+        ["joint", *params, "k_t [N m/A]"],
+        [[f"shoulder_lift_{k}", *["0.01392"] * 6, "0.1114 (0.1112)"] for k in range(3)],
+    )
+    truth = Table(
+        "The twin is not the model: truth against identified",
+        ["joint", "k_t [N m/A]", "J_m + J_r [kg m²]", "friction chosen", "held-out current R²"],
+        [
+            [n, "0.09832 (0.09862, -0.3 %)", "0.0001911 (0.0001913, -0.1 %)", m, "0.9994"]
+            for n, m in zip(NAMES, ["directional_power_law"] * 6, strict=True)
+        ],
+    )
+    parts = ["inertial", "gravity", "friction", "copper", "standby", "E_elec", "E_supply"]
+    dense = Table(
+        "Where the energy goes",
+        ["motion", *(f"{p} [J]" for p in parts), "peak power [W]", "mean power [W]"],
+        [["test A", *[f"{1000.0 + k:.1f}" for k in range(9)]]],
+    )
+    return [Section("Wide tables", "Tables wider than the card's text.", [friction, truth, dense])]
+
+
+def test_browser_tables_fit_the_card_at_1280_px(chromium: str, tmp_path: Path) -> None:
+    """Every table is at most as wide as its box (so nothing scrolls or runs off the card) in a
+    1280 px window, however long its headers: they wrap at spaces and after ``_`` and ``/``."""
+    report = write_report(
+        tmp_path / "report.html", title="t", subtitle="", sections=wide_sections()
+    )
+    assert "coulomb_<wbr>positive [N m]" in report.read_text(encoding="utf-8")
+    assert table_overflow(chromium, report, tmp_path / "work") == []
+
+
+def test_browser_table_fit_probe_sees_an_overflow(chromium: str, tmp_path: Path) -> None:
+    """The probe can fail: a table forced wider than the card is reported, by caption."""
+    report = write_report(
+        tmp_path / "report.html", title="t", subtitle="", sections=wide_sections()
+    )
+    text = report.read_text(encoding="utf-8")
+    forced = text.replace("</style>", "table { min-width: 1500px; }\n</style>")
+    report.write_text(forced, encoding="utf-8")
+    over = table_overflow(chromium, report, tmp_path / "work")
+    assert len(over) == 3  # each table (its box scrolls: the page itself does not)
+    assert over[0].startswith("Table 1. Friction and torque constants")

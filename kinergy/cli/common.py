@@ -7,6 +7,7 @@ import contextlib
 import enum
 import functools
 import hashlib
+import textwrap
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
@@ -27,6 +28,7 @@ from kinergy.logs.reading import InputLogs, LogReading
 from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
+    "TABLE_WIDTH",
     "accept_option",
     "bag_options",
     "columns_option",
@@ -55,13 +57,51 @@ __all__ = [
 F = TypeVar("F", bound=Callable[..., Any])
 
 
-def table(headers: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
-    """Left-aligned text columns, two spaces apart (the one table printer of the CLI)."""
-    widths = [max(len(str(x)) for x in col) for col in zip(headers, *rows, strict=False)]
-    lines = ["  ".join(str(h).ljust(w) for h, w in zip(headers, widths, strict=True)).rstrip()]
-    for row in rows:
-        lines.append("  ".join(str(x).ljust(w) for x, w in zip(row, widths, strict=True)).rstrip())
+#: the widest line :func:`table` prints, characters
+TABLE_WIDTH = 120
+
+
+def table(headers: Sequence[str], rows: Sequence[Sequence[Any]], width: int = TABLE_WIDTH) -> str:
+    """Left-aligned text columns, two spaces apart (the one table printer of the CLI), no line
+    longer than ``width`` characters.
+
+    A table wider than that is printed as blocks of its columns, one under the other (a blank
+    line between), each led by the first column, the row's name; a cell that would not fit even
+    so is wrapped onto more lines of its row.
+    """
+    cells = [[str(x) for x in row] for row in [headers, *rows]]
+    widths = [max(len(row[k]) for row in cells) for k in range(len(headers))]
+    key = min(widths[0], width // 3)
+    most = max(1, width - key - 2)  # the widest any other column may be
+    widths = [key] + [min(w, most) for w in widths[1:]]
+    blocks: list[list[int]] = []
+    for k in range(1, len(widths)):
+        if blocks and sum(widths[i] + 2 for i in blocks[-1]) + widths[k] <= width:
+            blocks[-1].append(k)
+        else:
+            blocks.append([0, k])
+    return "\n\n".join(_table_block(cells, widths, block) for block in blocks or [[0]])
+
+
+def _table_block(cells: list[list[str]], widths: list[int], columns: list[int]) -> str:
+    """The ``columns`` of ``cells`` as text lines, each cell wrapped to its column's width."""
+    lines = []
+    for row in cells:
+        wrapped = [_wrap(row[k], widths[k]) for k in columns]
+        for i in range(max(len(w) for w in wrapped)):
+            parts = [
+                (w[i] if i < len(w) else "").ljust(widths[k])
+                for w, k in zip(wrapped, columns, strict=True)
+            ]
+            lines.append("  ".join(parts).rstrip())
     return "\n".join(lines)
+
+
+def _wrap(text: str, width: int) -> list[str]:
+    """``text`` as lines of at most ``width`` characters (whole words where they fit)."""
+    if len(text) <= width:
+        return [text]
+    return textwrap.wrap(text, width, break_on_hyphens=False) or [""]
 
 
 def fmt(x: float) -> str:
@@ -360,7 +400,7 @@ def print_tables(tables: Mapping[str, Sequence[Any]], keys: Sequence[str]) -> No
     """Print the report tables under ``keys`` (:class:`kinergy.report.html.Table`) as text."""
     for key in keys:
         for t in tables.get(key, []):
-            click.echo(f"\n{t.caption}")
+            click.echo(f"\n{textwrap.fill(t.caption, TABLE_WIDTH)}")
             click.echo(table(t.headers, t.rows))
             if t.note:
-                click.echo(t.note)
+                click.echo(textwrap.fill(t.note, TABLE_WIDTH))

@@ -10,7 +10,10 @@ from kinergy.cli.common import print_tables, progress, report_folder_option, wri
 from kinergy.simulate import MISMATCHES
 from kinergy.workflows.demo import run_demo
 
-__all__ = ["demo"]
+__all__ = ["TABLES", "demo"]
+
+#: the demo's tables, in the order it prints them
+TABLES = ("IV", "V", "VI", "VII", "VIII", "breakdown", "timing", "truth")
 
 
 @click.command()
@@ -32,5 +35,5 @@ def demo(out: str | None, mismatch: str) -> None:
         tables, report, seconds = run_demo(
             None if out is None else Path(out), say, mismatch=mismatch
         )
-    print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown", "timing", "truth"])
+    print_tables(tables, TABLES)
     click.echo(f"\nreport: {report} ({seconds:.1f} s)")

@@ -1,6 +1,7 @@
 """Calling the compiled dynamics kernels: serially for small batches or one thread, else split
-over a pool of Python threads (the kernels release the GIL); compiled at first use, with a
-one-line notice on stderr when that takes a while (a fresh install, no on-disk cache yet).
+over a pool of Python threads (the kernels release the GIL). Each kernel is compiled at its
+first use (only the ones a command calls), with a one-line notice on stderr when that takes a
+while (a fresh install, no on-disk cache yet).
 
 How many threads a call uses is numba's thread count of the calling thread
 (:func:`kinergy.dynamics.threads.kernel_threads`, or the ``threads`` argument). Each of those
@@ -11,6 +12,7 @@ the calling thread: handing work to the pool costs tens of microseconds.
 
 from __future__ import annotations
 
+import enum
 import sys
 import threading
 from collections.abc import Callable
@@ -27,7 +29,8 @@ from kinergy.dynamics.threads import kernel_threads
 __all__ = [
     "CHUNK",
     "SERIAL_ROWS",
-    "compile_kernels",
+    "Kernel",
+    "compile_kernel",
     "regressor_gradient_into",
     "regressor_into",
     "rnea_into",
@@ -40,48 +43,64 @@ SERIAL_ROWS = 256
 CHUNK = 8 * _kernels.LANES
 #: the notice is printed when compiling takes longer than this, s
 _NOTICE_AFTER = 1.0
-_NOTICE = "kinergy: compiling the dynamics kernels (once, about 40 s)"
 
-_compiled: set[str] = set()
+
+class Kernel(enum.Enum):
+    """A compiled dynamics kernel; the value names it in the compile notice."""
+
+    RNEA = "RNEA"
+    REGRESSOR = "regressor"
+    GRADIENT = "regressor gradient"
+
+
+#: what compiling each kernel takes on a 2-core machine (one chain type), s
+_COMPILE_SECONDS = {Kernel.RNEA: 10, Kernel.REGRESSOR: 15, Kernel.GRADIENT: 30}
+
+_compiled: set[tuple[Kernel, bool]] = set()
 _lock = threading.Lock()
 _pool: ThreadPoolExecutor | None = None
 
 
-def _with_notice(compile_all: Callable[[], None]) -> None:
-    """Run ``compile_all``, printing :data:`_NOTICE` on stderr if it takes over a second."""
-    timer = threading.Timer(_NOTICE_AFTER, lambda: print(_NOTICE, file=sys.stderr, flush=True))
+def _with_notice(compile_one: Callable[[], None], kernel: Kernel) -> None:
+    """Run ``compile_one``, printing a notice on stderr if it takes over a second."""
+    notice = (
+        f"kinergy: compiling the dynamics {kernel.value} kernel "
+        f"(once, about {_COMPILE_SECONDS[kernel]} s)"
+    )
+    timer = threading.Timer(_NOTICE_AFTER, lambda: print(notice, file=sys.stderr, flush=True))
     timer.daemon = True
     timer.start()
     try:
-        compile_all()
+        compile_one()
     finally:
         timer.cancel()
 
 
-def compile_kernels(data: KernelData, *, gradient: bool = False) -> None:
-    """Compile (or load from numba's cache) the dynamics kernels once per process (with
-    ``gradient``, the regressor gradient's too), with a notice if that takes a while."""
-    zf = data.z_first
-    if f"dynamics{zf}" in _compiled and (not gradient or f"gradient{zf}" in _compiled):
+def compile_kernel(data: KernelData, kernel: Kernel) -> None:
+    """Compile (or load from numba's cache) one kernel for ``data``'s chain type once per
+    process, with a notice if that takes a while. Only the kernel a call needs is compiled:
+    the RNEA (what simulation, prediction and energy use) takes about 10 s on a fresh install,
+    the regressor (identification) 15 s more."""
+    key = (kernel, data.z_first)
+    if key in _compiled:
         return
     n = data.geo[0].shape[0]
     z = np.zeros((1, n))
     state = (z, z, z)
-
-    def dynamics() -> None:
-        _rnea(data)(0, 1, data.geo, data.ends[2], data.body, state, np.empty((1, n)))
-        _regressor(data)(0, 1, data.geo, data.ends[2], state, np.empty((1, n, 10 * n)), True)
-
-    def gradients() -> None:
-        w = np.zeros((1, n, 10 * n))
-        args = (data.geo, data.ends[2], state, w, 1e-5, np.empty((3, 1, n)))
-        _kernels.regressor_gradient_rows(0, 1, *args)
-
+    g0 = data.ends[2]
+    calls: dict[Kernel, Callable[[], None]] = {
+        Kernel.RNEA: lambda: _rnea(data)(0, 1, data.geo, g0, data.body, state, np.empty((1, n))),
+        Kernel.REGRESSOR: lambda: _regressor(data)(
+            0, 1, data.geo, g0, state, np.empty((1, n, 10 * n)), True
+        ),
+        Kernel.GRADIENT: lambda: _kernels.regressor_gradient_rows(
+            0, 1, data.geo, g0, state, np.zeros((1, n, 10 * n)), 1e-5, np.empty((3, 1, n))
+        ),
+    }
     with _lock:
-        for key, fn in (("dynamics", dynamics), ("gradient", gradients if gradient else None)):
-            if fn is not None and f"{key}{zf}" not in _compiled:
-                _with_notice(fn)
-                _compiled.add(f"{key}{zf}")
+        if key not in _compiled:
+            _with_notice(calls[kernel], kernel)
+            _compiled.add(key)
 
 
 def _rnea(data: KernelData) -> Callable[..., None]:
@@ -113,8 +132,9 @@ def _launch(
 ) -> None:
     """``kernel(lo, hi, *args)`` over rows 0:rows: on the calling thread for batches up to
     :data:`SERIAL_ROWS` (or one ``chunk``, if smaller) or one thread, else in blocks of ``chunk``
-    rows on as many pool threads as numba's thread count (or ``threads``) says. If the calling
-    thread is interrupted, the pool threads stop after the block they are on."""
+    rows on as many threads as numba's thread count (or ``threads``) says, the calling thread and
+    pool threads. If the calling thread is interrupted, the pool threads stop after the block
+    they are on."""
     if threads is not None:
         with kernel_threads(threads):
             _launch(kernel, rows, args, None, chunk)
@@ -134,8 +154,11 @@ def _launch(
                 return
             kernel(lo, min(rows, lo + chunk), *args)
 
-    futures = [_shared_pool().submit(work) for _ in range(workers)]
+    # the calling thread works too: the blocks start at once on the core it already has, and the
+    # pool's threads join as the system wakes them
+    futures = [_shared_pool().submit(work) for _ in range(workers - 1)]
     try:
+        work()
         for future in futures:
             future.result()
     finally:
@@ -151,7 +174,7 @@ def rnea_into(
 ) -> None:
     """Fill ``tau`` (N, n) with the RNEA torques of ``state`` (contiguous (N, n) each) under
     gravity ``g0`` (3,) in frame 0, on ``threads`` threads (None: as set)."""
-    compile_kernels(data)
+    compile_kernel(data, Kernel.RNEA)
     args = (data.geo, g0, data.body, state, tau)
     _launch(_rnea(data), tau.shape[0], args, threads)
 
@@ -168,7 +191,7 @@ def regressor_into(
     """Fill ``y`` (N, n, 10 n) with the regressor of ``state`` on ``threads`` threads (None: as
     set); ``g0`` overrides the gravity in frame 0. ``clear=False`` leaves the structurally zero
     entries alone: for a ``y`` that holds zeros there (fresh ``np.zeros``, or a regressor)."""
-    compile_kernels(data)
+    compile_kernel(data, Kernel.REGRESSOR)
     args = (data.geo, data.ends[2] if g0 is None else g0, state, y, clear)
     _launch(_regressor(data), y.shape[0], args, threads)
 
@@ -183,7 +206,7 @@ def regressor_gradient_into(
 ) -> None:
     """Fill ``sens`` (3, N, n) with the derivatives of ``sum(weights * Y)`` in each sample's
     ``q``, ``qd``, ``qdd`` (:func:`kinergy.dynamics._kernels.regressor_gradient_rows`)."""
-    compile_kernels(data, gradient=True)
+    compile_kernel(data, Kernel.GRADIENT)
     args = (data.geo, data.ends[2], state, weights, step_q, sens)
     # a sample costs 5 n + 1 regressors: the threads take one block of lanes at a time
     _launch(_kernels.regressor_gradient_rows, weights.shape[0], args, threads, _kernels.LANES)

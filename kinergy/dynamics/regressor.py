@@ -25,6 +25,7 @@ import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from kinergy.arrays import Array
+from kinergy.dynamics.blocks import result_array
 from kinergy.dynamics.chain import (
     check_state,
     contiguous_state,
@@ -104,8 +105,10 @@ def regressor(
     gravity : array_like, shape (3,), optional
         Overrides ``robot.gravity``.
     out : ndarray, shape (n, 10 n) or (N, n, 10 n), optional
-        C-contiguous float64 array the regressor is written to (any contents on entry): reusing
-        one saves the allocation and the page faults of a fresh (N, n, 10 n) array.
+        C-contiguous float64 array the regressor is written to (any contents on entry). Without
+        it the result is a new array of the caller's own; a large one reuses the memory of an
+        earlier result that nothing refers to any more (:mod:`kinergy.dynamics.blocks`), which
+        spares the page faults of fresh memory.
     threads : int, optional
         numba threads for this call (:func:`kinergy.dynamics.threads.kernel_threads`).
 
@@ -117,10 +120,11 @@ def regressor(
     single, s = check_state(robot, q=q, qd=qd, qdd=qdd)
     n = robot.n
     shape = (s["q"].shape[0], n, 10 * n)
-    # fresh zeros come from the OS as zero pages: the kernel then skips the structural zeros
-    y = np.zeros(shape) if out is None else output_array(out, shape, single)
+    # a fresh result may reuse the memory of one nothing refers to any more (no page faults):
+    # its contents are arbitrary, so the kernel writes the structural zeros too
+    y = result_array(shape) if out is None else output_array(out, shape, single)
     g0 = gravity_in_frame0(robot, gravity)
-    regressor_into(kernel_data(robot), contiguous_state(s), y, g0, threads, clear=out is not None)
+    regressor_into(kernel_data(robot), contiguous_state(s), y, g0, threads)
     if out is not None:
         return out
     return y[0] if single else y

@@ -53,4 +53,12 @@ MODEL = FrictionModel(
     shape_defaults={"exponent": EXPONENT},
     search={"exponent": EXPONENT_SEARCH},
     citation="power_law per direction of rotation (docs/FRICTION.md)",
+    units={
+        "coulomb_positive": "N m",
+        "coulomb_negative": "N m",
+        "viscous_positive": "N m (s/rad)^exponent",
+        "viscous_negative": "N m (s/rad)^exponent",
+        "exponent": "1",
+        "smoothing": "rad/s",
+    },
 )

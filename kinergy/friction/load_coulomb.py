@@ -47,4 +47,5 @@ MODEL = FrictionModel(
     columns=_columns,
     needs_load=True,
     citation="AURT (INTO-CPS Association); Bittencourt and Gunnarsson 2012",
+    units={"coulomb": "N m", "load": "1", "viscous": "N m s/rad", "smoothing": "rad/s"},
 )

@@ -66,4 +66,13 @@ MODEL = FrictionModel(
     needs_load=True,
     needs_temperature=True,
     citation="power_law + load_coulomb + thermal_viscous (docs/FRICTION.md)",
+    units={
+        "coulomb": "N m",
+        "load": "1",
+        "viscous": "N m (s/rad)^exponent",
+        "viscous_temperature": "N m (s/rad)^exponent/K",
+        "exponent": "1",
+        "reference_temperature": "°C",
+        "smoothing": "rad/s",
+    },
 )

@@ -71,4 +71,12 @@ MODEL = FrictionModel(
     bounds={"gamma1": (-np.inf, np.inf)},  # its sign goes with gamma2 - gamma3
     shape_defaults={"gamma2": 50.0, "gamma3": 5.0, "gamma5": 100.0},
     citation="nursing eq 13 (Makkar et al.)",
+    units={
+        "gamma1": "N m",
+        "gamma2": "s/rad",
+        "gamma3": "s/rad",
+        "gamma4": "N m",
+        "gamma5": "s/rad",
+        "gamma6": "N m s/rad",
+    },
 )

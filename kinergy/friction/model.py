@@ -88,6 +88,8 @@ class FrictionModel:
         ``exponent``); the linear parameters are solved for at every trial value.
     citation : str
         Where the model comes from (``UR5e eqs 11-16``).
+    units : mapping of str to str
+        Each parameter's unit (motor side), as tables print it: ``{"viscous": "N m s/rad"}``.
     linear_values, with_linear : callable, optional
         How :attr:`linear` maps to and from the parameters, when not one to one by name.
     """
@@ -104,6 +106,7 @@ class FrictionModel:
     needs_temperature: bool = False
     search: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     citation: str = ""
+    units: Mapping[str, str] = field(default_factory=dict)
     linear_values: Callable[[FrictionModel, Mapping[str, float]], Array] = _by_name
     with_linear: Callable[[FrictionModel, Mapping[str, float], Array], dict[str, float]] = (
         _replace_by_name

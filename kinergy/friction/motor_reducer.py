@@ -48,6 +48,12 @@ MODEL = FrictionModel(
     columns=columns,
     shape_defaults={"motor_coulomb": 0.5, "reducer_coulomb": 0.5},
     citation="framework Table 1",
+    units={
+        "motor_viscous": "N m s/rad",
+        "motor_coulomb": "N m",
+        "reducer_coulomb": "N m",
+        "smoothing": "rad/s",
+    },
     linear_values=_linear_values,
     with_linear=_with_linear,
 )

@@ -44,4 +44,10 @@ MODEL = FrictionModel(
     columns=_columns,
     needs_load=True,
     citation="UR5e eqs 11-16",
+    units={
+        "viscous": "N m s/rad",
+        "coulomb_direct": "N m",
+        "coulomb_reverse": "N m",
+        "smoothing": "rad/s",
+    },
 )

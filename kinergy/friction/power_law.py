@@ -58,4 +58,10 @@ MODEL = FrictionModel(
     shape_defaults={"exponent": EXPONENT},
     search={"exponent": EXPONENT_SEARCH},
     citation="power-law speed term (docs/FRICTION.md; fitted to a UR5e's factory calibration)",
+    units={
+        "coulomb": "N m",
+        "viscous": "N m (s/rad)^exponent",
+        "exponent": "1",
+        "smoothing": "rad/s",
+    },
 )

@@ -26,7 +26,7 @@ from kinergy.friction import (
     viscous_coulomb,
 )
 from kinergy.friction.model import FrictionModel
-from kinergy.friction.standstill import OPTIONAL_PARAMETERS, hold
+from kinergy.friction.standstill import OPTIONAL_PARAMETERS, OPTIONAL_UNITS, hold
 
 __all__ = [
     "MODELS",
@@ -35,6 +35,7 @@ __all__ = [
     "friction_torque",
     "get_model",
     "linear_values",
+    "parameter_units",
     "start_parameters",
     "with_linear_parameters",
 ]
@@ -66,6 +67,13 @@ def get_model(name: str) -> FrictionModel:
     except (KeyError, TypeError):
         known = ", ".join(sorted(MODELS))
         raise KinergyError(f"unknown friction model {name!r} (known: {known})") from None
+
+
+def parameter_units(model: str) -> dict[str, str]:
+    """Every parameter a joint of ``model`` may have (the optional standstill ones last), with
+    its unit, motor side: ``{"viscous": "N m s/rad", ..., "holding": "1"}``."""
+    spec = get_model(model)
+    return {**{name: spec.units.get(name, "") for name in spec.parameters}, **OPTIONAL_UNITS}
 
 
 def check_friction(model: str, params: Mapping[str, float]) -> dict[str, float]:

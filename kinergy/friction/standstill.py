@@ -18,11 +18,21 @@ from numpy.typing import NDArray
 
 from kinergy.arrays import Array
 
-__all__ = ["MIN_RUN", "OPTIONAL_PARAMETERS", "STILL_RATE", "hold", "hold_standstill", "sustained"]
+__all__ = [
+    "MIN_RUN",
+    "OPTIONAL_PARAMETERS",
+    "OPTIONAL_UNITS",
+    "STILL_RATE",
+    "hold",
+    "hold_standstill",
+    "sustained",
+]
 
 
 #: optional parameters of every model and their defaults
 OPTIONAL_PARAMETERS = {"standstill": 0.0, "holding": 1.0}
+#: ... and their units
+OPTIONAL_UNITS = {"standstill": "rad/s", "holding": "1"}
 #: a motor is stopped when |wm| < standstill and |dwm| < STILL_RATE * standstill (1/s)
 STILL_RATE = 100.0
 #: a run of motion shorter than this many samples does not set the held friction

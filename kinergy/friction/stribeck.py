@@ -40,4 +40,11 @@ MODEL = FrictionModel(
     positive=frozenset({"stribeck_speed"}),
     shape_defaults={"stribeck_speed": 10.0},
     citation="Stribeck (Olsson et al. 1998, eq 8)",
+    units={
+        "coulomb": "N m",
+        "static": "N m",
+        "stribeck_speed": "rad/s",
+        "viscous": "N m s/rad",
+        "smoothing": "rad/s",
+    },
 )

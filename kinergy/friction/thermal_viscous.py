@@ -66,4 +66,11 @@ MODEL = FrictionModel(
     shape_defaults={"reference_temperature": REFERENCE_TEMPERATURE},
     needs_temperature=True,
     citation="Raviola et al. 2021 (viscous friction of UR joints falls 17-20 % as they warm)",
+    units={
+        "coulomb": "N m",
+        "viscous": "N m s/rad",
+        "viscous_temperature": "N m s/(rad K)",
+        "reference_temperature": "°C",
+        "smoothing": "rad/s",
+    },
 )

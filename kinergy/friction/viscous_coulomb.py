@@ -36,4 +36,5 @@ MODEL = FrictionModel(
     linear=("viscous", "coulomb"),
     columns=columns,
     citation="framework Table 1",
+    units={"viscous": "N m s/rad", "coulomb": "N m", "smoothing": "rad/s"},
 )

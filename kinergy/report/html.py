@@ -245,6 +245,16 @@ def _png_size(path: Path) -> tuple[int, int] | None:
     return int(width), int(height)
 
 
+def _breakable(text: str) -> Any:
+    """``text`` escaped, with a line-break opportunity (``<wbr>``) after each ``_`` and ``/``:
+    a table cell such as ``coulomb_positive [N m]`` may wrap at ``coulomb_`` rather than
+    overflow its card."""
+    import markupsafe
+
+    parts = re.split(r"(?<=[_/])(?=.)", text)
+    return markupsafe.Markup("<wbr>").join(markupsafe.escape(part) for part in parts)
+
+
 @functools.cache
 def _template() -> Any:
     """The Jinja2 template, loaded once on first use (no work at import)."""
@@ -258,6 +268,7 @@ def _template() -> Any:
         lstrip_blocks=True,
         keep_trailing_newline=True,
     )
+    env.filters["breakable"] = _breakable
     return env.get_template("report.html.j2")
 
 

@@ -288,7 +288,8 @@ def error_boxplot(
         numbers of samples but the same joints.
     joint_names : sequence of str, length n
     quantity : str
-        What the errors are of, e.g. ``"Torque"``; the y label reads ``"{quantity} error [unit]"``.
+        What the errors are of, e.g. ``"torque"``: the title reads ``"Torque error per joint"``
+        and the y label ``"Torque error [unit]"`` (the first letter capitalised).
     unit : str
 
     Returns
@@ -307,6 +308,7 @@ def error_boxplot(
         raise KinergyError("errors_by_set: no data set given")
     sets = {str(k): _matrix(v, f"errors_by_set[{k!r}]", None, n) for k, v in errors_by_set.items()}
 
+    what = quantity[:1].upper() + quantity[1:]  # "torque" -> "Torque error per joint"
     k = len(sets)
     width = min(max((1.2 + 0.75 * n) * k, 7.0), 18.0)
     fig = _figure(width, 5.0)
@@ -325,12 +327,12 @@ def error_boxplot(
         ax.set_title(name, fontsize=_TITLE)
         ax.set_xlabel("Joint", fontsize=_LABEL)
         if i == 0:
-            ax.set_ylabel(f"{quantity} error [{unit}]", fontsize=_LABEL)
+            ax.set_ylabel(f"{what} error [{unit}]", fontsize=_LABEL)
         _style(ax)
         ax.grid(False, axis="x")
         if max(len(s) for s in names) * n > 48:
             ax.tick_params(axis="x", labelrotation=30)
-    fig.suptitle(f"{quantity} error per joint", fontsize=_SUPTITLE)
+    fig.suptitle(f"{what} error per joint", fontsize=_SUPTITLE)
     return fig
 
 

@@ -123,14 +123,15 @@ def _parameters_section(study: Study) -> tuple[Section, list[Table]]:
         )
     )
     warnings = study.result.warnings if study.result else []
-    text = intro + ("\n\nWarnings:\n" + "\n".join(warnings) if warnings else "")
+    # each warning a paragraph of its own (the report joins the lines of a paragraph)
+    text = "\n\n".join([intro, *(f"Warning: {w}" for w in warnings)])
     return Section("Identified drive parameters", text, tables, []), tables
 
 
 #: per compared signal: plot labels, units, table caption, figure numbers in the UR5e doc
 _SIGNALS = {
     "torque": {
-        "quantity": "joint torque",
+        "quantity": "Joint torque",
         "unit": "N m",
         "label": "target_moment",
         "series": "the controller's target_moment and the model's torque (UR5e Figs 8-9).",
@@ -141,7 +142,7 @@ _SIGNALS = {
         "against the controller's reference torque (eq 7).",
     },
     "current": {
-        "quantity": "motor current",
+        "quantity": "Motor current",
         "unit": "A",
         "label": "actual_current",
         "series": "measured and predicted motor current (UR5e Figs 11-12).",
@@ -197,7 +198,7 @@ def _accuracy_section(
         for name, c in comparisons.items()
     ]
     errors = {name: c.measured - c.predicted for name, c in comparisons.items()}
-    box = error_boxplot(errors, joint_names=names, quantity=f"{key} error", unit=info["unit"])
+    box = error_boxplot(errors, joint_names=names, quantity=key, unit=info["unit"])
     figures.append(_figure(box, figdir, f"{key}_errors.png", info["errors"]))
     paper = study.paper and study.model.n == 6
     published = seed.TABLE_V if key == "torque" else seed.TABLE_VII
@@ -267,13 +268,13 @@ def study_sections(study: Study, folder: Path) -> tuple[list[Section], dict[str,
     sections : list of Section
         For :func:`kinergy.report.html.write_report`.
     tables : dict of str to list of Table
-        The tables by key (``"IV"``, ``"V"``, ``"VI"``, ``"VII"``, ``"VIII"``, ``"breakdown"``,
-        ``"timing"``), for printing.
+        The tables by key (``"IV"``, ``"V"``, ``"VI"`` (one per friction model), ``"VII"``,
+        ``"VIII"``, ``"breakdown"``, ``"timing"``), for printing.
     """
     figdir = folder / "figures"
     figdir.mkdir(parents=True, exist_ok=True)
-    section, (iv, vi) = _parameters_section(study)
-    sections, tables = [section], {"IV": [iv], "VI": [vi]}
+    section, (iv, *vi) = _parameters_section(study)
+    sections, tables = [section], {"IV": [iv], "VI": vi}
     for key, number in (("torque", "V"), ("current", "VII")):
         comparisons = getattr(study, key)
         if comparisons:

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from kinergy.accounting.energy import EnergyReport
+from kinergy.friction.registry import get_model, parameter_units
 from kinergy.identify.metrics import JointMetrics
 from kinergy.model.robot import Robot
 from kinergy.report import seed
@@ -22,6 +23,7 @@ __all__ = [
     "accuracy_tables",
     "breakdown_table",
     "energy_tables",
+    "friction_table",
     "parameter_tables",
     "timing_table",
 ]
@@ -41,61 +43,64 @@ def _paper_key(name: str) -> str | None:
 
 
 def parameter_tables(model: Robot, truth: Robot | None = None) -> list[Table]:
-    """UR5e Tables IV (motor and reducer inertia) and VI (friction, torque constants) of ``model``,
-    with the twin's ``truth`` in brackets where given."""
+    """UR5e Table IV (motor and reducer inertia) of ``model`` and its Table VI (friction and
+    torque constants), one friction table per friction model the joints use, with a column per
+    parameter of that model and its unit; the twin's ``truth`` in brackets where given."""
     names = model.joint_names
-    inertia_rows, friction_rows = [], []
-
-    def pair(value: str, twin: str | None) -> str:
-        return value if twin is None else f"{value} ({twin})"
-
+    inertia_rows = []
     for j, joint in enumerate(model.joints):
         d = joint.drive
-        t = truth.joints[j].drive if truth is not None else None
         row = [names[j], _e(d.motor_inertia), _e(d.reducer_inertia), _e(d.rotor_inertia)]
-        if t is not None:
+        if truth is not None:
+            t = truth.joints[j].drive
             row += [_e(t.motor_inertia), f"{100 * (d.rotor_inertia / t.rotor_inertia - 1):+.2f}"]
         inertia_rows.append(row)
-        params = d.friction.params
-        tp = t.friction.params if t is not None and t.friction.model == d.friction.model else None
-        if d.friction.model == "power_flow":
-            cells = [
-                pair(_e(params["viscous"]), None if tp is None else _e(tp["viscous"])),
-                pair(
-                    _f(params["coulomb_direct"]), None if tp is None else _f(tp["coulomb_direct"])
-                ),
-                pair(
-                    _f(params["coulomb_reverse"]), None if tp is None else _f(tp["coulomb_reverse"])
-                ),
-            ]
-        else:
-            cells = [" ".join(f"{k}={v:.4g}" for k, v in params.items()), "", ""]
-        kt = pair(_f(d.torque_constant), None if t is None else _f(t.torque_constant))
-        friction_rows.append([names[j], d.friction.model, *cells, kt])
     inertia_headers = ["joint", "J_m [kg m²]", "J_r [kg m²]", "J_m + J_r [kg m²]"]
-    friction_headers = [
-        "joint",
-        "friction model",
-        "k_v [N m s/rad]",
-        "T_c dir [N m]",
-        "T_c rev [N m]",
-        "k_t [N m/A]",
-    ]
     note_iv = "Motor side. J_r from the reducer catalogue; J_m = identified (J_m + J_r) - J_r."
-    note_vi = "Motor side (UR5e eqs 11-17)."
     if truth is not None:
         inertia_headers += ["twin J_m (Table IV)", "J_m + J_r error [%]"]
         note_iv += " 'twin': the value the twin was built with (its true robot)."
-        note_vi += " In brackets: the value the twin was built with (its true robot)."
-    return [
-        Table("Motor and reducer inertia (UR5e Table IV)", inertia_headers, inertia_rows, note_iv),
-        Table(
-            "Friction and torque constants (UR5e Table VI)",
-            friction_headers,
-            friction_rows,
-            note_vi,
-        ),
-    ]
+    inertia = Table(
+        "Motor and reducer inertia (UR5e Table IV)", inertia_headers, inertia_rows, note_iv
+    )
+    families = dict.fromkeys(joint.drive.friction.model for joint in model.joints)
+    return [inertia, *(friction_table(model, family, truth) for family in families)]
+
+
+def friction_table(model: Robot, family: str, truth: Robot | None = None) -> Table:
+    """UR5e Table VI for the joints of ``model`` whose friction model is ``family``: the torque
+    constant, then one column per parameter of the model that any of them has (units from the
+    friction registry; "-" where a joint lacks an optional one); a joint of ``truth`` with the
+    same friction model in brackets."""
+    joints = [j for j, joint in enumerate(model.joints) if joint.drive.friction.model == family]
+    units = parameter_units(family)
+    used = {p for j in joints for p in model.joints[j].drive.friction.params}
+    params = [p for p in units if p in used]
+
+    def cell(value: float | None, twin: float | None) -> str:
+        text = "-" if value is None else f"{value:.4g}"
+        return text if twin is None else f"{text} ({twin:.4g})"
+
+    rows = []
+    for j in joints:
+        d = model.joints[j].drive
+        t = truth.joints[j].drive if truth is not None else None
+        twin = t.friction.params if t is not None and t.friction.model == family else {}
+        rows.append(
+            [
+                model.joint_names[j],
+                cell(d.torque_constant, None if t is None else t.torque_constant),
+                *(cell(d.friction.params.get(p), twin.get(p)) for p in params),
+            ]
+        )
+    headers = ["joint", "k_t [N m/A]", *(f"{p} [{units[p]}]" for p in params)]
+    note = f"Motor side. {family}: {get_model(family).citation}."
+    if truth is not None:
+        note += " In brackets: the value the twin was built with (its true robot)."
+    caption = "Friction and torque constants (UR5e Table VI)"
+    if family != "power_flow":
+        caption += f", {family} friction"
+    return Table(caption, headers, rows, note)
 
 
 def accuracy_tables(
