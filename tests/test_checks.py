@@ -197,7 +197,7 @@ def test_every_real_log_passes(robot, path, spec):
 def test_the_corrupted_2019_run_is_refused():
     path = UR10E / "identification_data" / "ur-19_09_27-11_32_02.csv"
     r = load_robot("ur10e")
-    with pytest.raises(KinergyError, match="units check failed.*beyond its limits"):
+    with pytest.raises(KinergyError, match=r"holds 1(\.\d+)?e\+30\d: not a value a robot logs"):
         CheckedLog(path, r, LogReading(columns=tuple(parse_columns(SHORT, 6)))).read()
 
 

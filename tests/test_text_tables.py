@@ -99,3 +99,45 @@ def test_friction_tables_one_per_model_with_its_parameters_and_units() -> None:
     assert doc.rows[0][2] == f"{viscous:.4g} ({viscous:.4g})"
     assert "(" not in power.rows[0][2] and "(" in power.rows[0][1]  # k_t has its truth
     assert "power_law:" in power.note and "nursing eq 13" in makkar.note
+
+
+def test_identify_prints_one_friction_table_per_model_within_the_width(
+    tmp_path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``kinergy identify --friction auto`` on the twin: each chosen model's table has its own
+    parameters with units, and no line of the text passes 120 characters."""
+    from kinergy.cli import main
+
+    log = tmp_path / "a.csv"
+    assert (
+        main(
+            [
+                "simulate",
+                "ur5e",
+                "--trajectory",
+                "test-a",
+                "--mismatch",
+                "realistic",
+                "--out",
+                str(log),
+            ]
+        )
+        == 0
+    )
+    capsys.readouterr()
+    out = tmp_path / "m.toml"
+    assert (
+        main(["identify", str(log), "--robot", "ur5e", "--friction", "auto", "--out", str(out)])
+        == 0
+    )
+    text = capsys.readouterr().out
+    assert max(len(line) for line in text.splitlines()) <= TABLE_WIDTH
+    from kinergy.friction.registry import get_model
+
+    models = {j.drive.friction.model for j in kinergy.load_robot(out).joints}
+    for model in models:
+        assert f"Friction, {model} (motor side)" in text
+        units = parameter_units(model)
+        for name in get_model(model).parameters:  # each parameter a column, with its unit
+            assert (f"{name} [{units[name]}]" if units[name] else name) in text
+    assert "friction (motor side)" not in text  # no longer one run-on column

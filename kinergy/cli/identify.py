@@ -20,7 +20,7 @@ from kinergy.cli.common import (
     writes,
 )
 from kinergy.cli.validate import validation_text
-from kinergy.friction.registry import MODELS
+from kinergy.friction.registry import MODELS, parameter_units
 from kinergy.identify.full import FullFit
 from kinergy.identify.options import IdentifyOptions, Method, Solver, Target
 from kinergy.identify.payload import PayloadEstimate
@@ -113,26 +113,46 @@ def _choice_text(result: IdentificationResult) -> list[str]:
     return [title, table(headers, rows)]
 
 
-def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
-    rows = []
-    for j in result.joints:
-        fr = " ".join(
-            f"{k}={_with_std(j, k, v, '.6g')}" for k, v in j.friction.items() if k != "model"
-        )
-        rows.append(
+def _friction_tables(result: IdentificationResult) -> list[str]:
+    """One table per friction model in the result: a column per parameter with its unit (motor
+    side), each value with its standard error and flag."""
+    lines: list[str] = []
+    models = dict.fromkeys(str(j.friction["model"]) for j in result.joints)
+    for model in models:
+        units = parameter_units(model)
+        names = [k for k in units if any(k in j.friction for j in result.joints)]
+        headers = ["joint", *(f"{k} [{units[k]}]" if units[k] else k for k in names)]
+        rows = [
             [
                 j.name,
-                _with_std(j, "rotor_inertia", j.rotor_inertia, ".4e"),
-                f"{j.motor_inertia:.4e}",
-                _with_std(j, "torque_constant", j.torque_constant, ".4f"),
-                f"{j.friction['model']} {fr}",
+                *(
+                    _with_std(j, k, float(j.friction[k]), ".4g") if k in j.friction else "-"
+                    for k in names
+                ),
             ]
-        )
+            for j in result.joints
+            if j.friction["model"] == model
+        ]
+        lines += [f"\nFriction, {model} (motor side)", table(headers, rows)]
+    return lines
+
+
+def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
+    rows = [
+        [
+            j.name,
+            _with_std(j, "rotor_inertia", j.rotor_inertia, ".4e"),
+            f"{j.motor_inertia:.4e}",
+            _with_std(j, "torque_constant", j.torque_constant, ".4f"),
+        ]
+        for j in result.joints
+    ]
     samples = result.fit.samples
-    headers = ["joint", "J_m+J_r [kg m^2]", "J_m [kg m^2]", "k_t [N m/A]", "friction (motor side)"]
+    headers = ["joint", "J_m+J_r [kg m^2]", "J_m [kg m^2]", "k_t [N m/A]"]
     lines = [
         f"{result.robot.name}: {result.method} identification from {logs} log(s), {samples} samples",
         table(headers, rows),
+        *_friction_tables(result),
     ]
     if isinstance(result.fit, FullFit):
         lines += _full_text(result.fit)
