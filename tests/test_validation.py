@@ -92,7 +92,9 @@ def test_a_corrupted_log_is_refused_in_one_line() -> None:
 
     corrupted = DATASETS / "identification_data" / "ur-19_09_27-11_32_02.csv"  # speeds of 1e293
     spec = "timestamp,actual_q:6,actual_qd:6,actual_current:6"
-    with pytest.raises(KinergyError, match=r"holds 1(\.\d+)?e\+30\d: not a value a robot logs in any unit"):
+    with pytest.raises(
+        KinergyError, match=r"holds 1(\.\d+)?e\+30\d: not a value a robot logs in any unit"
+    ):
         prepared_logs([corrupted], kinergy.load_robot("ur10e"), _reading(spec))
 
 
