@@ -363,3 +363,27 @@ def test_identify_and_validate_from_bags_print_what_the_csv_logs_give(
     assert main(["validate", "panda", str(bags[2])]) == 1
     err = capsys.readouterr().err
     assert "the robot's joint(s) joint1, joint2" in err and err.count("\n") == 1
+
+
+def test_a_bag_folder_is_known_by_the_content_of_its_files(tmp_path: Path) -> None:
+    """Two bags of different motions hash differently; the same bag copied hashes the same."""
+    import shutil
+
+    from kinergy.logs.reading import CheckedLog
+
+    robot = load_robot("ur10e")
+    from kinergy.predict import drive_state
+
+    digests = []
+    for seed, name in ((1, "a"), (2, "b")):
+        t, q, qd, _ = _motion(300, seed=seed)
+        current = drive_state(robot, q, qd, np.gradient(qd, t, axis=0)).current
+        write_bag(tmp_path / name, t, q, qd, current)
+    shutil.copytree(tmp_path / "a", tmp_path / "a-copy")
+    for name in ("a", "b", "a-copy"):
+        checked = CheckedLog(tmp_path / name, robot)
+        checked.read()
+        assert checked.provenance is not None and len(checked.provenance.sha256) == 64
+        assert checked.provenance.size > 0
+        digests.append(checked.provenance.sha256)
+    assert digests[0] != digests[1] and digests[0] == digests[2]

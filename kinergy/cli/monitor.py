@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import accept_option, fmt, load, progress
-from kinergy.jsonable import dumps
+from kinergy.cli.common import accept_option, fmt, json_result, load, progress
 from kinergy.live.monitor import CycleEnergy
 from kinergy.logs.checks import parse_accept
 from kinergy.workflows.monitor import monitor_cycles
@@ -68,7 +67,7 @@ def monitor(
     period = "not found" if tracker.period is None else f"{fmt(tracker.period)} s"
     if as_json:
         click.echo(
-            dumps(
+            json_result(
                 {
                     "robot": robot.name,
                     "period": tracker.period,

@@ -98,15 +98,27 @@ class Provenance:
     rows: int
 
 
+def _files(path: Path) -> list[Path]:
+    """The files a log is: the file itself, or every file of a log that is a folder (a rosbag2
+    folder, the panda-gaz layout), in sorted order."""
+    if path.is_dir():
+        return sorted(p for p in path.rglob("*") if p.is_file())
+    return [path]
+
+
 def _file_hash(path: Path, out: list[str], stop: threading.Event) -> None:
-    """SHA-256 of the file at ``path`` into ``out`` (nothing when ``stop`` is set first)."""
+    """SHA-256 of the log at ``path`` into ``out`` (nothing when ``stop`` is set first): of the
+    file's bytes, or of a folder's files, each by its relative name and bytes."""
     digest = hashlib.sha256()
     try:
-        with path.open("rb") as fh:
-            while block := fh.read(1 << 23):
-                if stop.is_set():
-                    return
-                digest.update(block)
+        for part in _files(path):
+            if path.is_dir():
+                digest.update(part.relative_to(path).as_posix().encode() + b"\0")
+            with part.open("rb") as fh:
+                while block := fh.read(1 << 23):
+                    if stop.is_set():
+                        return
+                    digest.update(block)
     except OSError:
         return
     out.append(digest.hexdigest())
@@ -268,7 +280,8 @@ class CheckedLog:
         else:
             assert hasher is not None
             hasher.join()
-            digest, size = (hashed[0] if hashed else ""), Path(self.source).stat().st_size
+            size = sum(p.stat().st_size for p in _files(Path(self.source)))
+            digest = hashed[0] if hashed else ""
         self.provenance = Provenance(self.path, digest, size, rows)
 
     def read(self) -> Log:
