@@ -29,9 +29,20 @@ from kinergy.friction.registry import (
     start_parameters,
     with_linear_parameters,
 )
+from kinergy.identify.chunks import Asks, answer, translated
 from kinergy.linalg import scaled_lstsq
 
-__all__ = ["CurveFit", "FrictionPoints", "choose_model", "fit_curve", "points_from", "search_shape"]
+__all__ = [
+    "CurveFit",
+    "FrictionPoints",
+    "Search",
+    "bounded_minimum",
+    "choose_model",
+    "fit_curve",
+    "points_from",
+    "search_shape",
+    "shape_search",
+]
 
 
 #: trial values of a searched shape parameter before the bounded refinement
@@ -102,26 +113,115 @@ class CurveFit:
         )
 
 
+#: a search of shape parameters (:func:`shape_search`): asks for the cost of batches of
+#: parameter sets and returns the parameters found
+Search = Asks[dict[str, float], float, dict[str, float]]
+
+
+def shape_search(model: str, params: Mapping[str, float]) -> Search:
+    """``params`` with each shape parameter the model searches (``FrictionModel.search``) set to
+    the value in its bounds that minimises a cost it asks for (:data:`Search`): a grid of
+    :data:`SEARCH_GRID` values in one batch, then a bounded 1-D refinement around the best
+    (:func:`bounded_minimum`); ``params`` unchanged for models without one."""
+    best = dict(params)
+    for name, (low, high) in get_model(model).search.items():
+        grid = np.linspace(low, high, SEARCH_GRID)
+        costs = yield [{**best, name: float(v)} for v in grid]
+        k = int(np.argmin(costs))
+        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+
+        def at(value: float, name: str = name) -> dict[str, float]:
+            return {**best, name: float(value)}
+
+        x, fx = yield from translated(bounded_minimum(lo, hi, xatol=1e-4), at, _same)
+        best[name] = float(x) if fx <= costs[k] else float(grid[k])
+    return best
+
+
+def _same(_: float, cost: float) -> float:
+    return cost
+
+
 def search_shape(
     model: str, params: Mapping[str, float], cost: Callable[[dict[str, float]], float]
 ) -> dict[str, float]:
-    """``params`` with each shape parameter the model searches (``FrictionModel.search``) set to
-    the value in its bounds that minimises ``cost`` (a grid of :data:`SEARCH_GRID` values, then
-    a bounded 1-D refinement around the best); ``params`` unchanged for models without one."""
-    from scipy.optimize import minimize_scalar  # slow to import; only shape searches need it
+    """:func:`shape_search` with each parameter set's cost from ``cost``."""
+    return answer(shape_search(model, params), lambda batch: [cost(p) for p in batch])
 
-    best = dict(params)
-    for name, (low, high) in get_model(model).search.items():
 
-        def trial(value: float, name: str = name) -> float:
-            return cost({**best, name: float(value)})
-
-        grid = np.linspace(low, high, SEARCH_GRID)
-        k = int(np.argmin([trial(v) for v in grid]))
-        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
-        found = minimize_scalar(trial, bounds=(lo, hi), method="bounded", options={"xatol": 1e-4})
-        best[name] = float(found.x) if found.fun <= trial(grid[k]) else float(grid[k])
-    return best
+def bounded_minimum(
+    x1: float, x2: float, *, xatol: float = 1e-5, maxiter: int = 500
+) -> Asks[float, float, tuple[float, float]]:
+    """Brent's bounded minimisation of a function of one value on ``[x1, x2]``, asking for its
+    value one point at a time; returns the minimum found and its value. The same steps as
+    SciPy's ``minimize_scalar(method="bounded")`` (Forsythe, Malcolm and Moler's ``fmin``), so
+    a search gives the same result whether its costs come from memory or from passes over
+    chunks."""
+    sqrt_eps = np.sqrt(2.2e-16)
+    golden_mean = 0.5 * (3.0 - np.sqrt(5.0))
+    a, b = x1, x2
+    fulc = a + golden_mean * (b - a)
+    nfc, xf = fulc, fulc
+    rat = e = 0.0
+    x = xf
+    (fx,) = yield [x]
+    num = 1
+    ffulc = fnfc = fx
+    xm = 0.5 * (a + b)
+    tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
+    tol2 = 2.0 * tol1
+    while np.abs(xf - xm) > (tol2 - 0.5 * (b - a)):
+        golden = True
+        if np.abs(e) > tol1:  # a parabolic step, if acceptable
+            golden = False
+            r = (xf - nfc) * (fx - ffulc)
+            q = (xf - fulc) * (fx - fnfc)
+            p = (xf - fulc) * q - (xf - nfc) * r
+            q = 2.0 * (q - r)
+            if q > 0.0:
+                p = -p
+            q = np.abs(q)
+            r = e
+            e = rat
+            if (np.abs(p) < np.abs(0.5 * q * r)) and (p > q * (a - xf)) and (p < q * (b - xf)):
+                rat = (p + 0.0) / q
+                x = xf + rat
+                if ((x - a) < tol2) or ((b - x) < tol2):
+                    si = np.sign(xm - xf) + ((xm - xf) == 0)
+                    rat = tol1 * si
+            else:
+                golden = True
+        if golden:  # a golden-section step
+            e = a - xf if xf >= xm else b - xf
+            rat = golden_mean * e
+        si = np.sign(rat) + (rat == 0)
+        x = xf + si * np.maximum(np.abs(rat), tol1)
+        (fu,) = yield [x]
+        num += 1
+        if fu <= fx:
+            if x >= xf:
+                a = xf
+            else:
+                b = xf
+            fulc, ffulc = nfc, fnfc
+            nfc, fnfc = xf, fx
+            xf, fx = x, fu
+        else:
+            if x < xf:
+                a = x
+            else:
+                b = x
+            if (fu <= fnfc) or (nfc == xf):
+                fulc, ffulc = nfc, fnfc
+                nfc, fnfc = x, fu
+            elif (fu <= ffulc) or (fulc == xf) or (fulc == nfc):
+                fulc, ffulc = x, fu
+        xm = 0.5 * (a + b)
+        tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
+        tol2 = 2.0 * tol1
+        if num >= maxiter:
+            break
+    return xf, fx
 
 
 def _linear_fit(model: str, params: Mapping[str, float], points: FrictionPoints) -> CurveFit:

@@ -46,6 +46,7 @@ from kinergy.drives.transmission import reflected_inertia, transmission_matrix
 from kinergy.dynamics.regressor import inertial_parameters
 from kinergy.errors import KinergyError
 from kinergy.friction.makkar import PARAMETERS as MAKKAR_PARAMETERS
+from kinergy.identify.chunks import LogChunks
 from kinergy.identify.cycles import cycle_average, find_period
 from kinergy.identify.friction_points import FrictionPoints, constant_speed_runs, friction_points
 from kinergy.identify.makkar_fit import MakkarFit, fit_makkar_lsq, fit_makkar_pso
@@ -426,14 +427,12 @@ def _write_links(robot: Robot, rf: RidgeFit, said: Messages) -> tuple[Robot, tup
 # The whole procedure
 
 
-def _check_inputs(datas: Sequence[IdentData], fit: str) -> None:
-    if not datas:
-        raise KinergyError("no log to identify from")
+def _check_inputs(logs: LogChunks, fit: str) -> None:
     if fit not in ("lsq", "pso"):
         raise KinergyError(f"unknown Makkar fit {fit!r} (known: lsq, pso)")
-    for d in datas:
-        if d.current is None:
-            raise KinergyError(f"{d.path}: the nursing method needs actual_current")
+    for segment, summary in zip(logs.segments, logs.summaries, strict=True):
+        if "current" not in summary.has:
+            raise KinergyError(f"{segment.path}: the nursing method needs actual_current")
 
 
 def _fitter(fit: str, seed: int) -> Fitter:
@@ -481,6 +480,24 @@ def identify_nursing(
     trim: int = 10,
     seed: int = 0,
 ) -> IdentificationResult:
+    """:func:`nursing` on prepared logs held in memory (each one chunk)."""
+    options = dict(eta=eta, fit=fit, period=period, cutoff=cutoff, split=split)
+    return nursing(robot, LogChunks.of(datas), alphas=alphas, trim=trim, seed=seed, **options)  # type: ignore[arg-type]
+
+
+def nursing(
+    robot: Robot,
+    logs: LogChunks,
+    *,
+    eta: float = 1.0,
+    fit: str = "lsq",
+    period: float | None = None,
+    cutoff: float | None = FILTER_CUTOFF,
+    split: float = 0.7,
+    alphas: ArrayLike | None = None,
+    trim: int = 10,
+    seed: int = 0,
+) -> IdentificationResult:
     """The nursing doc's identification (sections 4.1-4.2) from prepared logs.
 
     The four steps of the module docstring. Logs in which one joint moves (the others below a
@@ -494,7 +511,7 @@ def identify_nursing(
     ----------
     robot : Robot
         The starting model (kinematics, coupling, gear ratios, torque constants, rotor inertias).
-    datas : sequence of IdentData
+    logs : LogChunks
         Prepared logs with ``actual_current``.
     eta : float
         Eq 21's efficiency (the twin: 1; the doc's robot: 0.82).
@@ -514,7 +531,8 @@ def identify_nursing(
     KinergyError
         No logs, a log without ``actual_current``, an unknown ``fit``.
     """
-    _check_inputs(datas, fit)
+    _check_inputs(logs, fit)
+    datas = _whole(logs)
     said = Messages()
     fitter = _fitter(fit, seed)
     runs, excitation = _sort_logs(robot, datas, eta, trim)
@@ -532,7 +550,7 @@ def identify_nursing(
     links = kept is not None and len(kept) < robot.n
     identified = _sources(identified, friction=bool(new_friction), links=links)
     fit_out = NursingFit(
-        **fit_fields(identified, datas, said),
+        **fit_fields(identified, logs, said),
         friction_runs=tuple(joint_fits),
         friction_motors=tuple(motor_fits),
         ridge=summary,
@@ -541,3 +559,11 @@ def identify_nursing(
     )
     joints = _drive_estimates(identified, set(new_friction))
     return IdentificationResult(identified, "nursing", joints, fit_out)
+
+
+def _whole(logs: LogChunks) -> list[IdentData]:
+    """Each segment's chunks joined."""
+    parts: list[list[IdentData]] = [[] for _ in logs.segments]
+    for k, chunk in logs.chunks():
+        parts[k].append(chunk)
+    return [IdentData.joined(p) for p in parts]

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import MODELS
 
-__all__ = ["AUTO", "IdentifyOptions", "Method", "Solver", "Target"]
+__all__ = ["AUTO", "CurrentOptions", "Hold", "IdentifyOptions", "Method", "Solver", "Target"]
 
 #: ``friction``: per joint, the model with the lowest cross-validated current RMS
 AUTO = "auto"
@@ -49,6 +49,46 @@ class Solver(enum.StrEnum):
     RIDGE = "ridge"
 
 
+class Hold(enum.Enum):
+    """How much of its friction a stopped joint holds through standstill, as the current fit
+    tries it (:mod:`kinergy.identify.sequential`): each fraction of
+    :data:`~kinergy.identify.drive_steps.HOLDINGS`, keeping whichever explains the currents best
+    (``SEARCH``), none (the UR5e doc's model) or all of it."""
+
+    SEARCH = "search"
+    NONE = "none"
+    FULL = "full"
+
+
+def _check_friction(friction: str | None) -> None:
+    if friction is not None and friction != AUTO and friction not in MODELS:
+        known = ", ".join([*sorted(MODELS), AUTO])
+        raise KinergyError(f"--friction: unknown model {friction!r}; known: {known}")
+
+
+@dataclass(frozen=True)
+class CurrentOptions:
+    """What the torque constants and friction are fitted with on the currents (UR5e eqs 17-18).
+
+    Attributes
+    ----------
+    friction : str or None
+        A friction model of the registry for every joint, :data:`AUTO` (per joint, the model
+        with the lowest cross-validated current RMS) or None (each joint's own model).
+    hold : Hold
+    """
+
+    friction: str | None = None
+    hold: Hold = Hold.SEARCH
+
+    def __post_init__(self) -> None:
+        _check_friction(self.friction)
+
+    @property
+    def auto(self) -> bool:
+        return self.friction == AUTO
+
+
 @dataclass(frozen=True)
 class IdentifyOptions:
     """The options of an identification.
@@ -73,9 +113,15 @@ class IdentifyOptions:
     solver: Solver = Solver.OLS
     ridge: float = 0.0
 
+    def record(self) -> dict[str, str | float]:
+        """The options as a model file records them (``friction`` only when given)."""
+        out: dict[str, str | float] = {"method": self.method.value}
+        if self.friction is not None:
+            out["friction"] = self.friction
+        out.update(target=self.target.value, solver=self.solver.value, ridge=self.ridge)
+        return out
+
     def __post_init__(self) -> None:
-        if self.friction is not None and self.friction != AUTO and self.friction not in MODELS:
-            known = ", ".join([*sorted(MODELS), AUTO])
-            raise KinergyError(f"--friction: unknown model {self.friction!r}; known: {known}")
+        _check_friction(self.friction)
         if not 0.0 <= self.ridge < float("inf"):
             raise KinergyError(f"--ridge must be >= 0 and finite, got {self.ridge}")

@@ -14,15 +14,14 @@ Results are frozen dataclasses, written as JSON by :mod:`kinergy.jsonable`:
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from kinergy.arrays import Array
 from kinergy.drives.transmission import joint_torque
-from kinergy.identify.metrics import JointMetrics, fit_metrics
+from kinergy.identify.chunks import LogChunks, data_history
+from kinergy.identify.metrics import JointMetrics, MetricSums
 from kinergy.jsonable import to_jsonable
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs
@@ -43,6 +42,7 @@ __all__ = [
     "drive_fields",
     "fit_fields",
     "predict",
+    "predictions",
     "validation_metrics",
 ]
 
@@ -178,6 +178,10 @@ class Prediction:
     current: Array | None
     joint_torque: Array | None
 
+    def after(self, skip: int) -> Prediction:
+        """The predictions from row ``skip`` on."""
+        return Prediction(*(None if x is None else x[skip:] for x in vars(self).values()))
+
 
 def predict(robot: Robot, data: IdentData) -> Prediction:
     """Predict what ``data``'s log recorded: reference torques on the commanded motion, currents
@@ -193,47 +197,59 @@ def predict(robot: Robot, data: IdentData) -> Prediction:
     return Prediction(torque, current, joint)
 
 
+def predictions(
+    robot: Robot, logs: LogChunks, *fields: str
+) -> Iterator[tuple[int, IdentData, Prediction]]:
+    """:func:`predict` over every chunk (of the logs that have ``fields``): (segment number,
+    chunk, predictions), friction held through standstill as in each whole log."""
+    held = data_history(robot)
+    for k, chunk in logs.chunks(*fields):
+        data, skip = held.ahead(k, chunk)
+        pred = predict(robot, data)
+        held.update(data, skip)
+        yield k, chunk, pred.after(skip)
+
+
 def fit_fields(
     robot: Robot,
-    datas: Sequence[IdentData],
+    logs: LogChunks,
     said: Messages,
     *,
     samples: int | None = None,
 ) -> dict[str, Any]:
     """The :class:`Fit` fields every method reports, as keyword arguments of its fit: the
-    identified ``robot``'s :func:`validation_metrics` on ``datas``, the samples used (all the
+    identified ``robot``'s :func:`validation_metrics` on ``logs``, the samples used (all the
     logs' unless given), the logs, their lags (s) and what the fit ``said``."""
     return {
-        **vars(validation_metrics(robot, datas)),
-        "samples": int(sum(len(d) for d in datas)) if samples is None else samples,
-        "logs": tuple(d.path for d in datas),
-        "lag": tuple(d.lag for d in datas),
+        **vars(validation_metrics(robot, logs)),
+        "samples": sum(s.samples for s in logs.summaries) if samples is None else samples,
+        "logs": logs.paths,
+        "lag": logs.lags,
         "warnings": tuple(said.warnings),
         "notes": tuple(said.notes),
     }
 
 
-def validation_metrics(robot: Robot, datas: Sequence[IdentData]) -> Validation:
+def validation_metrics(robot: Robot, logs: LogChunks | Sequence[IdentData]) -> Validation:
     """UR5e Tables V and VII over several logs (pooled): per joint mean, max, RMS error and R^2
     of the torque (against ``target_moment``), the current (against ``actual_current``) and, for
-    arms with torque sensors, the joint torque."""
-    pairs: dict[str, tuple[list[Array], list[Array]]] = {
-        "torque": ([], []),
-        "current": ([], []),
-        "joint_torque": ([], []),
-    }
-    for data in datas:
-        pred = predict(robot, data)
+    arms with torque sensors, the joint torque. Where every log has joint voltages, the
+    predicted currents are kept (:attr:`LogChunks.currents`) for the electrics' fit."""
+    logs = logs if isinstance(logs, LogChunks) else LogChunks.of(logs)
+    sums: dict[str, MetricSums] = {}
+    keep = logs.every("voltage", "current")
+    kept = logs.derived() if keep else None
+    for _, chunk, pred in predictions(robot, logs):
         for key, measured, predicted in (
-            ("torque", data.tau_ref, pred.torque),
-            ("current", data.current, pred.current),
-            ("joint_torque", data.torque, pred.joint_torque),
+            ("torque", chunk.tau_ref, pred.torque),
+            ("current", chunk.current, pred.current),
+            ("joint_torque", chunk.torque, pred.joint_torque),
         ):
             if measured is not None and predicted is not None:
-                pairs[key][0].append(measured)
-                pairs[key][1].append(predicted)
-    found = {
-        key: fit_metrics(np.vstack(meas), np.vstack(preds)) if meas else None
-        for key, (meas, preds) in pairs.items()
-    }
-    return Validation(**found)
+                sums.setdefault(key, MetricSums(robot.n)).add(measured, predicted)
+        if kept is not None:
+            kept.put([pred.current])
+    if kept is not None:
+        logs.currents = (robot, kept)
+    names = ("torque", "current", "joint_torque")
+    return Validation(**{k: sums[k].metrics() if k in sums else None for k in names})
