@@ -75,7 +75,7 @@ import numpy as np
 from kinergy.dynamics.regressor import BaseParameters, base_parameters, inertial_parameters
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import MODELS, get_model, linear_values, with_linear_parameters
-from kinergy.identify.chunks import LogChunks, Summary
+from kinergy.identify.chunks import LogChunks, Summary, one_blas_thread
 from kinergy.identify.columns import (
     LOAD_DEPENDENT,
     Regression,
@@ -380,7 +380,7 @@ def _evaluate(
             wm = rows.wm[:, flows]
             mismatch += int(np.sum(np.sign(wm * own) != np.sign(wm * rows.load[:, flows])))
         first = -at % step
-        poses.append(rows.q[first::step])
+        poses.append(rows.q[first::step].copy())  # no view: it would keep the chunk
         at += len(rows.q)
     return _Evaluation(
         regression.metrics(),
@@ -629,6 +629,7 @@ def identify_full(
     return full(robot, LogChunks.of(datas), options, currents=currents)
 
 
+@one_blas_thread
 def full(
     robot: Robot,
     logs: LogChunks,

@@ -15,7 +15,18 @@ from dataclasses import dataclass
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import MODELS
 
-__all__ = ["AUTO", "CurrentOptions", "Hold", "IdentifyOptions", "Method", "Solver", "Target"]
+__all__ = [
+    "AUTO",
+    "FILTER_CUTOFF",
+    "CurrentOptions",
+    "Hold",
+    "IdentifyOptions",
+    "MakkarMethod",
+    "Method",
+    "NursingOptions",
+    "Solver",
+    "Target",
+]
 
 #: ``friction``: per joint, the model with the lowest cross-validated current RMS
 AUTO = "auto"
@@ -125,3 +136,49 @@ class IdentifyOptions:
         _check_friction(self.friction)
         if not 0.0 <= self.ridge < float("inf"):
             raise KinergyError(f"--ridge must be >= 0 and finite, got {self.ridge}")
+
+
+#: the nursing doc's low-pass cutoff for the motor currents, Hz
+FILTER_CUTOFF = 15.0
+
+
+class MakkarMethod(enum.StrEnum):
+    """How the nursing method fits Makkar's friction curve (nursing eq 13): least squares or
+    the doc's particle swarm."""
+
+    LSQ = "lsq"
+    PSO = "pso"
+
+
+@dataclass(frozen=True)
+class NursingOptions:
+    """The options of the nursing method (:func:`kinergy.identify.nursing.nursing`).
+
+    Attributes
+    ----------
+    eta : float
+        Nursing eq 21's efficiency (the twin: 1; the doc's robot: 0.82).
+    fit : MakkarMethod
+    period : float or None
+        The excitation's period, s; None: found from each log.
+    cutoff : float or None
+        The currents' low-pass cutoff, Hz (the doc's 15); None: not filtered.
+    split : float
+        The share of the excitation samples (in time) that trains the ridge regression, in
+        (0, 1].
+    alphas : tuple of float or None
+        The ridge weights tried (default ``logspace(-12, 0, 49)``).
+    trim : int
+        Samples dropped at each end of a constant-speed run.
+    seed : int
+        The particle swarm's seed.
+    """
+
+    eta: float = 1.0
+    fit: MakkarMethod = MakkarMethod.LSQ
+    period: float | None = None
+    cutoff: float | None = FILTER_CUTOFF
+    split: float = 0.7
+    alphas: tuple[float, ...] | None = None
+    trim: int = 10
+    seed: int = 0

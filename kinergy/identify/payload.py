@@ -40,7 +40,8 @@ from kinergy.drives.electrics import torque_constants
 from kinergy.drives.transmission import joint_torque
 from kinergy.dynamics.regressor import regressor
 from kinergy.errors import KinergyError
-from kinergy.identify.chunks import LogChunks, data_history
+from kinergy.identify.chunks import LogChunks, data_history, one_blas_thread
+from kinergy.identify.columns import ROWS
 from kinergy.identify.drive_steps import joined
 from kinergy.identify.physical import inertia_vector, link_from_standard
 from kinergy.linalg import Reduced, scaled_solution
@@ -118,6 +119,7 @@ def identify_payload(
     return payload(robot, LogChunks.of(datas), signal=signal)
 
 
+@one_blas_thread
 def payload(
     robot: Robot, logs: LogChunks, *, signal: str = "auto"
 ) -> tuple[Payload, PayloadEstimate]:
@@ -388,16 +390,18 @@ def _cells(bare: Robot, guess: Robot, logs: LogChunks, signal: str) -> list[_Cel
     held = data_history(guess)
     at = 0
     for k, chunk in logs.chunks():
-        data, skip = held.ahead(k, chunk)
-        a, b = _residuals(bare, guess, data, signal, skip)
-        held.update(data, skip)
-        size = len(chunk)
-        for c, (lo, hi) in enumerate(itertools.pairwise(cuts)):
-            lo, hi = max(lo, at), min(hi, at + size)
-            if lo < hi:
-                rows = slice(n * (lo - at), n * (hi - at))
-                problems[c] = problems[c].stack(a[rows], b[rows])
-        at += size
+        for lo in range(0, len(chunk), ROWS):
+            part = chunk.sliced(lo, min(lo + ROWS, len(chunk)))
+            data, skip = held.ahead(k, part)
+            a, b = _residuals(bare, guess, data, signal, skip)
+            held.update(data, skip)
+            size = len(part)
+            for c, (lo, hi) in enumerate(itertools.pairwise(cuts)):
+                lo, hi = max(lo, at), min(hi, at + size)
+                if lo < hi:
+                    rows = slice(n * (lo - at), n * (hi - at))
+                    problems[c] = problems[c].stack(a[rows], b[rows])
+            at += size
     out = []
     for c, (lo, _) in enumerate(itertools.pairwise(cuts)):
         log = int(np.searchsorted(starts, lo, side="right")) - 1

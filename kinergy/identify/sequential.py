@@ -33,7 +33,7 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import get_model
-from kinergy.identify.chunks import STILL_SPEED, LogChunks, Summary
+from kinergy.identify.chunks import STILL_SPEED, LogChunks, Summary, one_blas_thread
 from kinergy.identify.drive_steps import (
     AUTO_CANDIDATES,
     CurrentStats,
@@ -229,6 +229,7 @@ def identify_sequential(
     return sequential(robot, LogChunks.of(datas), CurrentOptions(friction, hold))
 
 
+@one_blas_thread
 def sequential(
     robot: Robot, logs: LogChunks, options: CurrentOptions | None = None
 ) -> IdentificationResult:
@@ -281,6 +282,7 @@ class DrivesFromCurrents:
     said: Messages
 
 
+@one_blas_thread
 def drives_from_currents(
     robot: Robot, logs: LogChunks, options: CurrentOptions | None = None
 ) -> DrivesFromCurrents:
