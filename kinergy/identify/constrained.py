@@ -160,7 +160,7 @@ def _solve(problem: cp.Problem) -> str | None:
                 problem.solve(solver=solver)
         except (cp.error.SolverError, ValueError):  # pragma: no cover - solver failure
             continue
-        if problem.status in ("optimal", "optimal_inaccurate"):
+        if problem.status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
             return solver
     return None
 

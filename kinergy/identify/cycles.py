@@ -12,7 +12,6 @@ of periods without the phase lag of a filter:
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -104,7 +103,7 @@ class CycleAverage:
 
 def cycle_average(
     t: ArrayLike, signals: ArrayLike | Mapping[str, ArrayLike], period: float
-) -> tuple[Array, Any]:
+) -> tuple[Array, Array | dict[str, Array]]:
     """Eq 24 (:class:`CycleAverage`) of signals held whole.
 
     Parameters

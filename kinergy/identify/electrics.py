@@ -9,7 +9,7 @@ gives both (:func:`fit_electrics`). :func:`with_electrics` writes them into a mo
 
 The arm's supply (``actual_robot_voltage`` x ``actual_robot_current``) is the motors' bus power
 plus a constant standby (:mod:`kinergy.drives.bus`); with a model that predicts the motors' power,
-the mean of the rest is the standby power (:func:`fit_standby`).
+the mean of the rest is the standby power (:func:`kinergy.workflows.identify.measured_electrics`).
 """
 
 from __future__ import annotations
@@ -22,19 +22,14 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kinergy.arrays import Array
-from kinergy.drives.bus import supply_power
 from kinergy.errors import KinergyError
 from kinergy.linalg import Reduced, scaled_lstsq, scaled_solution
 from kinergy.model.robot import Robot
-from kinergy.predict import drive_state
-from kinergy.trajectory.motion import CONTROLLER_DT
 
 __all__ = [
     "ElectricsFit",
     "ElectricsSums",
-    "StandbyFit",
     "fit_electrics",
-    "fit_standby",
     "with_electrics",
 ]
 
@@ -167,46 +162,3 @@ def with_electrics(robot: Robot, fits: Sequence[ElectricsFit | None]) -> Robot:
         )
         joints.append(dataclasses.replace(joint, drive=drive))
     return robot.with_joints(joints)
-
-
-@dataclass(frozen=True)
-class StandbyFit:
-    """The arm's standby power (W), its standard error (W, from the spread of the per-second
-    means) and the samples it is the mean over."""
-
-    standby: float
-    std: float
-    samples: int
-
-
-def fit_standby(
-    robot: Robot,
-    motion: tuple[Array, Array, Array],
-    supply: Array,
-    *,
-    temperature: Array | None = None,
-    dt: float = CONTROLLER_DT,
-) -> StandbyFit:
-    """The standby power: measured supply power minus the motors' predicted draw, averaged.
-
-    Parameters
-    ----------
-    robot : Robot
-        A model that predicts the motors' electrical power (identified drives and electrics);
-        its own ``standby_power`` is not used.
-    motion : (q, qd, qdd), each (N, n)
-        The real motion, rad, rad/s, rad/s^2.
-    supply : ndarray, shape (N,)
-        Measured supply power ``actual_robot_voltage * actual_robot_current``, W.
-    temperature : ndarray, shape (N, n), optional
-        Joint temperatures, deg C.
-    dt : float
-        Sample period, s (the standard error takes one-second means as independent).
-    """
-    q, qd, qdd = motion
-    state = drive_state(robot, q, qd, qdd, temperature=temperature)
-    rest = np.asarray(supply, dtype=float) - supply_power(state.power).motors
-    per_second = max(1, round(1.0 / dt))
-    means = [rest[k : k + per_second].mean() for k in range(0, rest.size, per_second)]
-    std = float(np.std(means) / np.sqrt(len(means))) if len(means) > 1 else float("nan")
-    return StandbyFit(float(rest.mean()), std, int(rest.size))

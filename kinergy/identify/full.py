@@ -445,7 +445,7 @@ def _joints(
             flags = {"rotor_inertia": flags["rotor_inertia"], **drives.flags[m]}
             std = {"rotor_inertia": std["rotor_inertia"], **drives.std[m]}
         fields = drive_fields(joint, rotor_inertia=float(written.x[col]))
-        names = get_model(fields["friction"]["model"]).linear
+        names = get_model(joint.drive.friction.model).linear
         out.append(
             FullJoint(
                 **fields,
@@ -505,7 +505,7 @@ def _fit(logs: LogChunks, steps: _Steps, *, solver: Solver, ridge: float) -> Ful
     b = cols.n_link
     regression = steps.evaluation.regression
     return FullFit(
-        **fit_fields(steps.robot, logs, said),
+        **vars(fit_fields(steps.robot, logs, said)),
         target=target.value,
         solver=solver.value,
         ridge=float(ridge),

@@ -588,7 +588,7 @@ def nursing(
     links = kept is not None and len(kept) < robot.n
     identified = _sources(identified, friction=bool(new_friction), links=links)
     fit_out = NursingFit(
-        **fit_fields(identified, logs, said),
+        **vars(fit_fields(identified, logs, said)),
         friction_runs=tuple(joint_fits),
         friction_motors=tuple(motor_fits),
         ridge=summary,

@@ -43,6 +43,7 @@ from kinergy.errors import KinergyError
 from kinergy.identify.chunks import LogChunks, data_history, one_blas_thread
 from kinergy.identify.columns import ROWS
 from kinergy.identify.drive_steps import joined
+from kinergy.identify.options import Target
 from kinergy.identify.physical import inertia_vector, link_from_standard
 from kinergy.linalg import Reduced, scaled_solution
 from kinergy.logs.prepare import IdentData
@@ -113,15 +114,21 @@ class PayloadEstimate:
 
 
 def identify_payload(
-    robot: Robot, datas: Sequence[IdentData], *, signal: str = "auto"
+    robot: Robot, datas: Sequence[IdentData], *, signal: Target | str = Target.AUTO
 ) -> tuple[Payload, PayloadEstimate]:
     """:func:`payload` from prepared logs held in memory (each one chunk)."""
-    return payload(robot, LogChunks.of(datas), signal=signal)
+    try:
+        parsed = Target(signal)
+    except ValueError:
+        raise KinergyError(
+            f"unknown signal {signal!r} (known: auto, current, torque, moment)"
+        ) from None
+    return payload(robot, LogChunks.of(datas), signal=parsed)
 
 
 @one_blas_thread
 def payload(
-    robot: Robot, logs: LogChunks, *, signal: str = "auto"
+    robot: Robot, logs: LogChunks, *, signal: Target = Target.AUTO
 ) -> tuple[Payload, PayloadEstimate]:
     """Identify the payload at the flange from logs taken with it.
 
@@ -131,9 +138,9 @@ def payload(
         The model identified without the payload (its own payload, if any, is ignored).
     logs : LogChunks
         Logs taken with the payload.
-    signal : {"auto", "current", "torque", "moment"}
-        What measures the joint torques: motor currents (default when present), measured joint
-        torques, or ``target_moment`` (only if the controller was told about the payload).
+    signal : Target
+        What measures the joint torques: motor currents (``AUTO``: them when present), measured
+        joint torques, or ``target_moment`` (only if the controller was told about the payload).
 
     Returns
     -------
@@ -149,7 +156,7 @@ def payload(
         No usable signal, a negative mass, or a motion that does not excite the payload.
     """
     bare = robot.with_payload(None)
-    signal = _pick_signal(logs) if signal == "auto" else signal
+    signal = _pick_signal(logs) if signal == Target.AUTO else signal
     cells, x, std, cond = _point_mass(robot, bare, logs, signal)
     every = [c.problem for c in cells]
     full, full_std, cond_full = scaled_solution(joined(every))
@@ -307,9 +314,13 @@ def _uncertainty_notes(
     return tuple(notes)
 
 
-def _pick_signal(logs: LogChunks) -> str:
+def _pick_signal(logs: LogChunks) -> Target:
     """The signal every log has: currents, else measured torques, else ``target_moment``."""
-    for name, attr in (("current", "current"), ("torque", "torque"), ("moment", "tau_ref")):
+    for name, attr in (
+        (Target.CURRENT, "current"),
+        (Target.TORQUE, "torque"),
+        (Target.MOMENT, "tau_ref"),
+    ):
         if logs.every(attr):
             return name
     raise KinergyError(
@@ -318,7 +329,7 @@ def _pick_signal(logs: LogChunks) -> str:
 
 
 def _point_mass(
-    robot: Robot, bare: Robot, logs: LogChunks, signal: str
+    robot: Robot, bare: Robot, logs: LogChunks, signal: Target
 ) -> tuple[list[_Cell], Array, Array, float]:
     """Mass and first moment ``[m, m c]`` (4,) by least squares, iterated to a fixed point because
     the payload moves the friction's power-flow direction (UR5e eqs 12-13), a pass over the logs
@@ -344,14 +355,14 @@ def _com(robot: Robot, x: Array) -> Array:
 
 
 def _residuals(
-    bare: Robot, guess: Robot, data: IdentData, signal: str, skip: int
+    bare: Robot, guess: Robot, data: IdentData, signal: Target, skip: int
 ) -> tuple[Array, Array]:
     """The payload regressor of ``data``'s samples after the first ``skip`` (rows: samples x
     joints, 10 columns) and the torque the bare model leaves unexplained, with friction
     evaluated on the loaded ``guess`` (held through standstill as the ``skip`` samples before
     say)."""
     n = bare.n
-    if signal == "moment":
+    if signal == Target.MOMENT:
         if data.tau_ref is None:
             raise KinergyError(f"{data.path}: no target_moment")
         q, qd, qdd = data.q_cmd[skip:], data.qd_cmd[skip:], data.qdd_cmd[skip:]
@@ -362,7 +373,7 @@ def _residuals(
         state = drive_state(bare, q, qd, qdd)
         loaded = drive_state(guess, data.q, data.qd, data.qdd).tau_friction[skip:]
         predicted = joint_torque(bare, state.tau_load + loaded)
-        if signal == "current":
+        if signal == Target.CURRENT:
             if data.current is None:
                 raise KinergyError(f"{data.path}: no actual_current")
             measured = joint_torque(bare, data.current[skip:] * torque_constants(bare))
@@ -374,7 +385,7 @@ def _residuals(
     return y[:, :, 10 * (n - 1) :].reshape(-1, 10), (measured - predicted).reshape(-1)
 
 
-def _cells(bare: Robot, guess: Robot, logs: LogChunks, signal: str) -> list[_Cell]:
+def _cells(bare: Robot, guess: Robot, logs: LogChunks, signal: Target) -> list[_Cell]:
     """One pass: every cell's triangle (:class:`_Cell`) of the payload's regression with
     friction evaluated on ``guess``."""
     n = bare.n
@@ -435,7 +446,7 @@ def _finish(
     std: Array,
     cond: float,
     inertia_ok: bool,
-    signal: str,
+    signal: Target,
     samples: int,
 ) -> tuple[Payload, PayloadEstimate]:
     """The payload and its report from ``[m, m c, I_o]`` (10,) and standard errors."""
@@ -450,7 +461,7 @@ def _finish(
         note = "the motion does not excite the payload's inertia enough: point mass"
     inertia_ok = inertia_ok and note is None
     report = PayloadEstimate(
-        signal=signal,
+        signal=signal.value,
         mass=mass,
         mass_std=float(std[0]),
         com=tuple(com.tolist()),

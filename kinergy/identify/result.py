@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypedDict
 
 from kinergy.arrays import Array
 from kinergy.drives.transmission import joint_torque
@@ -35,6 +35,7 @@ __all__ = [
     "IDENTIFIED",
     "KEPT",
     "DriveEstimate",
+    "DriveFields",
     "Fit",
     "IdentificationResult",
     "Prediction",
@@ -82,24 +83,34 @@ class Fit(Validation):
     notes: tuple[str, ...] = ()
 
 
-def friction_entry(joint: Joint) -> dict[str, Any]:
+def friction_entry(joint: Joint) -> dict[str, str | float]:
     """``{"model": name, **parameters}`` of a joint's friction, as results report it."""
     return {"model": joint.drive.friction.model, **joint.drive.friction.params}
 
 
-def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> dict[str, Any]:
+class DriveFields(TypedDict):
+    """The fields every method's per-joint result starts from (:func:`drive_fields`)."""
+
+    name: str
+    rotor_inertia: float
+    motor_inertia: float
+    torque_constant: float
+    friction: dict[str, str | float]
+
+
+def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> DriveFields:
     """A joint's drive as the model holds it, as :class:`DriveEstimate` fields (``name``,
     ``rotor_inertia``, ``motor_inertia``, ``torque_constant``, ``friction``): keyword arguments
     of a method's per-joint result. ``rotor_inertia`` (kg m^2, motor side) replaces the drive's
     J_m + J_r where a method estimates it on its own."""
     drive = joint.drive
-    return {
-        "name": joint.name,
-        "rotor_inertia": drive.rotor_inertia if rotor_inertia is None else rotor_inertia,
-        "motor_inertia": drive.motor_inertia,
-        "torque_constant": drive.torque_constant,
-        "friction": friction_entry(joint),
-    }
+    return DriveFields(
+        name=joint.name,
+        rotor_inertia=drive.rotor_inertia if rotor_inertia is None else rotor_inertia,
+        motor_inertia=drive.motor_inertia,
+        torque_constant=drive.torque_constant,
+        friction=friction_entry(joint),
+    )
 
 
 @dataclass(frozen=True)
@@ -214,20 +225,18 @@ def fit_fields(
     robot: Robot,
     logs: LogChunks,
     said: Messages,
-    *,
-    samples: int | None = None,
-) -> dict[str, Any]:
-    """The :class:`Fit` fields every method reports, as keyword arguments of its fit: the
-    identified ``robot``'s :func:`validation_metrics` on ``logs``, the samples used (all the
-    logs' unless given), the logs, their lags (s) and what the fit ``said``."""
-    return {
+) -> Fit:
+    """The :class:`Fit` every method reports (its own fit extends it, ``**vars(fit)``): the
+    identified ``robot``'s :func:`validation_metrics` on ``logs``, the samples, the logs, their
+    lags (s) and what the fit ``said``."""
+    return Fit(
         **vars(validation_metrics(robot, logs)),
-        "samples": sum(s.samples for s in logs.summaries) if samples is None else samples,
-        "logs": logs.paths,
-        "lag": logs.lags,
-        "warnings": tuple(said.warnings),
-        "notes": tuple(said.notes),
-    }
+        samples=sum(s.samples for s in logs.summaries),
+        logs=logs.paths,
+        lag=logs.lags,
+        warnings=tuple(said.warnings),
+        notes=tuple(said.notes),
+    )
 
 
 def validation_metrics(robot: Robot, logs: LogChunks | Sequence[IdentData]) -> Validation:

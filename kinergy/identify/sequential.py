@@ -259,7 +259,7 @@ def sequential(
     sources = _sources(staged, has_ref, has_current)
     identified = dataclasses.replace(staged, sources=sources)
     fit = SequentialFit(
-        **fit_fields(identified, logs, said),
+        **vars(fit_fields(identified, logs, said)),
         condition_rotor_inertia=cond,
         friction_holding=held,
         friction_choice=choices if options.auto else None,
