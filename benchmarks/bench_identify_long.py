@@ -116,7 +116,9 @@ def logs_in(folder: Path) -> dict[tuple[int, bool], Path]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cases", default=",".join(CASES), help="comma-separated, of: " + ", ".join(CASES))
+    parser.add_argument(
+        "--cases", default=",".join(CASES), help="comma-separated, of: " + ", ".join(CASES)
+    )
     parser.add_argument("--logs", type=Path, help="a folder to keep (or find) the logs in")
     args = parser.parse_args()
     cases = [c.strip() for c in args.cases.split(",")]
@@ -128,7 +130,9 @@ def main() -> None:
         folder = args.logs or Path(tmp)
         folder.mkdir(parents=True, exist_ok=True)
         logs = logs_in(folder)
-        print("| case | log | wall s | CPU s | peak RSS MB | load before / after | 60 / 5 min (wall, CPU) |")
+        print(
+            "| case | log | wall s | CPU s | peak RSS MB | load before / after | 60 / 5 min (wall, CPU) |"
+        )
         print("|---|---|---:|---:|---:|---|---|")
         for case in cases:
             loaded, options = CASES[case]
@@ -142,7 +146,9 @@ def main() -> None:
                 r = runs[minutes] = timed(command)
                 ratio = ""
                 if minutes == 60:
-                    ratio = f"{r['wall'] / runs[5]['wall']:.1f} x, {r['cpu'] / runs[5]['cpu']:.1f} x"
+                    ratio = (
+                        f"{r['wall'] / runs[5]['wall']:.1f} x, {r['cpu'] / runs[5]['cpu']:.1f} x"
+                    )
                 print(
                     f"| {case} | {minutes} min | {r['wall']:.1f} | {r['cpu']:.1f} | {r['rss']:.0f} | "
                     f"{r['load']:.1f} / {r['load_after']:.1f} | {ratio} |",

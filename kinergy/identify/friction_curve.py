@@ -149,79 +149,40 @@ def search_shape(
     return answer(shape_search(model, params), lambda batch: [cost(p) for p in batch])
 
 
+class _Unknown(Exception):
+    """The cost at ``value`` is not known yet."""
+
+    def __init__(self, value: float):
+        self.value = value
+
+
 def bounded_minimum(
-    x1: float, x2: float, *, xatol: float = 1e-5, maxiter: int = 500
+    low: float, high: float, *, xatol: float = 1e-5
 ) -> Asks[float, float, tuple[float, float]]:
-    """Brent's bounded minimisation of a function of one value on ``[x1, x2]``, asking for its
-    value one point at a time; returns the minimum found and its value. The same steps as
-    SciPy's ``minimize_scalar(method="bounded")`` (Forsythe, Malcolm and Moler's ``fmin``), so
-    a search gives the same result whether its costs come from memory or from passes over
-    chunks."""
-    sqrt_eps = np.sqrt(2.2e-16)
-    golden_mean = 0.5 * (3.0 - np.sqrt(5.0))
-    a, b = x1, x2
-    fulc = a + golden_mean * (b - a)
-    nfc, xf = fulc, fulc
-    rat = e = 0.0
-    x = xf
-    (fx,) = yield [x]
-    num = 1
-    ffulc = fnfc = fx
-    xm = 0.5 * (a + b)
-    tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
-    tol2 = 2.0 * tol1
-    while np.abs(xf - xm) > (tol2 - 0.5 * (b - a)):
-        golden = True
-        if np.abs(e) > tol1:  # a parabolic step, if acceptable
-            golden = False
-            r = (xf - nfc) * (fx - ffulc)
-            q = (xf - fulc) * (fx - fnfc)
-            p = (xf - fulc) * q - (xf - nfc) * r
-            q = 2.0 * (q - r)
-            if q > 0.0:
-                p = -p
-            q = np.abs(q)
-            r = e
-            e = rat
-            if (np.abs(p) < np.abs(0.5 * q * r)) and (p > q * (a - xf)) and (p < q * (b - xf)):
-                rat = (p + 0.0) / q
-                x = xf + rat
-                if ((x - a) < tol2) or ((b - x) < tol2):
-                    si = np.sign(xm - xf) + ((xm - xf) == 0)
-                    rat = tol1 * si
-            else:
-                golden = True
-        if golden:  # a golden-section step
-            e = a - xf if xf >= xm else b - xf
-            rat = golden_mean * e
-        si = np.sign(rat) + (rat == 0)
-        x = xf + si * np.maximum(np.abs(rat), tol1)
-        (fu,) = yield [x]
-        num += 1
-        if fu <= fx:
-            if x >= xf:
-                a = xf
-            else:
-                b = xf
-            fulc, ffulc = nfc, fnfc
-            nfc, fnfc = xf, fx
-            xf, fx = x, fu
+    """SciPy's bounded minimisation (Brent's ``fminbound``) of a function of one value on
+    ``[low, high]``, asking for its value one point at a time; returns the minimum found and
+    its value. Each time it needs a value it does not know yet, the search is run again from
+    the start with the values known so far (it is deterministic, so it retraces its steps to
+    the new point): the same result whether the costs come from memory or from passes over
+    chunks, for a few dozen cheap reruns."""
+    from scipy.optimize import minimize_scalar  # slow to import; only shape searches need it
+
+    known: dict[float, float] = {}
+
+    def cost(value: float) -> float:
+        if float(value) not in known:
+            raise _Unknown(float(value))
+        return known[float(value)]
+
+    while True:
+        try:
+            found = minimize_scalar(
+                cost, bounds=(low, high), method="bounded", options={"xatol": xatol}
+            )
+        except _Unknown as unknown:
+            (known[unknown.value],) = yield [unknown.value]
         else:
-            if x < xf:
-                a = x
-            else:
-                b = x
-            if (fu <= fnfc) or (nfc == xf):
-                fulc, ffulc = nfc, fnfc
-                nfc, fnfc = x, fu
-            elif (fu <= ffulc) or (fulc == xf) or (fulc == nfc):
-                fulc, ffulc = x, fu
-        xm = 0.5 * (a + b)
-        tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
-        tol2 = 2.0 * tol1
-        if num >= maxiter:
-            break
-    return xf, fx
+            return float(found.x), float(found.fun)
 
 
 def _linear_fit(model: str, params: Mapping[str, float], points: FrictionPoints) -> CurveFit:
