@@ -228,7 +228,7 @@ def _electrics_fits(
         assert chunk.current is not None and chunk.voltage is not None
         voltage, wm = equivalent_voltage(chunk.voltage), chunk.qd @ n_mat.T
         for m, motor in enumerate(motors):
-            motor.add(chunk.current[:, m], voltage[:, m], wm[:, m], predicted[:, m])
+            motor.add(chunk.current[:, m], voltage[:, m], wm[:, m], instrument=predicted[:, m])
     fits: list[ElectricsFit | None] = []
     for m, (joint, motor) in enumerate(zip(robot.joints, motors, strict=True)):
         try:
