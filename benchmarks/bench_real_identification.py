@@ -39,6 +39,17 @@ HELD_OUT = UR10E / "validation_data" / "ur-20_01_17-ptp_10_points.csv"
 PAYLOAD_MASS = 2.805
 
 
+def ur10e_logs(paths: list[Path], *, repair: bool = False) -> list:
+    """The prepared segments of UR10e logs (``UR10E_COLUMNS``), read through the checks."""
+    from kinergy.io.columns import parse_columns
+    from kinergy.logs.reading import LogReading
+    from kinergy.model import load_robot
+    from kinergy.workflows.logs import prepared_logs
+
+    reading = LogReading(columns=tuple(parse_columns(UR10E_COLUMNS, 6)), repair=repair)
+    return prepared_logs(paths, load_robot("ur10e"), reading)[0]
+
+
 def kinergy(*args: str) -> tuple[int, str, str]:
     """Run the command line; exit status, stdout and stderr."""
     done = subprocess.run(
@@ -103,9 +114,8 @@ def standstill_evidence(model: Path) -> dict:
     it); then what sets the level at rest (:func:`rest_level_evidence`)."""
     from kinergy.identify.result import predict
     from kinergy.model import load_robot
-    from kinergy.workflows.logs import prepared_logs
 
-    data = prepared_logs([HELD_OUT], n_joints=6, columns=UR10E_COLUMNS)[0]
+    data = ur10e_logs([HELD_OUT])[0]
     assert data.current is not None
     predicted = predict(load_robot(str(model)), data).current
     assert predicted is not None
@@ -144,7 +154,6 @@ def rest_level_evidence(model: Path) -> dict:
 
     from kinergy.identify.result import predict
     from kinergy.model import Friction, load_robot
-    from kinergy.workflows.logs import prepared_logs
 
     robot = load_robot(str(model))
     bare = robot.with_joints(
@@ -152,7 +161,7 @@ def rest_level_evidence(model: Path) -> dict:
          for j in robot.joints]
     )  # fmt: skip
     fractions: dict[int, list[float]] = {3: [], 4: [], 5: []}
-    for data in prepared_logs(unloaded_runs(), n_joints=6, columns=UR10E_COLUMNS):
+    for data in ur10e_logs(unloaded_runs()):
         load = predict(bare, data).current
         for j, found in fractions.items():
             coulomb = robot.joints[j].drive.friction.params["coulomb_direct"]
@@ -251,13 +260,11 @@ def pair_difference(model: Path, loaded: Path) -> dict:
     from kinergy.identify.payload import _com, block_std
     from kinergy.linalg import scaled_lstsq
     from kinergy.model import load_robot
-    from kinergy.workflows.logs import prepared_logs
 
     robot = load_robot(str(model)).with_payload(None)
     bare = loaded.with_name(loaded.name.replace("Load", ""))
     on, off = (
-        max(prepared_logs([log], n_joints=6, columns=UR10E_COLUMNS, repair=True), key=len)
-        for log in (loaded, bare)
+        max(ur10e_logs([log], repair=True), key=len) for log in (loaded, bare)
     )  # the longest segment of each
     t_on, t_off = on.t - on.t[0], off.t - off.t[0]
     lags = np.arange(-5.0, 5.0, 0.002)

@@ -14,6 +14,7 @@ import pytest
 import kinergy
 from kinergy.cli import main
 from kinergy.errors import KinergyError
+from kinergy.identify.options import Hold
 from kinergy.identify.payload import identify_payload
 from kinergy.identify.result import validation_metrics
 from kinergy.identify.sequential import identify_sequential
@@ -77,7 +78,7 @@ def test_result_json_has_the_contract_keys(twin_result) -> None:
 def test_exact_twin_is_recovered_to_round_off(ur5e: kinergy.Robot) -> None:
     # without noise and lag the regression is exact: the seed's Table IV and VI values come back
     log = _twin(ur5e, paper_trajectory(ur5e, "test-a", dt=0.004), TwinSettings.exact(), "exact")
-    result = identify_sequential(ur5e, [prepare(log, 6)], hold=False)
+    result = identify_sequential(ur5e, [prepare(log, 6)], hold=Hold.NONE)
     for true, found in zip(ur5e.joints, result.robot.joints, strict=True):
         assert found.drive.rotor_inertia == pytest.approx(true.drive.rotor_inertia, rel=1e-6)
         assert found.drive.torque_constant == pytest.approx(true.drive.torque_constant, rel=1e-6)

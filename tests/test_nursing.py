@@ -381,3 +381,30 @@ def test_nursing_command_json(monkeypatch) -> None:
 
 def test_transmission_of_the_nursing_arm_is_diag_n_times_coupling(arm) -> None:
     np.testing.assert_allclose(transmission_matrix(arm), 3060.0 * arm.coupling)
+
+
+def test_the_nursing_method_does_not_depend_on_the_chunks(arm) -> None:
+    """Logs cut into chunks of 997 rows (filtered on windows, cycle-averaged by sums per phase)
+    give the whole logs' identification: the averaged torques to round-off of the filter's
+    window (its reach: 1e-25 of the impulse response), the ridge's base parameters with them."""
+    from kinergy.identify.chunks import LogChunks, WholeSegment
+    from kinergy.identify.options import NursingOptions
+
+    run = back_and_forth_motion(arm, 1)
+    motion, _, _ = table6_motion(arm, periods=3, dt=0.004)
+    datas = [
+        _twin_data(arm, run.motion, TwinSettings(seed=1), "run"),
+        _twin_data(arm, motion, TwinSettings(seed=2), "excitation"),
+    ]
+    whole = nu.identify_nursing(arm, datas)
+    logs = LogChunks([WholeSegment(d) for d in datas], rows=997, spool=True)
+    chunked = nu.nursing(arm, logs, NursingOptions())
+    logs.close()
+    assert [r.gamma for r in chunked.fit.friction_runs] == [
+        r.gamma for r in whole.fit.friction_runs
+    ]
+    assert chunked.fit.friction_runs and chunked.fit.ridge.logs[0].cycles == 3
+    got = np.array([b.value for b in chunked.fit.base_parameters])
+    want = np.array([b.value for b in whole.fit.base_parameters])
+    np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12 * np.abs(want).max())
+    np.testing.assert_allclose(chunked.fit.ridge.rmse_test, whole.fit.ridge.rmse_test, rtol=1e-9)

@@ -1,6 +1,7 @@
-"""The stacked regression columns of the full method (:mod:`kinergy.identify.full`, its eq (1)).
+"""The regression columns of the full method (:mod:`kinergy.identify.full`, its eq (1)).
 
-Rows are the (sample, joint) pairs of every log, stacked; columns, in this order:
+Rows are the (sample, joint) pairs of every log, made chunk by chunk (:class:`Regression`);
+columns, in this order:
 
 - link base columns ``Y_b`` (nursing eqs 15-16; :meth:`BaseParameters.regressor`);
 - reflected rotor inertias: motor ``m``'s column on joint ``j`` is ``N[m, j] (N qdd)_m``
@@ -13,13 +14,13 @@ told apart; :func:`scale_row` measures it against the model's published masses.
 
 The ``power_flow`` model's columns depend on the direction of power flow through the gear, i.e.
 on the sign of the load torque: :func:`power_flow_load` decides it from the measurement, and the
-friction block is rebuilt for each decision (:func:`set_friction`).
+friction block is rebuilt for each decision (:meth:`Regression.rows`).
 """
 
 from __future__ import annotations
 
-import itertools
-from collections.abc import Sequence
+import dataclasses
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,24 +35,31 @@ from kinergy.friction.registry import (
     linear_values,
     start_parameters,
 )
+from kinergy.identify.chunks import History, LogChunks
+from kinergy.identify.drive_steps import _Signals, rotor_columns, signal_history
+from kinergy.identify.options import Target
+from kinergy.logs.prepare import IdentData
 from kinergy.model.robot import Robot
+from kinergy.predict import drive_state
 
 __all__ = [
     "LOAD_DEPENDENT",
+    "ROWS",
     "Columns",
-    "Stacked",
+    "Regression",
+    "Rows",
     "columns",
     "joint_frictions",
     "power_flow_load",
-    "rotor_columns",
     "scale_row",
-    "set_friction",
-    "stack",
 ]
 
 
 #: friction models whose columns depend on the load torque (the direction of power flow)
 LOAD_DEPENDENT = ("power_flow",)
+#: samples whose rows are made at a time (a chunk is cut into pieces of at most this many): the
+#: rows of 8192 samples of a 6-joint arm with 60 columns take 24 MB
+ROWS = 8192
 
 
 @dataclass(frozen=True)
@@ -81,13 +89,6 @@ class Columns:
     def friction(self, x: Array, m: int) -> Array:
         """Motor ``m``'s friction levels in the unknowns ``x`` (p,)."""
         return x[self.fric_at[m] : self.fric_at[m + 1]]
-
-
-def rotor_columns(n_mat: Array, dwm: Array) -> Array:
-    """Reflected rotor inertia columns, shape (N, n, n): motor ``m``'s column on joint ``j`` is
-    ``N[m, j] (N qdd)_m`` (UR5e eq 2), ``dwm = qdd N^T`` (N, n) the motor accelerations, rad/s^2;
-    times ``J`` (kg m^2, motor side) they give joint torques ``N^T diag(J) N qdd``."""
-    return n_mat.T[None, :, :] * dwm[:, None, :]
 
 
 def joint_frictions(
@@ -139,75 +140,6 @@ def columns(
     )
 
 
-@dataclass(frozen=True, eq=False)
-class Stacked:
-    """The full method's regression over every log; ``N`` samples, ``n`` joints, ``p`` columns.
-
-    Attributes
-    ----------
-    cols : Columns
-    models, params : list
-        Each motor's friction model and its parameters (:func:`joint_frictions`).
-    n_mat : ndarray, shape (n, n)
-        Transmission matrix, motor speeds ``wm = N qd``.
-    q, qd, qdd : ndarray, shape (N, n)
-        The motion regressed on (rad, rad/s, rad/s^2).
-    a : ndarray, shape (N, n, p)
-        Regressor, rows (sample, joint); the friction block is filled by :func:`set_friction`.
-    y3 : ndarray, shape (N, n)
-        The target as joint torques, N m.
-    tau_m : ndarray, shape (N, n)
-        The target as motor torques, N m (``N^-T y3``).
-    wm, dwm : ndarray, shape (N, n)
-        Motor speeds (rad/s) and accelerations (rad/s^2).
-    starts : ndarray of int
-        Log boundaries in the samples.
-    temperature : ndarray, shape (N, n), or None
-        ``joint_temperatures`` (deg C) where every log has them, for temperature-dependent
-        friction; None: the models' reference temperature.
-    """
-
-    cols: Columns
-    models: list[str]
-    params: list[dict[str, float]]
-    n_mat: Array
-    q: Array
-    qd: Array
-    qdd: Array
-    a: Array
-    y3: Array
-    tau_m: Array
-    wm: Array
-    dwm: Array
-    starts: NDArray[np.intp]
-    temperature: Array | None = None
-
-    @property
-    def a_flat(self) -> Array:
-        """The regressor as a matrix, shape (N n, p) (a view of :attr:`a`)."""
-        return self.a.reshape(-1, self.a.shape[2])
-
-    @property
-    def y(self) -> Array:
-        """The target, shape (N n,)."""
-        return self.y3.reshape(-1)
-
-    @property
-    def n_fixed(self) -> int:
-        """Columns before the friction block (link and rotor)."""
-        return self.cols.n_link + self.n_mat.shape[0]
-
-    @property
-    def needs_load(self) -> bool:
-        """Whether any friction model takes the load torque (``needs_load`` in the registry)."""
-        return any(get_model(m).needs_load for m in self.models)
-
-    @property
-    def needs_flow(self) -> bool:
-        """Whether any friction model depends on the direction of power flow (``power_flow``)."""
-        return any(m in LOAD_DEPENDENT for m in self.models)
-
-
 def scale_row(robot: Robot, base: BaseParameters, q: Array) -> Array:
     """How the link base parameters scale the model's gravity torques, shape (b,).
 
@@ -223,69 +155,15 @@ def scale_row(robot: Robot, base: BaseParameters, q: Array) -> Array:
     return np.asarray(np.einsum("sj,sjb->b", g0, at_rest) / float(np.sum(g0**2)))
 
 
-def stack(
-    robot: Robot,
-    base: BaseParameters,
-    cols: Columns,
-    frictions: tuple[list[str], list[dict[str, float]]],
-    motion: tuple[Array, Array, Array],
-    y3: Array,
-    lengths: Sequence[int],
-    temperature: Array | None = None,
-) -> Stacked:
-    """The link base and rotor columns of ``motion`` (q, qd, qdd, each (N, n)); the friction
-    block is left to :func:`set_friction`. ``y3`` (N, n) is the target as joint torques, N m;
-    ``lengths`` the samples of each log; ``temperature`` (N, n) deg C or None."""
-    q, qd, qdd = motion
-    n, samples, n_link = robot.n, q.shape[0], cols.n_link
-    n_mat = transmission_matrix(robot)
-    a = np.empty((samples, n, cols.prior.size))
-    a[:, :, :n_link] = base.regressor(regressor(robot, q, qd, qdd))
-    wm, dwm = qd @ n_mat.T, qdd @ n_mat.T
-    a[:, :, n_link : n_link + n] = rotor_columns(n_mat, dwm)
-    tau_m = np.asarray(np.linalg.solve(n_mat.T, y3.T).T, dtype=float)
-    starts = np.cumsum([0, *lengths])
-    return Stacked(cols, *frictions, n_mat, q, qd, qdd, a, y3, tau_m, wm, dwm, starts, temperature)
-
-
-def set_friction(stacked: Stacked, load: Array) -> None:
-    """Fill ``stacked.a``'s friction block, joint side ``N^T F`` (N, n, k), in place, for the load
-    torques ``load`` (N, n, motor side).
-
-    Columns are built log by log (``stacked.starts`` bounds them) so friction held through
-    standstill sees each log's samples in time order.
-    """
-    n_mat, models, params, temps = (
-        stacked.n_mat,
-        stacked.models,
-        stacked.params,
-        stacked.temperature,
-    )
-    col = stacked.n_fixed
-    for m, model in enumerate(models):
-        width = len(get_model(model).linear)
-        if width == 0:
-            continue
-        f = np.vstack(
-            [
-                friction_columns(
-                    model,
-                    params[m],
-                    stacked.wm[a:b, m],
-                    load[a:b, m],
-                    stacked.dwm[a:b, m],
-                    temperature=None if temps is None else temps[a:b, m],
-                )
-                for a, b in itertools.pairwise(stacked.starts)
-            ]
-        )
-        # motor m's friction reaches joint j through N[m, j]
-        stacked.a[:, :, col : col + width] = n_mat[m][None, :, None] * f[:, None, :]
-        col += width
-
-
-def power_flow_load(stacked: Stacked, values: list[Array], previous: Array) -> Array:
-    """Load torques (motor side, (N, n)) that set the friction's power-flow direction.
+def power_flow_load(
+    model: str,
+    params: dict[str, float],
+    values: Array,
+    signals: _Signals,
+    skip: int,
+    previous: Array,
+) -> Array:
+    """One motor's load torque (motor side, (N,)) that sets its friction's power-flow direction.
 
     The load is the measured motor torque less the friction, ``tau_load = tau_m - f`` (UR5e eqs
     12-17), and the friction depends on the direction: a sample is "direct" when
@@ -299,25 +177,184 @@ def power_flow_load(stacked: Stacked, values: list[Array], previous: Array) -> A
 
     Parameters
     ----------
-    stacked : Stacked
-        Motor speeds, accelerations and measured motor torques (``tau_m``), log boundaries.
-    values : list of ndarray
-        Each motor's friction levels (the model's ``linear`` parameters, :mod:`kinergy.friction`).
-    previous : ndarray, shape (N, n)
+    model, params, values :
+        The motor's friction model, its parameters and its linear parameters' values.
+    signals : _Signals
+        Motor speeds, accelerations and the measured motor torque (``current``, N m) of the
+        samples, the first ``skip`` of them those a friction held through standstill recalls
+        (:class:`~kinergy.identify.chunks.History`).
+    previous : ndarray, shape (N - skip,)
         The loads of the previous pass, N m, motor side.
     """
-    out = previous.copy()
-    for m, model in enumerate(stacked.models):
-        if model not in LOAD_DEPENDENT:
-            continue
-        for a, b in itertools.pairwise(stacked.starts):
-            w, acc = stacked.wm[a:b, m], stacked.dwm[a:b, m]
-            meas, params = stacked.tau_m[a:b, m], stacked.params[m]
-            direction = np.sign(w)
-            load_dir = meas - friction_columns(model, params, w, direction, acc) @ values[m]
-            load_rev = meas - friction_columns(model, params, w, -direction, acc) @ values[m]
-            is_dir, is_rev = w * load_dir > 0.0, w * load_rev < 0.0
-            out[a:b, m] = np.where(
-                is_dir & ~is_rev, load_dir, np.where(is_rev & ~is_dir, load_rev, previous[a:b, m])
-            )
-    return out
+    w, acc = signals.wm, signals.dwm
+    direction = np.sign(w)
+    f_dir = friction_columns(model, params, w, direction, acc)[skip:] @ values
+    f_rev = friction_columns(model, params, w, -direction, acc)[skip:] @ values
+    w, meas = w[skip:], signals.current[skip:]
+    load_dir, load_rev = meas - f_dir, meas - f_rev
+    is_dir, is_rev = w * load_dir > 0.0, w * load_rev < 0.0
+    return np.where(is_dir & ~is_rev, load_dir, np.where(is_rev & ~is_dir, load_rev, previous))
+
+
+@dataclass(frozen=True, eq=False)
+class Rows:
+    """Eq (1)'s rows of some samples: the regressor ``a`` (N, n, p), the target as joint torques
+    ``y3`` (N, n, N m), the positions regressed on ``q`` (N, n, rad), the motor speeds ``wm``
+    (N, n, rad/s), and the friction's load torques before (``previous``) and as used
+    (``load``), (N, n), N m motor side."""
+
+    a: Array
+    q: Array
+    y3: Array
+    wm: Array
+    previous: Array
+    load: Array
+
+
+@dataclass(frozen=True, eq=False)
+class Regression:
+    """The full method's regression, eq (1) of :mod:`kinergy.identify.full`, over the logs'
+    chunks: what its columns are and how a chunk's rows are made.
+
+    Attributes
+    ----------
+    robot : Robot
+        Kinematics, transmission, torque constants (against currents) and the model the first
+        load torques come from.
+    base : BaseParameters
+    cols : Columns
+    models, params : list
+        Each motor's friction model and its parameters (:func:`joint_frictions`).
+    target : Target
+        ``MOMENT`` (on the commanded motion, no friction), ``TORQUE`` or ``CURRENT``.
+    temperature : bool
+        Every log has ``joint_temperatures`` (for temperature-dependent friction; else the
+        models' reference temperature).
+    """
+
+    robot: Robot
+    base: BaseParameters
+    cols: Columns
+    models: list[str]
+    params: list[dict[str, float]]
+    target: Target
+    temperature: bool
+
+    @property
+    def n_mat(self) -> Array:
+        return transmission_matrix(self.robot)
+
+    @property
+    def n_fixed(self) -> int:
+        """Columns before the friction block (link and rotor)."""
+        return self.cols.n_link + self.robot.n
+
+    @property
+    def needs_load(self) -> bool:
+        """Whether any friction model takes the load torque (``needs_load`` in the registry)."""
+        return any(get_model(m).needs_load for m in self.models)
+
+    @property
+    def needs_flow(self) -> bool:
+        """Whether any friction model depends on the direction of power flow (``power_flow``)."""
+        return any(m in LOAD_DEPENDENT for m in self.models)
+
+    @property
+    def own_load(self) -> list[int]:
+        """The motors whose friction takes the load torque the fitted model gives itself
+        (``load_coulomb``, ``load_thermal_power_law``: the link side's, which friction does
+        not change)."""
+        return [
+            m
+            for m, name in enumerate(self.models)
+            if name not in LOAD_DEPENDENT and get_model(name).needs_load
+        ]
+
+    def motion(self, chunk: IdentData) -> tuple[Array, Array, Array]:
+        """The motion regressed on: commanded against ``target_moment``, else the real one."""
+        if self.target == Target.MOMENT:
+            return chunk.q_cmd, chunk.qd_cmd, chunk.qdd_cmd
+        return chunk.q, chunk.qd, chunk.qdd
+
+    def torques(self, chunk: IdentData) -> Array:
+        """The target as joint torques, (N, n) N m: ``N^T (k_t * I)`` for the current."""
+        if self.target == Target.CURRENT:
+            assert chunk.current is not None
+            kt = np.array([j.drive.torque_constant for j in self.robot.joints])
+            return np.asarray((chunk.current * kt) @ self.n_mat, dtype=float)
+        y3 = chunk.tau_ref if self.target == Target.MOMENT else chunk.torque
+        assert y3 is not None
+        return np.asarray(y3, dtype=float)
+
+    def histories(self) -> list[History[_Signals]]:
+        """Per motor, what its friction held through standstill needs of earlier chunks."""
+        return [signal_history(float(p.get("standstill", 0.0))) for p in self.params]
+
+    def rows(
+        self,
+        logs: LogChunks,
+        loads: Iterator[list[Array | None]] | None = None,
+        x: Array | None = None,
+    ) -> Iterator[tuple[int, Rows]]:
+        """Eq (1)'s rows of every chunk, in pieces of at most :data:`ROWS` samples (segment
+        number, :class:`Rows`).
+
+        The friction's load torques: the model's (the first pass, ``loads`` None); those of
+        a previous pass (``loads``: one record per piece, as ``Rows.load`` was) as they are; or,
+        after a fit with unknowns ``x``, the next ones (:func:`power_flow_load` with the fitted
+        friction for ``power_flow``, the fitted model's own load torque for the other
+        load-dependent models)."""
+        cols, n, n_fixed, n_mat = self.cols, self.robot.n, self.n_fixed, self.n_mat
+        values = [cols.friction(cols.prior if x is None else x, m) for m in range(n)]
+        histories = self.histories()
+        for k, chunk in logs.chunks():
+            for lo in range(0, len(chunk), ROWS):
+                part = chunk.sliced(lo, min(lo + ROWS, len(chunk)))
+                q, qd, qdd = self.motion(part)
+                y3 = self.torques(part)
+                tau_m = np.asarray(np.linalg.solve(n_mat.T, y3.T).T, dtype=float)
+                wm, dwm = qd @ n_mat.T, qdd @ n_mat.T
+                a = np.empty((len(part), n, cols.prior.size))
+                a[:, :, : cols.n_link] = self.base.regressor(regressor(self.robot, q, qd, qdd))
+                a[:, :, cols.n_link : n_fixed] = rotor_columns(n_mat, dwm)
+                if not self.needs_load:
+                    previous = np.zeros_like(q)
+                elif loads is None:
+                    previous = np.asarray(drive_state(self.robot, q, qd, qdd).tau_load)
+                else:
+                    (stored,) = next(loads)
+                    assert stored is not None
+                    previous = stored
+                load = previous.copy()
+                if x is not None and self.own_load:
+                    tau_sim = a[:, :, :n_fixed] @ x[:n_fixed]
+                    own = np.linalg.solve(n_mat.T, tau_sim.T).T
+                    load[:, self.own_load] = own[:, self.own_load]
+                temps = part.temperature if self.temperature else None
+                col = n_fixed
+                for m, model in enumerate(self.models):
+                    temp = None if temps is None else temps[:, m]
+                    signals = _Signals(previous[:, m], wm[:, m], dwm[:, m], tau_m[:, m], temp)
+                    held, skip = histories[m].ahead(k, signals)
+                    if model in LOAD_DEPENDENT and (loads is None or x is not None):
+                        load[:, m] = power_flow_load(
+                            model, self.params[m], values[m], held, skip, previous[:, m]
+                        )
+                    held = dataclasses.replace(
+                        held, tau_load=np.concatenate([held.tau_load[:skip], load[:, m]])
+                    )
+                    width = len(get_model(model).linear)
+                    if width:
+                        f = friction_columns(
+                            model,
+                            self.params[m],
+                            held.wm,
+                            held.tau_load,
+                            held.dwm,
+                            temperature=held.temperature,
+                        )[skip:]
+                        # motor m's friction reaches joint j through N[m, j]
+                        a[:, :, col : col + width] = n_mat[m][None, :, None] * f[:, None, :]
+                        col += width
+                    histories[m].update(held, skip)
+                yield k, Rows(a, q, y3, wm, previous, load)

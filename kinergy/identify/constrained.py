@@ -53,6 +53,8 @@ MARGIN = 1e-5
 #: weights (in units of the model's chi^2) of the terms that settle what the data cannot see
 _EPS_LINKS = 1e-6
 _EPS_DROPPED = 1e-4
+#: singular values of the regression's triangle below this share of the largest are round-off
+_ROUND_OFF = 1e-12
 
 
 def bounds(cols: Columns, models: Sequence[str]) -> tuple[Array, Array]:
@@ -126,7 +128,16 @@ def _lmi(pi: cp.Expression, payload: Array, t: Array) -> tuple[list[cp.Constrain
 def _metric(problem: Solved) -> Array:
     """``L`` with ``|L (z - z_hat)|^2`` the chi^2 increase of the unknowns ``z`` (scaled) over the
     regression's optimum ``z_hat``: the triangle (with the ridge term) over the residual's
-    standard deviation (floored at 1e-6 of the signal for noise-free data)."""
+    standard deviation (floored at 1e-6 of the signal for noise-free data), in the canonical
+    form ``S V^T`` of its singular value decomposition, the directions whose singular value is
+    round-off (below :data:`_ROUND_OFF` of the largest: columns the data cannot tell apart)
+    left out.
+
+    The triangle is the least-squares problem only up to rotations of its rows, and where
+    columns are merged its last rows are round-off that depends on how the rows were folded;
+    the solver equilibrates rows, so those would steer where it stops along the directions the
+    data do not see. In canonical form the constrained fit depends on the problem alone, not on
+    the chunks its rows came in."""
     red = problem.reduced
     sigma2 = max(problem.sigma2, 1e-12 * float(red.r_y @ red.r_y) / red.rows, 1e-300)
     rows = [red.r_a]
@@ -134,7 +145,10 @@ def _metric(problem: Solved) -> Array:
         ridge = np.zeros((problem.kept.size, red.r_a.shape[1]))
         ridge[np.arange(problem.kept.size), problem.kept] = np.sqrt(problem.lam)
         rows.append(ridge)
-    return np.vstack(rows) / np.sqrt(sigma2)
+    _, s, vt = np.linalg.svd(np.vstack(rows), full_matrices=False)
+    keep = s > _ROUND_OFF * s[0]
+    sign = np.sign(vt[np.arange(vt.shape[0]), np.argmax(np.abs(vt), axis=1)])
+    return np.asarray(((s * sign)[:, None] * vt)[keep] / np.sqrt(sigma2))
 
 
 def _solve(problem: cp.Problem) -> str | None:
@@ -146,7 +160,7 @@ def _solve(problem: cp.Problem) -> str | None:
                 problem.solve(solver=solver)
         except (cp.error.SolverError, ValueError):  # pragma: no cover - solver failure
             continue
-        if problem.status in ("optimal", "optimal_inaccurate"):
+        if problem.status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
             return solver
     return None
 

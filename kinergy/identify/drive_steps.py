@@ -1,20 +1,33 @@
-"""The drive steps of the sequential identification (UR5e doc sections 3-4), one joint at a time.
+"""The drive steps of the sequential identification (UR5e doc sections 3-4), as folds over chunks.
 
-- :func:`rotor_inertias`: ``J_m + J_r`` per motor from the controller's reference torque
-  (UR5e eqs 7-9), by least squares through the transmission matrix;
+- :func:`rotor_problem`, :func:`rotor_step`: ``J_m + J_r`` per motor from the controller's
+  reference torque (UR5e eqs 7-9), by least squares through the transmission matrix, its rows
+  folded chunk by chunk into one QR triangle;
 - :func:`current_step`: torque constant and friction of every motor together from the measured
   current (UR5e eqs 17-18): the current is linear in ``1/k_t`` (times the load torque) and in the
-  friction parameters over ``k_t``; with ``hold="auto"`` the standstill hold that fits best, with
-  ``friction="auto"`` the registry model that predicts held-out blocks best (:func:`candidates`).
+  friction parameters over ``k_t``. Each fit it tries (a model, its shape, the fraction of its
+  friction a stopped joint holds: a *trial*) is a triangle per block of samples, folded in one
+  pass over the chunks with currents together with every other trial asked for at the same
+  time: the holds of every joint in one pass; a shape search (``power_law``'s exponent,
+  :func:`~kinergy.identify.friction_curve.shape_search`) a pass per step of all joints' searches;
+  ``friction="auto"`` scores each model by cross-validation over :data:`FOLDS` blocks from
+  those per-block triangles (no pass of its own). When more than one pass may be needed, the
+  motor signals of eq 18 (load torque, speed, acceleration, current) are kept from the first.
 
 :mod:`kinergy.identify.sequential` runs them in order and assembles the typed result.
+
+One difference from a cross-validation that refits on the rows left: each block's rows carry the
+friction their whole log held through standstill into them, also when the block before them is
+the one left out (refitting the rows left would start the hold afresh after the gap). Only
+stopped rows right after a block edge can differ, and the held friction is the motion's, not the
+measured current's.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import itertools
-from collections.abc import Callable, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -30,45 +43,49 @@ from kinergy.friction.registry import (
     start_parameters,
     with_linear_parameters,
 )
-from kinergy.identify.columns import rotor_columns
-from kinergy.identify.friction_curve import search_shape
-from kinergy.identify.result import (
-    IDENTIFIED,
-    KEPT,
+from kinergy.identify.chunks import (
+    STILL_SPEED,
+    Asks,
+    History,
+    LogChunks,
+    Summary,
+    answer,
+    together,
+    translated,
 )
+from kinergy.identify.friction_curve import shape_search
+from kinergy.identify.options import CurrentOptions, Hold
+from kinergy.identify.result import IDENTIFIED, KEPT
 from kinergy.jsonable import OPTIONAL
-from kinergy.linalg import Reduced, scaled_lstsq, scaled_solution
+from kinergy.linalg import Reduced, scaled_solution
 from kinergy.logs.prepare import IdentData
 from kinergy.messages import Messages
 from kinergy.model.robot import Friction, Joint, Robot
 
 __all__ = [
     "AUTO_CANDIDATES",
-    "CurrentProblem",
+    "FOLDS",
+    "HOLDINGS",
+    "STILL_SPEED",
     "CurrentStats",
     "FrictionChoice",
-    "JointFitter",
-    "best_hold",
     "candidates",
-    "current_fitter",
-    "current_problem",
     "current_step",
-    "fit_joints",
     "holdings_of",
+    "joined",
     "motor_signals",
-    "rotor_inertias",
+    "per_motor",
+    "rotor_columns",
     "rotor_problem",
     "rotor_solution",
     "rotor_step",
+    "signal_history",
     "solve_current",
-    "stack",
     "start_params",
     "with_rotor_inertias",
 ]
 
 
-#: joint speed below which a joint counts as still, rad/s
-STILL_SPEED = 0.005
 #: a regression whose column-scaled condition number exceeds this cannot be trusted
 MAX_CONDITION = 1e8
 #: fractions of the friction a stopped joint is tried with (0: none, the seed's model)
@@ -94,24 +111,40 @@ MIN_TEMPERATURE_SPAN = 3.0
 FOLDS = 5
 
 
-def stack(datas: Sequence[IdentData], name: str) -> Array:
-    """Field ``name`` of every log, stacked: ``(sum N_k, n)``."""
-    return np.vstack([getattr(d, name) for d in datas])
+def joined(problems: Sequence[Reduced]) -> Reduced:
+    """Least-squares problems in the same unknowns (unit column scale, as
+    :meth:`Reduced.empty <kinergy.linalg.Reduced.empty>` starts them) together: the triangle of
+    their triangles, the rows of all."""
+    r = np.vstack([p.r for p in problems])
+    both = Reduced.empty(r.shape[1] - 1).stack(r[:, :-1], r[:, -1])
+    return dataclasses.replace(both, rows=sum(p.rows for p in problems))
 
 
-def rotor_problem(robot: Robot, datas: Sequence[IdentData], into: Reduced | None = None) -> Reduced:
+# ---------------------------------------------------------------------------------------------
+# Step 2: rotor inertias (UR5e eqs 7-9, Table IV)
+
+
+def rotor_columns(n_mat: Array, dwm: Array) -> Array:
+    """Reflected rotor inertia columns, shape (N, n, n): motor ``m``'s column on joint ``j`` is
+    ``N[m, j] (N qdd)_m`` (UR5e eq 2), ``dwm = qdd N^T`` (N, n) the motor accelerations, rad/s^2;
+    times ``J`` (kg m^2, motor side) they give joint torques ``N^T diag(J) N qdd``."""
+    return n_mat.T[None, :, :] * dwm[:, None, :]
+
+
+def rotor_problem(robot: Robot, logs: LogChunks) -> Reduced | None:
     """Step 2's least squares (UR5e eqs 7-9) folded into a triangle (:class:`Reduced`), every
     motor's column: ``tau_ref - f_link = N^T diag(J) N qdd`` with ``N`` the transmission matrix,
-    linear in J; rows (sample, joint) of ``datas`` stacked onto ``into`` (default none yet)."""
+    linear in J; rows (sample, joint) of every chunk with ``target_moment`` (None: there is
+    none)."""
     n_mat = transmission_matrix(robot)
-    problem = Reduced.empty(robot.n) if into is None else into
-    for data in datas:
-        assert data.tau_ref is not None
-        f_link = rnea(robot, data.q_cmd, data.qd_cmd, data.qdd_cmd)
+    problem, seen = Reduced.empty(robot.n), False
+    for _, chunk in logs.chunks("tau_ref"):
+        assert chunk.tau_ref is not None
+        f_link = rnea(robot, chunk.q_cmd, chunk.qd_cmd, chunk.qdd_cmd)
         # rows (sample, joint), column m: contribution of J_m, n_mat[m, j] * (N qdd)_m
-        a = rotor_columns(n_mat, data.qdd_cmd @ n_mat.T).reshape(-1, robot.n)
-        problem = problem.stack(a, (data.tau_ref - f_link).reshape(-1))
-    return problem
+        a = rotor_columns(n_mat, chunk.qdd_cmd @ n_mat.T).reshape(-1, robot.n)
+        problem, seen = problem.stack(a, (chunk.tau_ref - f_link).reshape(-1)), True
+    return problem if seen else None
 
 
 def rotor_solution(
@@ -135,146 +168,6 @@ def rotor_solution(
     inertia, std = known.copy(), np.full(robot.n, np.nan)
     inertia[active], std[active] = sol, sol_std
     return inertia, std, cond
-
-
-def rotor_inertias(
-    robot: Robot, datas: Sequence[IdentData], active: Sequence[int] | None = None
-) -> tuple[Array, Array, float]:
-    """Step 2: ``J_m + J_r`` per motor from ``target_moment`` (UR5e eqs 7-9): :func:`rotor_solution`
-    of :func:`rotor_problem` (kg m^2 motor side, standard deviations, condition number)."""
-    return rotor_solution(robot, rotor_problem(robot, datas), active)
-
-
-@dataclass(frozen=True, eq=False)
-class _Signals:
-    """One motor's signals for eq 18, motor side, each (N,): load torque ``tau_load`` (N m),
-    speed ``wm`` (rad/s), acceleration ``dwm`` (rad/s^2), measured ``current`` (A), the joint
-    ``temperature`` (deg C, None when not logged) and the stretch of time each row belongs to
-    (``piece``, int: one per log; a friction held through standstill never crosses into the
-    next piece)."""
-
-    tau_load: Array
-    wm: Array
-    dwm: Array
-    current: Array
-    temperature: Array | None = None
-    piece: NDArray[np.int64] | None = None
-
-    def rows(self, keep: NDArray[np.bool_]) -> _Signals:
-        """The rows ``keep``; where rows are left out between two kept ones, a new piece."""
-        t = None if self.temperature is None else self.temperature[keep]
-        piece = None
-        if self.piece is not None:
-            index = np.flatnonzero(keep)
-            cut = (np.diff(index) > 1) | (np.diff(self.piece[keep]) != 0)
-            piece = np.concatenate([[0], np.cumsum(cut)])
-        return _Signals(
-            self.tau_load[keep], self.wm[keep], self.dwm[keep], self.current[keep], t, piece
-        )
-
-
-@dataclass(frozen=True, eq=False)
-class _CurrentFit:
-    """Eq 18 for one motor: ``x = [1/k_t, values/k_t]`` with standard errors, the condition
-    number, the squared current error, and whether ``k_t`` was held at the model's."""
-
-    model: str
-    params: dict[str, float]
-    x: Array
-    std: Array
-    cond: float
-    sse: float
-    fixed: bool
-
-
-def _columns(model: str, params: dict[str, float], signals: _Signals) -> Array:
-    """Eq 18's regressor ``[tau_load, friction columns]`` (N, 1 + k)."""
-    s = signals
-    bounds = [0, s.wm.size]
-    if s.piece is not None:
-        bounds[1:1] = list(np.flatnonzero(np.diff(s.piece)) + 1)
-    parts = []
-    for lo, hi in itertools.pairwise(bounds):
-        t = None if s.temperature is None else s.temperature[lo:hi]
-        w, load, dw = s.wm[lo:hi], s.tau_load[lo:hi], s.dwm[lo:hi]
-        parts.append(friction_columns(model, params, w, load, dw, temperature=t))
-    return np.column_stack([s.tau_load, np.vstack(parts)])
-
-
-def current_problem(model: str, params: dict[str, float], signals: _Signals) -> Reduced:
-    """Eq 18's least squares for one motor, ``[tau_load, friction columns | current]``, folded
-    into its triangle (:class:`Reduced`; stack more chunks onto it in time order)."""
-    a = _columns(model, params, signals)
-    return Reduced.empty(a.shape[1]).stack(a, signals.current)
-
-
-#: eq 18's least squares: the regressor ``[tau_load, friction columns]`` (N, 1 + k) and the
-#: current (N,), or both folded into a triangle (:func:`current_problem`, chunk by chunk)
-CurrentProblem = Reduced | tuple[Array, Array]
-
-
-def _eq18(problem: CurrentProblem, kt_prior: float | None = None) -> tuple[Array, Array, float]:
-    """:func:`~kinergy.linalg.scaled_lstsq` of eq 18 (x, standard errors, condition); with
-    ``kt_prior``, of the friction columns alone against ``current - tau_load / kt_prior``."""
-    if isinstance(problem, Reduced):
-        if kt_prior is None:
-            return scaled_solution(problem)
-        p = problem.r.shape[1] - 1
-        rest_of = np.zeros((p + 1, p))
-        rest_of[1:p, : p - 1] = np.eye(p - 1)
-        rest_of[0, -1], rest_of[p, -1] = -1.0 / kt_prior, 1.0
-        return scaled_solution(problem.combine(rest_of))
-    a, current = problem
-    if kt_prior is None:
-        return scaled_lstsq(a, current)
-    return scaled_lstsq(a[:, 1:], current - a[:, 0] / kt_prior)
-
-
-def solve_current(
-    model: str, params: dict[str, float], problem: CurrentProblem, kt_prior: float
-) -> _CurrentFit:
-    """Eq 18 for one motor (:func:`_current_fit`), the model's shape parameters held, from its
-    rows or its triangle (:data:`CurrentProblem`: the same fit to round-off)."""
-    x, std, cond = _eq18(problem)
-    fixed = not (x[0] > 0 and std[0] < MAX_KT_SPREAD * x[0])
-    if fixed:
-        rest, rest_std, cond = _eq18(problem, kt_prior)
-        x = np.concatenate([[1.0 / kt_prior], rest])
-        std = np.concatenate([[0.0], rest_std])
-    if isinstance(problem, Reduced):
-        sse = problem.norm2(np.append(-x, 1.0))
-    else:
-        sse = float(np.sum((problem[1] - problem[0] @ x) ** 2))
-    return _CurrentFit(model, params, x, std, cond, sse, fixed)
-
-
-def _solve_current(
-    model: str, params: dict[str, float], signals: _Signals, kt_prior: float
-) -> _CurrentFit:
-    """Eq 18 for one motor with the model's shape parameters held (:func:`_current_fit`)."""
-    problem = (_columns(model, params, signals), signals.current)
-    return solve_current(model, params, problem, kt_prior)
-
-
-def _current_fit(
-    model: str, params: dict[str, float], signals: _Signals, kt_prior: float
-) -> _CurrentFit:
-    """Eq 18 for one motor: ``I = [tau_load, friction columns] @ [1/k_t, values/k_t]``.
-
-    When the load torque is too small against the friction and noise to pin ``1/k_t`` down
-    (relative standard deviation above :data:`MAX_KT_SPREAD`, or a non-positive estimate),
-    ``k_t`` is fixed at ``kt_prior`` and only the friction is fitted. Shape parameters the model
-    searches (``power_law``'s exponent) are found by a 1-D search on the squared current error
-    (:func:`kinergy.identify.friction_curve.search_shape`).
-    """
-    if not get_model(model).search:
-        return _solve_current(model, params, signals, kt_prior)
-    shaped = search_shape(model, params, lambda p: _solve_current(model, p, signals, kt_prior).sse)
-    return _solve_current(model, shaped, signals, kt_prior)
-
-
-# ---------------------------------------------------------------------------------------------
-# Step 2: rotor inertias (UR5e eqs 7-9, Table IV)
 
 
 def rotor_step(
@@ -328,19 +221,75 @@ def with_rotor_inertias(robot: Robot, rotor: Array, said: Messages) -> Robot:
 # Step 3: torque constants and friction (UR5e eqs 17-18)
 
 
-def motor_signals(robot: Robot, rotor: Array, logs: Sequence[IdentData]) -> list[_Signals]:
-    """Per motor: the load torque of ``robot`` with rotor inertias ``rotor``, the motor speed and
-    acceleration, the measured current and the joint temperature (when every log has it), on
-    the real motion of ``logs`` (:class:`_Signals`)."""
-    q, qd, qdd = stack(logs, "q"), stack(logs, "qd"), stack(logs, "qdd")
+@dataclass(frozen=True, eq=False)
+class _Signals:
+    """One motor's signals for eq 18, motor side, each (N,): load torque ``tau_load`` (N m),
+    speed ``wm`` (rad/s), acceleration ``dwm`` (rad/s^2), measured ``current`` (A), the joint
+    ``temperature`` (deg C, None when not logged) and the stretch of time each row belongs to
+    (``piece``, int: a friction held through standstill never crosses into the next piece)."""
+
+    tau_load: Array
+    wm: Array
+    dwm: Array
+    current: Array
+    temperature: Array | None = None
+    piece: NDArray[np.int64] | None = None
+
+
+def _columns(model: str, params: dict[str, float], signals: _Signals) -> Array:
+    """Eq 18's regressor ``[tau_load, friction columns]`` (N, 1 + k)."""
+    s = signals
+    bounds = [0, s.wm.size]
+    if s.piece is not None:
+        bounds[1:1] = list(np.flatnonzero(np.diff(s.piece)) + 1)
+    parts = []
+    for lo, hi in itertools.pairwise(bounds):
+        t = None if s.temperature is None else s.temperature[lo:hi]
+        w, load, dw = s.wm[lo:hi], s.tau_load[lo:hi], s.dwm[lo:hi]
+        parts.append(friction_columns(model, params, w, load, dw, temperature=t))
+    return np.column_stack([s.tau_load, np.vstack(parts)])
+
+
+def signal_history(still: float) -> History[_Signals]:
+    """A :class:`~kinergy.identify.chunks.History` of one motor's eq 18 signals."""
+
+    def take(x: _Signals, index: NDArray[np.int64]) -> _Signals:
+        t = None if x.temperature is None else x.temperature[index]
+        return _Signals(x.tau_load[index], x.wm[index], x.dwm[index], x.current[index], t)
+
+    def join(parts: Sequence[_Signals]) -> _Signals:
+        def cat(name: str) -> Array | None:
+            values = [getattr(p, name) for p in parts]
+            return None if any(v is None for v in values) else np.concatenate(values)
+
+        return _Signals(*(cat(n) for n in ("tau_load", "wm", "dwm", "current", "temperature")))  # type: ignore[arg-type]
+
+    def at_rest(x: _Signals) -> _Signals:
+        return dataclasses.replace(x, wm=np.zeros_like(x.wm), dwm=np.zeros_like(x.dwm))
+
+    return History([still], take, join, at_rest, lambda x: x.wm[:, None])
+
+
+def motor_signals(
+    robot: Robot, rotor: Array, chunk: IdentData, temperature: bool
+) -> list[Array | None]:
+    """Eq 18's signals of every motor on the chunk's real motion: the load torque of ``robot``
+    with rotor inertias ``rotor`` (N m), the motor speed (rad/s) and acceleration (rad/s^2), the
+    measured current (A), each (N, n), and (``temperature``, else None) the joint temperatures
+    (deg C); :func:`per_motor` splits them."""
+    assert chunk.current is not None
     n_mat = transmission_matrix(robot)
-    tau_sim = rnea(robot, q, qd, qdd) + qdd @ (n_mat.T @ (rotor[:, None] * n_mat)).T
+    tau_sim = rnea(robot, chunk.q, chunk.qd, chunk.qdd)
+    tau_sim += chunk.qdd @ (n_mat.T @ (rotor[:, None] * n_mat)).T
     tau_load = np.asarray(np.linalg.solve(n_mat.T, tau_sim.T).T, dtype=float)
-    wm, dwm, current = qd @ n_mat.T, qdd @ n_mat.T, stack(logs, "current")
-    temps = None
-    if all(d.temperature is not None for d in logs):
-        temps = stack(logs, "temperature")
-    piece = np.repeat(np.arange(len(logs)), [d.qd.shape[0] for d in logs])
+    temps = chunk.temperature if temperature else None
+    return [tau_load, chunk.qd @ n_mat.T, chunk.qdd @ n_mat.T, chunk.current, temps]
+
+
+def per_motor(signals: Sequence[Array | None]) -> list[_Signals]:
+    """:func:`motor_signals` as each motor's :class:`_Signals`."""
+    tau_load, wm, dwm, current, temps = signals
+    assert tau_load is not None and wm is not None and dwm is not None and current is not None
     return [
         _Signals(
             tau_load[:, m],
@@ -348,10 +297,46 @@ def motor_signals(robot: Robot, rotor: Array, logs: Sequence[IdentData]) -> list
             dwm[:, m],
             current[:, m],
             None if temps is None else temps[:, m],
-            piece,
         )
-        for m in range(robot.n)
+        for m in range(tau_load.shape[1])
     ]
+
+
+@dataclass(frozen=True, eq=False)
+class _CurrentFit:
+    """Eq 18 for one motor: ``x = [1/k_t, values/k_t]`` with standard errors, the condition
+    number, the squared current error, and whether ``k_t`` was held at the model's."""
+
+    model: str
+    params: dict[str, float]
+    x: Array
+    std: Array
+    cond: float
+    sse: float
+    fixed: bool
+
+
+def solve_current(
+    model: str, params: dict[str, float], problem: Reduced, kt_prior: float
+) -> _CurrentFit:
+    """Eq 18 for one motor, ``I = [tau_load, friction columns] @ [1/k_t, values/k_t]``, the
+    model's shape parameters held, from its triangle (:class:`Reduced`, unit column scale).
+
+    When the load torque is too small against the friction and noise to pin ``1/k_t`` down
+    (relative standard deviation above :data:`MAX_KT_SPREAD`, or a non-positive estimate),
+    ``k_t`` is fixed at ``kt_prior`` and only the friction is fitted.
+    """
+    x, std, cond = scaled_solution(problem)
+    fixed = not (x[0] > 0 and std[0] < MAX_KT_SPREAD * x[0])
+    if fixed:
+        p = problem.r.shape[1] - 1
+        rest_of = np.zeros((p + 1, p))  # the friction columns against current - tau_load / k_t
+        rest_of[1:p, : p - 1] = np.eye(p - 1)
+        rest_of[0, -1], rest_of[p, -1] = -1.0 / kt_prior, 1.0
+        rest, rest_std, cond = scaled_solution(problem.combine(rest_of))
+        x = np.concatenate([[1.0 / kt_prior], rest])
+        std = np.concatenate([[0.0], rest_std])
+    return _CurrentFit(model, params, x, std, cond, problem.norm2(np.append(-x, 1.0)), fixed)
 
 
 def start_params(joint: Joint, model: str, standstill: float, holding: float) -> dict[str, float]:
@@ -365,33 +350,135 @@ def start_params(joint: Joint, model: str, standstill: float, holding: float) ->
     return params
 
 
-def _best_hold(
-    joint: Joint,
-    model: str,
-    standstill: float,
-    signals: _Signals,
-    holdings: Sequence[float],
-) -> _CurrentFit:
-    """Eq 18 with each fraction of ``holdings`` of the friction held through standstill (below
-    ``standstill`` rad/s, motor side): :func:`best_hold`."""
-
-    def fit(holding: float) -> _CurrentFit:
-        params = start_params(joint, model, standstill, holding)
-        return _current_fit(model, params, signals, joint.drive.torque_constant)
-
-    return best_hold(holdings, fit)
+def holdings_of(hold: Hold) -> tuple[float, ...]:
+    """The friction fractions held through standstill that ``hold`` tries (:data:`HOLDINGS`)."""
+    return {Hold.SEARCH: HOLDINGS, Hold.NONE: (0.0,), Hold.FULL: (1.0,)}[hold]
 
 
-def best_hold(holdings: Sequence[float], fit: Callable[[float], _CurrentFit]) -> _CurrentFit:
-    """Of the fits of eq 18 holding each fraction of ``holdings`` of the friction through
-    standstill (``fit(holding)``), the first whose squared current error no later one cuts by
-    :data:`MIN_GAIN`."""
-    best: _CurrentFit | None = None
-    for holding in holdings:
-        this = fit(holding)
-        if best is None or this.sse < best.sse * (1.0 - MIN_GAIN):
+@dataclass(frozen=True)
+class _Trial:
+    """One fit of eq 18 tried: a motor, a friction model and all its parameters."""
+
+    motor: int
+    model: str
+    params: tuple[tuple[str, float], ...]
+
+    @classmethod
+    def of(cls, motor: int, model: str, params: dict[str, float]) -> _Trial:
+        return cls(motor, model, tuple(params.items()))
+
+
+@dataclass(eq=False)
+class _Blocks:
+    """A trial's eq 18 folded into one triangle per block of samples (:func:`joined` gives the
+    whole problem)."""
+
+    parts: list[Reduced]
+    _total: Reduced | None = None
+
+    @property
+    def total(self) -> Reduced:
+        if self._total is None:
+            self._total = self.parts[0] if len(self.parts) == 1 else joined(self.parts)
+        return self._total
+
+
+class _Passes:
+    """Answers the trials of eq 18 asked for (:data:`~kinergy.identify.chunks.Asks`): each new
+    batch is one pass over the logs with currents, the motor signals of ``staged`` with rotor
+    inertias ``rotor`` computed on the first and, when ``keep``, kept for the others; every
+    trial's triangles are cached. ``edges`` cut the samples (of those logs, stacked) into the
+    blocks each trial is folded into."""
+
+    def __init__(
+        self, logs: LogChunks, staged: Robot, rotor: Array, edges: Sequence[int], keep: bool
+    ):
+        self.logs, self.staged, self.rotor, self.edges = logs, staged, rotor, list(edges)
+        # one log with currents but no temperatures turns them off for all
+        self.warm = all("temperature" in s.has for s in logs.summaries if "current" in s.has)
+        self.store = logs.derived() if keep else None
+        self.owner: list[int] = []
+        self.cache: dict[_Trial, _Blocks] = {}
+        self.still = [STILL_SPEED * abs(j.drive.gear_ratio) for j in staged.joints]
+
+    def _signals(self) -> Iterator[tuple[int, list[_Signals]]]:
+        if self.store is not None and self.owner:
+            for k, record in zip(self.owner, self.store, strict=True):
+                yield k, per_motor(record)
+            return
+        for k, chunk in self.logs.chunks("current"):
+            signals = motor_signals(self.staged, self.rotor, chunk, self.warm)
+            if self.store is not None:
+                self.store.put(signals)
+                self.owner.append(k)
+            yield k, per_motor(signals)
+
+    def __call__(self, asked: list[_Trial]) -> list[_Blocks]:
+        new = list(dict.fromkeys(t for t in asked if t not in self.cache))
+        if new:
+            self.cache.update(self._fold(new))
+        return [self.cache[t] for t in asked]
+
+    def _fold(self, trials: list[_Trial]) -> dict[_Trial, _Blocks]:
+        """One pass: every trial's triangles."""
+        widths = {t: 1 + len(get_model(t.model).linear) for t in trials}
+        out = {t: _Blocks([Reduced.empty(widths[t]) for _ in self.edges[1:]]) for t in trials}
+        motors = sorted({t.motor for t in trials})
+        history = {m: signal_history(self.still[m]) for m in motors}
+        at = 0
+        for k, signals in self._signals():
+            size = signals[0].wm.size
+            cuts = [
+                (b, max(lo, at) - at, min(hi, at + size) - at)
+                for b, (lo, hi) in enumerate(itertools.pairwise(self.edges))
+                if lo < at + size and hi > at
+            ]
+            for m in motors:
+                data, skip = history[m].ahead(k, signals[m])
+                for t in (t for t in trials if t.motor == m):
+                    cols = _columns(t.model, dict(t.params), data)[skip:]
+                    parts = out[t].parts
+                    for b, lo, hi in cuts:
+                        parts[b] = parts[b].stack(cols[lo:hi], signals[m].current[lo:hi])
+                history[m].update(data, skip)
+            at += size
+        return out
+
+
+def _solved(trial: _Trial, blocks: _Blocks, kt: float) -> _CurrentFit:
+    return solve_current(trial.model, dict(trial.params), blocks.total, kt)
+
+
+def _fit_hold(
+    m: int, joint: Joint, model: str, params: dict[str, float]
+) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, _Blocks]]:
+    """Eq 18 for motor ``m`` from ``params``, their shape searched first where the model does
+    (:func:`~kinergy.identify.friction_curve.shape_search`, on the squared current error)."""
+    kt = joint.drive.torque_constant
+    if get_model(model).search:
+        params = yield from translated(
+            shape_search(model, params),
+            lambda p: _Trial.of(m, model, p),
+            lambda p, b: _solved(_Trial.of(m, model, p), b, kt).sse,
+        )
+    trial = _Trial.of(m, model, params)
+    (blocks,) = yield [trial]
+    return _solved(trial, blocks, kt), blocks
+
+
+def _fit_model(
+    m: int, joint: Joint, model: str, holdings: Sequence[float]
+) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, _Blocks]]:
+    """Eq 18 with each fraction of ``holdings`` of the friction held through standstill: the
+    first fit whose squared current error no later one cuts by :data:`MIN_GAIN`."""
+    standstill = STILL_SPEED * abs(joint.drive.gear_ratio)
+    fits = yield from together(
+        [_fit_hold(m, joint, model, start_params(joint, model, standstill, h)) for h in holdings]
+    )
+    best = fits[0]
+    for this in fits[1:]:
+        if this[0].sse < best[0].sse * (1.0 - MIN_GAIN):
             best = this
-    assert best is not None
     return best
 
 
@@ -410,29 +497,23 @@ class FrictionChoice:
     gain_std: float | None = field(default=None, metadata=OPTIONAL)
 
 
-def candidates(signals: _Signals) -> list[str]:
-    """The models of :data:`AUTO_CANDIDATES` this joint's logs can support: temperature-dependent
-    ones only where its temperature spans :data:`MIN_TEMPERATURE_SPAN`."""
-    t = signals.temperature
-    warm = t is not None and float(np.ptp(t)) >= MIN_TEMPERATURE_SPAN
-    return [m for m in AUTO_CANDIDATES if warm or not get_model(m).needs_temperature]
+def candidates(summary: Summary, m: int) -> list[str]:
+    """The models of :data:`AUTO_CANDIDATES` motor ``m``'s logs (``summary``) can support:
+    temperature-dependent ones only where its temperature spans :data:`MIN_TEMPERATURE_SPAN`."""
+    cold, warm = summary.cold, summary.warm
+    spans = cold is not None and warm is not None and warm[m] - cold[m] >= MIN_TEMPERATURE_SPAN
+    return [c for c in AUTO_CANDIDATES if spans or not get_model(c).needs_temperature]
 
 
-def _cv_errors(fit: _CurrentFit, signals: _Signals, kt_prior: float) -> Array:
-    """Squared current error (A^2) summed over each of :data:`FOLDS` contiguous blocks of the
-    samples, ``fit``'s model (its shape and hold held) fitted on the others, shape (FOLDS,)."""
-    index = np.arange(signals.current.size)
-    edges = np.linspace(0, index.size, FOLDS + 1).astype(int)
-    fold = np.searchsorted(edges, index, side="right") - 1
-    if signals.piece is not None and np.unique(signals.piece).size >= 3:
-        fold = signals.piece
-    a = _columns(fit.model, fit.params, signals)
-    squared = []
-    for k in np.unique(fold):
-        held = fold == k
-        train = _solve_current(fit.model, fit.params, signals.rows(~held), kt_prior)
-        squared.append(float(np.sum((signals.current[held] - a[held] @ train.x) ** 2)))
-    return np.array(squared)
+def _cv_errors(fit: _CurrentFit, blocks: _Blocks, kt_prior: float) -> Array:
+    """Squared current error (A^2) of each block, ``fit``'s model (its shape and hold held)
+    fitted on the others, shape (blocks,)."""
+    errors = []
+    for k, held in enumerate(blocks.parts):
+        train = joined([p for i, p in enumerate(blocks.parts) if i != k])
+        x = solve_current(fit.model, fit.params, train, kt_prior).x
+        errors.append(held.norm2(np.append(-x, 1.0)))
+    return np.array(errors)
 
 
 def _gain(errors: dict[str, Array], model: str, other: str) -> tuple[float, float]:
@@ -446,19 +527,21 @@ def _gain(errors: dict[str, Array], model: str, other: str) -> tuple[float, floa
 
 
 def _auto_fit(
-    joint: Joint, standstill: float, signals: _Signals, holdings: Sequence[float]
-) -> tuple[_CurrentFit, FrictionChoice]:
+    m: int, joint: Joint, models: list[str], holdings: Sequence[float], samples: int
+) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, FrictionChoice | None]]:
     """``friction="auto"``: every candidate model fitted with its own standstill hold and scored
     by cross-validation; the lowest held-out RMS wins unless it beats Coulomb + viscous by no
     more than the standard error of that gain. Candidates whose regression is singular on these
     logs are left out."""
     kt = joint.drive.torque_constant
+    tried = yield from together([_fit_model(m, joint, model, holdings) for model in models])
     fits, errors = {}, {}
-    for model in candidates(signals):
-        fit = _best_hold(joint, model, standstill, signals, holdings)
+    for model, (fit, blocks) in zip(models, tried, strict=True):
         if fit.cond <= MAX_CONDITION:
-            fits[model], errors[model] = fit, _cv_errors(fit, signals, kt)
-    scores = {m: float(np.sqrt(e.sum() / signals.current.size)) for m, e in errors.items()}
+            fits[model], errors[model] = fit, _cv_errors(fit, blocks, kt)
+    if not fits:  # every candidate singular: as the first (refused, naming it)
+        return tried[0][0], None
+    scores = {c: float(np.sqrt(e.sum() / samples)) for c, e in errors.items()}
     ranked = sorted(scores, key=scores.__getitem__)
     best, gain, std = ranked[0], None, None
     if "viscous_coulomb" in scores:
@@ -466,7 +549,7 @@ def _auto_fit(
         if gain <= std:
             best = "viscous_coulomb"
             gain, std = 0.0, None
-    others = [m for m in ranked if m != best]
+    others = [c for c in ranked if c != best]
     choice = FrictionChoice(
         model=best,
         cv_rms=scores,
@@ -475,6 +558,13 @@ def _auto_fit(
         gain_std=std,
     )
     return fits[best], choice
+
+
+def _fixed_fit(
+    m: int, joint: Joint, model: str, holdings: Sequence[float]
+) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, FrictionChoice | None]]:
+    fit, _ = yield from _fit_model(m, joint, model, holdings)
+    return fit, None
 
 
 @dataclass(frozen=True)
@@ -544,79 +634,58 @@ def _apply_current_fit(
     return dataclasses.replace(joint, drive=drive), stats
 
 
+def _folds(logs: LogChunks) -> list[int]:
+    """Where the cross-validation's blocks of the samples of the logs with currents (stacked)
+    begin and end: each log, when there are 3 or more, else :data:`FOLDS` contiguous blocks."""
+    sizes = [logs.summaries[k].samples for k in logs.which("current")]
+    if len(sizes) >= 3:
+        return [0, *np.cumsum(sizes).tolist()]
+    return np.linspace(0, sum(sizes), FOLDS + 1).astype(int).tolist()
+
+
 def current_step(
     staged: Robot,
     rotor: Array,
-    logs: Sequence[IdentData],
+    logs: LogChunks,
     problems: dict[int, str],
-    options: tuple[str | None, str | bool],
+    options: CurrentOptions,
     said: Messages,
 ) -> tuple[Robot, list[CurrentStats], tuple[float | None, ...], tuple[FrictionChoice | None, ...]]:
-    """Torque constants and friction of every identifiable motor from the currents (eqs 17-18);
-    ``options`` = (friction model, ``"auto"`` or None; hold). Returns the robot, each joint's
-    statistics, the friction fraction held through standstill and, with ``"auto"``, how each
-    joint's model was chosen (None where not fitted)."""
-    fitter = current_fitter(staged, rotor, logs, options)
-    return fit_joints(staged, problems, fitter, said)
-
-
-def current_fitter(
-    staged: Robot,
-    rotor: Array,
-    logs: Sequence[IdentData],
-    options: tuple[str | None, str | bool],
-) -> JointFitter:
-    """Step 3's fit of one joint on ``logs`` held whole (:data:`JointFitter`); ``options`` as
-    :func:`current_step`."""
-    friction, hold = options
-    signals = motor_signals(staged, rotor, logs)
-    holdings = holdings_of(hold)
-
-    def fit_joint(
-        m: int, joint: Joint, standstill: float
-    ) -> tuple[_CurrentFit, FrictionChoice | None]:
-        if friction == "auto":
-            return _auto_fit(joint, standstill, signals[m], holdings)
-        model = friction or joint.drive.friction.model
-        return _best_hold(joint, model, standstill, signals[m], holdings), None
-
-    return fit_joint
-
-
-def holdings_of(hold: str | bool) -> tuple[float, ...]:
-    """The friction fractions held through standstill that ``hold`` tries (:data:`HOLDINGS`)."""
-    return HOLDINGS if hold == "auto" else ((1.0,) if hold else (0.0,))
-
-
-#: one joint's eq 18 fit: (motor index, joint, standstill speed in rad/s motor side) -> the fit
-#: and, with ``friction="auto"``, how its model was chosen
-JointFitter = Callable[[int, Joint, float], tuple[_CurrentFit, "FrictionChoice | None"]]
-
-
-def fit_joints(
-    staged: Robot, problems: dict[int, str], fit_joint: JointFitter, said: Messages
-) -> tuple[Robot, list[CurrentStats], tuple[float | None, ...], tuple[FrictionChoice | None, ...]]:
-    """Step 3 over the joints: each identifiable joint fitted by ``fit_joint`` and written
-    (:func:`_apply_current_fit`); returns as :func:`current_step`."""
+    """Torque constants and friction of every identifiable motor from the currents of ``logs``
+    (eqs 17-18; the motors in ``problems`` keep the model's), every joint's fits folded in the
+    same passes (module docstring). Returns the robot, each joint's statistics, the friction
+    fraction held through standstill and, with ``"auto"``, how each joint's model was chosen
+    (None where not fitted)."""
+    holdings = holdings_of(options.hold)
+    active = [m for m in range(staged.n) if m not in problems]
+    models = [options.friction or j.drive.friction.model for j in staged.joints]
+    summary = logs.summary("current")
+    edges = _folds(logs) if options.auto else [0, summary.samples]
+    if options.auto:
+        asks = [
+            _auto_fit(m, staged.joints[m], candidates(summary, m), holdings, summary.samples)
+            for m in active
+        ]
+    else:
+        asks = [_fixed_fit(m, staged.joints[m], models[m], holdings) for m in active]
+    several = options.auto or any(get_model(models[m]).search for m in active)
+    passes = _Passes(logs, staged, rotor, edges, several)
+    fits = dict(zip(active, answer(together(asks), passes), strict=True))
     joints: list[Joint] = []
     stats: list[CurrentStats] = []
     held: list[float | None] = []
     chosen: list[FrictionChoice | None] = []
     for m, joint in enumerate(staged.joints):
-        if m in problems:
+        if m not in fits:
             joints.append(joint)
             stats.append(CurrentStats())
             held.append(None)
             chosen.append(None)
             continue
-        fit, choice = fit_joint(m, joint, STILL_SPEED * abs(joint.drive.gear_ratio))
+        fit, choice = fits[m]
         held.append(float(fit.params.get("holding", 0.0)))
         chosen.append(choice)
         new, stat = _apply_current_fit(m, joint, fit, said)
         joints.append(new)
         stats.append(stat)
     return staged.with_joints(joints), stats, tuple(held), tuple(chosen)
-
-
-# ---------------------------------------------------------------------------------------------
-# The method

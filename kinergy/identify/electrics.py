@@ -9,7 +9,7 @@ gives both (:func:`fit_electrics`). :func:`with_electrics` writes them into a mo
 
 The arm's supply (``actual_robot_voltage`` x ``actual_robot_current``) is the motors' bus power
 plus a constant standby (:mod:`kinergy.drives.bus`); with a model that predicts the motors' power,
-the mean of the rest is the standby power (:func:`fit_standby`).
+the mean of the rest is the standby power (:func:`kinergy.workflows.identify.measured_electrics`).
 """
 
 from __future__ import annotations
@@ -22,19 +22,14 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kinergy.arrays import Array
-from kinergy.drives.bus import supply_power
 from kinergy.errors import KinergyError
-from kinergy.linalg import Reduced, scaled_lstsq, scaled_solution
+from kinergy.linalg import Reduced, scaled_solution
 from kinergy.model.robot import Robot
-from kinergy.predict import drive_state
-from kinergy.trajectory.motion import CONTROLLER_DT
 
 __all__ = [
     "ElectricsFit",
     "ElectricsSums",
-    "StandbyFit",
     "fit_electrics",
-    "fit_standby",
     "with_electrics",
 ]
 
@@ -80,18 +75,9 @@ def fit_electrics(
         Fewer than 3 points, or points that cannot separate ``R`` from ``k_b`` (the current and
         the speed proportional to each other, or one of them zero throughout).
     """
-    i, v, w = (np.asarray(x, dtype=float).ravel() for x in (current, voltage, wm))
-    if i.size < 3:
-        raise KinergyError(f"fitting R and k_b needs at least 3 points, got {i.size}")
-    wt = np.ones(i.size) if weights is None else np.asarray(weights, dtype=float).ravel()
-    a = np.column_stack([i, w])
-    x, std, cond = scaled_lstsq(a * wt[:, None], v * wt)
-    _check_separable(cond)
-    if instrument is not None:
-        z = np.column_stack([np.asarray(instrument, dtype=float).ravel(), w]) * wt[:, None]
-        x = np.linalg.solve(z.T @ (a * wt[:, None]), z.T @ (v * wt))
-    rms = float(np.sqrt(np.mean((a @ x - v) ** 2)))
-    return ElectricsFit(float(x[0]), float(x[1]), float(std[0]), float(std[1]), rms, int(i.size))
+    sums = ElectricsSums()
+    sums.add(current, voltage, wm, weights=weights, instrument=instrument)
+    return sums.fit()
 
 
 def _check_separable(cond: float) -> None:
@@ -105,24 +91,41 @@ def _check_separable(cond: float) -> None:
 
 @dataclass
 class ElectricsSums:
-    """:func:`fit_electrics` (unweighted, with an instrument) of one motor accumulated block by
-    block: eq 19's least squares folded into its triangle and the instrumental normal
-    equations ``Z^T A`` (2, 2), ``Z^T V`` (2,), ``Z = [instrument, wm]``, ``A = [I, wm]``."""
+    """:func:`fit_electrics` of one motor folded block by block: eq 19's least squares in a
+    triangle of its weighted rows (and of its rows as they are, for the RMS, when weighted) and,
+    with an instrument, the instrumental normal equations ``Z^T W^2 A`` (2, 2) and
+    ``Z^T W^2 V`` (2,), ``Z = [instrument, wm]``, ``A = [I, wm]``, ``W`` the weights."""
 
     problem: Reduced = field(default_factory=lambda: Reduced.empty(2))
-    zta: Array = field(default_factory=lambda: np.zeros((2, 2)))
-    ztv: Array = field(default_factory=lambda: np.zeros(2))
+    plain: Reduced | None = None
+    zta: Array | None = None
+    ztv: Array | None = None
 
-    def add(self, current: Array, voltage: Array, wm: Array, instrument: Array) -> None:
-        """Fold in a block of samples, each (k,): A, V, rad/s and the instrument, A."""
-        a = np.column_stack([current, wm])
-        z = np.column_stack([instrument, wm])
-        self.problem = self.problem.stack(a, voltage)
-        self.zta += z.T @ a
-        self.ztv += z.T @ voltage
+    def add(
+        self,
+        current: ArrayLike,
+        voltage: ArrayLike,
+        wm: ArrayLike,
+        *,
+        weights: ArrayLike | None = None,
+        instrument: ArrayLike | None = None,
+    ) -> None:
+        """Fold in a block of samples, each (k,): A, V, rad/s, the weights and the
+        instrument (A), as :func:`fit_electrics` takes them."""
+        i, v, w = (np.asarray(x, dtype=float).ravel() for x in (current, voltage, wm))
+        a = np.column_stack([i, w])
+        wt = np.ones(i.size) if weights is None else np.asarray(weights, dtype=float).ravel()
+        self.problem = self.problem.stack(a * wt[:, None], v * wt)
+        if weights is not None:
+            self.plain = (self.plain or Reduced.empty(2)).stack(a, v)
+        if instrument is not None:
+            z = np.column_stack([np.asarray(instrument, dtype=float).ravel(), w]) * wt[:, None]
+            zta, ztv = z.T @ (a * wt[:, None]), z.T @ (v * wt)
+            self.zta = zta if self.zta is None else self.zta + zta
+            self.ztv = ztv if self.ztv is None else self.ztv + ztv
 
     def fit(self) -> ElectricsFit:
-        """The :class:`ElectricsFit` of every block (as :func:`fit_electrics` of them all).
+        """The :class:`ElectricsFit` of every block.
 
         Raises
         ------
@@ -132,10 +135,12 @@ class ElectricsSums:
         samples = self.problem.rows
         if samples < 3:
             raise KinergyError(f"fitting R and k_b needs at least 3 points, got {samples}")
-        _, std, cond = scaled_solution(self.problem)
+        x, std, cond = scaled_solution(self.problem)
         _check_separable(cond)
-        x = np.linalg.solve(self.zta, self.ztv)
-        rms = float(np.sqrt(self.problem.norm2(np.append(x, -1.0)) / samples))
+        if self.zta is not None and self.ztv is not None:
+            x = np.asarray(np.linalg.solve(self.zta, self.ztv), dtype=float)
+        rows = self.plain or self.problem
+        rms = float(np.sqrt(rows.norm2(np.append(x, -1.0)) / samples))
         return ElectricsFit(float(x[0]), float(x[1]), float(std[0]), float(std[1]), rms, samples)
 
 
@@ -167,46 +172,3 @@ def with_electrics(robot: Robot, fits: Sequence[ElectricsFit | None]) -> Robot:
         )
         joints.append(dataclasses.replace(joint, drive=drive))
     return robot.with_joints(joints)
-
-
-@dataclass(frozen=True)
-class StandbyFit:
-    """The arm's standby power (W), its standard error (W, from the spread of the per-second
-    means) and the samples it is the mean over."""
-
-    standby: float
-    std: float
-    samples: int
-
-
-def fit_standby(
-    robot: Robot,
-    motion: tuple[Array, Array, Array],
-    supply: Array,
-    *,
-    temperature: Array | None = None,
-    dt: float = CONTROLLER_DT,
-) -> StandbyFit:
-    """The standby power: measured supply power minus the motors' predicted draw, averaged.
-
-    Parameters
-    ----------
-    robot : Robot
-        A model that predicts the motors' electrical power (identified drives and electrics);
-        its own ``standby_power`` is not used.
-    motion : (q, qd, qdd), each (N, n)
-        The real motion, rad, rad/s, rad/s^2.
-    supply : ndarray, shape (N,)
-        Measured supply power ``actual_robot_voltage * actual_robot_current``, W.
-    temperature : ndarray, shape (N, n), optional
-        Joint temperatures, deg C.
-    dt : float
-        Sample period, s (the standard error takes one-second means as independent).
-    """
-    q, qd, qdd = motion
-    state = drive_state(robot, q, qd, qdd, temperature=temperature)
-    rest = np.asarray(supply, dtype=float) - supply_power(state.power).motors
-    per_second = max(1, round(1.0 / dt))
-    means = [rest[k : k + per_second].mean() for k in range(0, rest.size, per_second)]
-    std = float(np.std(means) / np.sqrt(len(means))) if len(means) > 1 else float("nan")
-    return StandbyFit(float(rest.mean()), std, int(rest.size))

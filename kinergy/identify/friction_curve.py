@@ -29,9 +29,20 @@ from kinergy.friction.registry import (
     start_parameters,
     with_linear_parameters,
 )
+from kinergy.identify.chunks import Asks, answer, translated
 from kinergy.linalg import scaled_lstsq
 
-__all__ = ["CurveFit", "FrictionPoints", "choose_model", "fit_curve", "points_from", "search_shape"]
+__all__ = [
+    "CurveFit",
+    "FrictionPoints",
+    "Search",
+    "bounded_minimum",
+    "choose_model",
+    "fit_curve",
+    "points_from",
+    "search_shape",
+    "shape_search",
+]
 
 
 #: trial values of a searched shape parameter before the bounded refinement
@@ -102,26 +113,76 @@ class CurveFit:
         )
 
 
+#: a search of shape parameters (:func:`shape_search`): asks for the cost of batches of
+#: parameter sets and returns the parameters found
+Search = Asks[dict[str, float], float, dict[str, float]]
+
+
+def shape_search(model: str, params: Mapping[str, float]) -> Search:
+    """``params`` with each shape parameter the model searches (``FrictionModel.search``) set to
+    the value in its bounds that minimises a cost it asks for (:data:`Search`): a grid of
+    :data:`SEARCH_GRID` values in one batch, then a bounded 1-D refinement around the best
+    (:func:`bounded_minimum`); ``params`` unchanged for models without one."""
+    best = dict(params)
+    for name, (low, high) in get_model(model).search.items():
+        grid = np.linspace(low, high, SEARCH_GRID)
+        costs = yield [{**best, name: float(v)} for v in grid]
+        k = int(np.argmin(costs))
+        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+
+        def at(value: float, name: str = name) -> dict[str, float]:
+            return {**best, name: float(value)}
+
+        x, fx = yield from translated(bounded_minimum(lo, hi, xatol=1e-4), at, _same)
+        best[name] = float(x) if fx <= costs[k] else float(grid[k])
+    return best
+
+
+def _same(_: float, cost: float) -> float:
+    return cost
+
+
 def search_shape(
     model: str, params: Mapping[str, float], cost: Callable[[dict[str, float]], float]
 ) -> dict[str, float]:
-    """``params`` with each shape parameter the model searches (``FrictionModel.search``) set to
-    the value in its bounds that minimises ``cost`` (a grid of :data:`SEARCH_GRID` values, then
-    a bounded 1-D refinement around the best); ``params`` unchanged for models without one."""
+    """:func:`shape_search` with each parameter set's cost from ``cost``."""
+    return answer(shape_search(model, params), lambda batch: [cost(p) for p in batch])
+
+
+class _Unknown(Exception):
+    """The cost at ``value`` is not known yet."""
+
+    def __init__(self, value: float):
+        self.value = value
+
+
+def bounded_minimum(
+    low: float, high: float, *, xatol: float = 1e-5
+) -> Asks[float, float, tuple[float, float]]:
+    """SciPy's bounded minimisation (Brent's ``fminbound``) of a function of one value on
+    ``[low, high]``, asking for its value one point at a time; returns the minimum found and
+    its value. Each time it needs a value it does not know yet, the search is run again from
+    the start with the values known so far (it is deterministic, so it retraces its steps to
+    the new point): the same result whether the costs come from memory or from passes over
+    chunks, for a few dozen cheap reruns."""
     from scipy.optimize import minimize_scalar  # slow to import; only shape searches need it
 
-    best = dict(params)
-    for name, (low, high) in get_model(model).search.items():
+    known: dict[float, float] = {}
 
-        def trial(value: float, name: str = name) -> float:
-            return cost({**best, name: float(value)})
+    def cost(value: float) -> float:
+        if float(value) not in known:
+            raise _Unknown(float(value))
+        return known[float(value)]
 
-        grid = np.linspace(low, high, SEARCH_GRID)
-        k = int(np.argmin([trial(v) for v in grid]))
-        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
-        found = minimize_scalar(trial, bounds=(lo, hi), method="bounded", options={"xatol": 1e-4})
-        best[name] = float(found.x) if found.fun <= trial(grid[k]) else float(grid[k])
-    return best
+    while True:
+        try:
+            found = minimize_scalar(
+                cost, bounds=(low, high), method="bounded", options={"xatol": xatol}
+            )
+        except _Unknown as unknown:
+            (known[unknown.value],) = yield [unknown.value]
+        else:
+            return float(found.x), float(found.fun)
 
 
 def _linear_fit(model: str, params: Mapping[str, float], points: FrictionPoints) -> CurveFit:

@@ -72,13 +72,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from kinergy.arrays import Array
-from kinergy.drives.transmission import transmission_matrix
 from kinergy.dynamics.regressor import BaseParameters, base_parameters, inertial_parameters
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import MODELS, get_model, linear_values, with_linear_parameters
-from kinergy.identify.columns import Stacked, columns, joint_frictions, scale_row, stack
-from kinergy.identify.metrics import JointMetrics, fit_metrics
+from kinergy.identify.chunks import LogChunks, Summary, one_blas_thread
+from kinergy.identify.columns import (
+    LOAD_DEPENDENT,
+    Regression,
+    columns,
+    joint_frictions,
+    scale_row,
+)
+from kinergy.identify.metrics import JointMetrics, MetricSums
+from kinergy.identify.options import CurrentOptions, IdentifyOptions, Method, Solver, Target
 from kinergy.identify.regression import (
     MAX_CONDITION,
     FlowFit,
@@ -106,21 +112,16 @@ from kinergy.model.robot import Friction, Robot
 
 __all__ = [
     "MAX_CONDITION",
-    "SOLVERS",
-    "TARGETS",
     "FullFit",
     "FullJoint",
     "Parameter",
     "PhysicalFit",
+    "full",
     "identify_full",
     "rescaled",
 ]
 
 
-#: signals the regression can be made against; "auto" picks torque, else moment, else current
-TARGETS = ("auto", "moment", "torque", "current")
-#: least-squares variants
-SOLVERS = ("ols", "wls", "ridge")
 #: a joint whose speed never exceeds this (rad/s) counts as not moving
 MOVING_SPEED = 0.05
 #: samples needed per unknown parameter
@@ -132,11 +133,11 @@ SCALE_NOTE = (
     "projected on the model's, equal the model's)"
 )
 #: the IdentData field and the log signal of each target
-_FIELD = {"moment": "tau_ref", "torque": "torque", "current": "current"}
+_FIELD = {Target.MOMENT: "tau_ref", Target.TORQUE: "torque", Target.CURRENT: "current"}
 _SIGNAL = {
-    "moment": "target_moment",
-    "torque": "measured joint torques",
-    "current": "actual_current",
+    Target.MOMENT: "target_moment",
+    Target.TORQUE: "measured joint torques",
+    Target.CURRENT: "actual_current",
 }
 
 
@@ -258,52 +259,68 @@ class FullFit(Fit):
 # Checks of the options and the logs
 
 
-def _check_options(solver: str, ridge: float, friction: str | None) -> None:
-    if solver not in SOLVERS:
-        raise KinergyError(f"unknown solver {solver!r} (known: {', '.join(SOLVERS)})")
+def _parsed(target: Target | str, solver: Solver | str) -> tuple[Target, Solver]:
+    """``target`` and ``solver`` as their types (the Python API's strings parsed)."""
+    try:
+        target = Target(target)
+    except ValueError:
+        known = ", ".join(t.value for t in Target)
+        raise KinergyError(f"unknown target {target!r} (known: {known})") from None
+    try:
+        solver = Solver(solver)
+    except ValueError:
+        known = ", ".join(s.value for s in Solver)
+        raise KinergyError(f"unknown solver {solver!r} (known: {known})") from None
+    return target, solver
+
+
+def _check_options(solver: Solver, ridge: float, friction: str | None) -> None:
     if isinstance(ridge, bool) or not isinstance(ridge, int | float) or not np.isfinite(ridge):
         raise KinergyError(f"ridge must be a finite number, got {ridge!r}")
     if ridge < 0.0:
         raise KinergyError(f"ridge must be >= 0, got {ridge:g}")
-    if solver == "ridge" and ridge == 0.0:
+    if solver == Solver.RIDGE and ridge == 0.0:
         raise KinergyError("solver 'ridge' needs ridge > 0 (the weight of the prior, e.g. 1e-4)")
-    if solver != "ridge" and ridge != 0.0:
-        raise KinergyError(f"ridge = {ridge:g} is only used by solver 'ridge', not {solver!r}")
+    if solver != Solver.RIDGE and ridge != 0.0:
+        raise KinergyError(
+            f"ridge = {ridge:g} is only used by solver 'ridge', not {solver.value!r}"
+        )
     if friction is not None and friction not in MODELS:
         raise KinergyError(
             f"unknown friction model {friction!r} (known: {', '.join(sorted(MODELS))})"
         )
 
 
-def _pick_target(datas: Sequence[IdentData], target: str) -> str:
-    """``target``, checked against the logs; ``"auto"``: torque, else moment, else current."""
-    if target not in TARGETS:
-        raise KinergyError(f"unknown target {target!r} (known: {', '.join(TARGETS)})")
-    if target == "auto":
-        for name in ("torque", "moment", "current"):
-            if all(getattr(d, _FIELD[name]) is not None for d in datas):
+def _pick_target(logs: LogChunks, target: Target) -> Target:
+    """``target``, checked against the logs; ``AUTO``: torque, else moment, else current."""
+    if target == Target.AUTO:
+        for name in (Target.TORQUE, Target.MOMENT, Target.CURRENT):
+            if logs.every(_FIELD[name]):
                 return name
         raise KinergyError(
             "the full method needs measured joint torques, target_moment or actual_current in "
             "every log; the logs have none of them in common"
         )
-    missing = [d.path for d in datas if getattr(d, _FIELD[target]) is None]
+    missing = [s.path for s, summary in zip(logs.segments, logs.summaries, strict=True)
+               if _FIELD[target] not in summary.has]  # fmt: skip
     if missing:
         raise KinergyError(
-            f"target {target!r} needs {_SIGNAL[target]}, missing in {', '.join(missing)}"
+            f"target {target.value!r} needs {_SIGNAL[target]}, missing in {', '.join(missing)}"
         )
     return target
 
 
-def _diagnose(robot: Robot, qd: Array, n_params: int) -> None:
-    """One line naming what the logs cannot identify: too few samples, joints that never move."""
+def _diagnose(robot: Robot, summary: Summary, commanded: bool, n_params: int) -> None:
+    """One line naming what the logs cannot identify: too few samples, joints that never move
+    (in the motion regressed on: commanded against ``target_moment``)."""
     problems = []
-    samples = qd.shape[0]
+    samples = summary.samples
     need = SAMPLES_PER_PARAMETER * n_params
     if samples < need:
         problems.append(f"only {samples} samples for {n_params} parameters (need at least {need})")
+    peak = summary.peak_cmd if commanded else summary.peak
     for j, joint in enumerate(robot.joints):
-        top = float(np.max(np.abs(qd[:, j]))) if samples else 0.0
+        top = float(peak[j]) if samples else 0.0
         if top < MOVING_SPEED:
             problems.append(
                 f"joint {j + 1} ({joint.name}) never moves (max |qd| {top:.3g} rad/s): its link, "
@@ -317,35 +334,60 @@ def _diagnose(robot: Robot, qd: Array, n_params: int) -> None:
 # The steps
 
 
-def _target_torques(robot: Robot, datas: Sequence[IdentData], target: str) -> Array:
-    """The target as joint torques, (N, n) N m: ``N^T (k_t * I)`` for the current."""
-    y3 = np.vstack([getattr(d, _FIELD[target]) for d in datas])
-    if target == "current":
-        kt = np.array([j.drive.torque_constant for j in robot.joints])
-        y3 = (y3 * kt) @ transmission_matrix(robot)
-    return np.asarray(y3, dtype=float)
-
-
-def _stack(
-    robot: Robot,
-    base: BaseParameters,
-    datas: Sequence[IdentData],
-    target: str,
-    friction: str | None,
-) -> Stacked:
-    """The stacked regression of every log (:func:`kinergy.identify.columns.stack`), after
-    checking the logs can identify its columns (:func:`_diagnose`)."""
-    commanded = target == "moment"
+def _regression(
+    robot: Robot, base: BaseParameters, logs: LogChunks, target: Target, friction: str | None
+) -> Regression:
+    """Eq (1) over ``logs`` (:class:`kinergy.identify.columns.Regression`), after checking the
+    logs can identify its columns (:func:`_diagnose`)."""
+    commanded = target == Target.MOMENT
     frictions = joint_frictions(robot, friction, commanded)
     cols = columns(robot, base, *frictions)
-    names = ("q_cmd", "qd_cmd", "qdd_cmd") if commanded else ("q", "qd", "qdd")
-    q, qd, qdd = (np.vstack([getattr(d, k) for d in datas]) for k in names)
-    _diagnose(robot, qd, cols.prior.size)
-    y3 = _target_torques(robot, datas, target)
-    temps = [d.temperature for d in datas if d.temperature is not None]
-    temperature = np.vstack(temps) if len(temps) == len(datas) else None
-    lengths = [len(d) for d in datas]
-    return stack(robot, base, cols, frictions, (q, qd, qdd), y3, lengths, temperature)
+    _diagnose(robot, logs.summary(), commanded, cols.prior.size)
+    return Regression(robot, base, cols, *frictions, target, logs.every("temperature"))
+
+
+@dataclass(frozen=True, eq=False)
+class _Evaluation:
+    """What a last pass over the rows finds: the per-joint metrics (N m, joint side) of the
+    regression's prediction of the target and of the constrained fit's (None when not used),
+    the samples whose power-flow direction the fitted model's own load torque disagrees with,
+    and a few thousand of the positions regressed on (for :func:`scale_row`)."""
+
+    regression: tuple[JointMetrics, ...]
+    physical: tuple[JointMetrics, ...] | None
+    mismatch: int
+    q: np.ndarray
+
+
+def _evaluate(
+    reg: Regression, logs: LogChunks, flow: FlowFit, solved: Solved, written: WriteBack
+) -> _Evaluation:
+    """:class:`_Evaluation` in one pass over the rows, with the load torques of the fit."""
+    n, n_fixed, n_mat = reg.robot.n, reg.n_fixed, reg.n_mat
+    regression = MetricSums(n)
+    physical = MetricSums(n) if written.chi2 is not None else None
+    flows = [m for m, model in enumerate(reg.models) if model in LOAD_DEPENDENT]
+    step = max(1, logs.summary().samples // 2000)
+    mismatch, at, poses = 0, 0, []
+    loads = iter(flow.loads) if flow.loads is not None else None
+    for _, rows in reg.rows(logs, loads):
+        regression.add(rows.y3, rows.a @ solved.x)
+        if physical is not None:
+            physical.add(rows.y3, rows.a @ written.x)
+        if flows:  # how often the fitted model's own load torque disagrees
+            tau_sim = rows.a[:, :, :n_fixed] @ flow.ols.x[:n_fixed]
+            own = np.linalg.solve(n_mat.T, tau_sim.T).T[:, flows]
+            wm = rows.wm[:, flows]
+            mismatch += int(np.sum(np.sign(wm * own) != np.sign(wm * rows.load[:, flows])))
+        first = -at % step
+        poses.append(rows.q[first::step].copy())  # no view: it would keep the chunk
+        at += len(rows.q)
+    return _Evaluation(
+        regression.metrics(),
+        None if physical is None else physical.metrics(),
+        mismatch,
+        np.vstack(poses),
+    )
 
 
 def _optional(value: float) -> float | None:
@@ -353,8 +395,8 @@ def _optional(value: float) -> float | None:
 
 
 def _parameters(
-    x: Array,
-    std: Array,
+    x: np.ndarray,
+    std: np.ndarray,
     names: Sequence[str],
     groups: Sequence[str | None],
     flags: Sequence[str | None],
@@ -369,15 +411,15 @@ def _parameters(
 
 
 def _regression_drive(
-    m: int, written: WriteBack, solved: Solved, stacked: Stacked, commanded: bool
+    m: int, written: WriteBack, solved: Solved, reg: Regression, commanded: bool
 ) -> tuple[dict[str, str], dict[str, float | None]]:
     """Flags and standard errors of motor ``m``'s rotor inertia, torque constant and friction as
     the regression gave them."""
-    cols = stacked.cols
+    cols = reg.cols
     col = cols.n_link + m
     flags = {"rotor_inertia": written.flags[col], "torque_constant": KEPT}
     std: dict[str, float | None] = {"rotor_inertia": _optional(solved.std[col])}
-    names = get_model(stacked.models[m]).linear
+    names = get_model(reg.models[m]).linear
     for k, name in enumerate(names):
         at = int(cols.fric_at[m]) + k
         flags[name] = KEPT if commanded else written.flags[at]
@@ -390,20 +432,20 @@ def _joints(
     robot: Robot,
     written: WriteBack,
     solved: Solved,
-    stacked: Stacked,
+    reg: Regression,
     drives: DrivesFromCurrents | None,
 ) -> tuple[FullJoint, ...]:
     """Per joint: the drive as written, with standard errors, flags and the merged flag."""
-    cols, commanded = stacked.cols, stacked.models == ["none"] * robot.n
+    cols, commanded = reg.cols, reg.target == Target.MOMENT
     out = []
     for m, joint in enumerate(robot.joints):
         col = cols.n_link + m
-        flags, std = _regression_drive(m, written, solved, stacked, commanded)
+        flags, std = _regression_drive(m, written, solved, reg, commanded)
         if drives is not None:
             flags = {"rotor_inertia": flags["rotor_inertia"], **drives.flags[m]}
             std = {"rotor_inertia": std["rotor_inertia"], **drives.std[m]}
         fields = drive_fields(joint, rotor_inertia=float(written.x[col]))
-        names = get_model(fields["friction"]["model"]).linear
+        names = get_model(joint.drive.friction.model).linear
         out.append(
             FullJoint(
                 **fields,
@@ -417,43 +459,39 @@ def _joints(
     return tuple(out)
 
 
-def _physical(stacked: Stacked, written: WriteBack) -> PhysicalFit | None:
+def _physical(reg: Regression, written: WriteBack, evaluation: _Evaluation) -> PhysicalFit | None:
     """The constrained fit's record, when the robot was written from it."""
-    if written.chi2 is None or written.solver is None:
+    if written.chi2 is None or written.solver is None or evaluation.physical is None:
         return None
-    n_link, n = stacked.cols.n_link, stacked.y3.shape[1]
-    predicted = (stacked.a_flat @ written.x).reshape(stacked.y3.shape)
+    n_link, n = reg.cols.n_link, reg.robot.n
     return PhysicalFit(
         chi2_increase=written.chi2,
         active=written.active,
         solver=written.solver,
         base_parameters=tuple(written.x[:n_link].tolist()),
         rotor_inertia=tuple(written.x[n_link : n_link + n].tolist()),
-        regression=fit_metrics(stacked.y3, predicted),
+        regression=evaluation.physical,
     )
 
 
 @dataclass(frozen=True, eq=False)
 class _Steps:
-    """What the steps of :func:`identify_full` produced, for its fit record."""
+    """What the steps of :func:`full` produced, for its fit record."""
 
-    stacked: Stacked
-    base: BaseParameters
+    reg: Regression
     flow: FlowFit
     solved: Solved
     merging: Merging
     written: WriteBack
+    evaluation: _Evaluation
     drives: DrivesFromCurrents | None
     robot: Robot
 
 
-def _fit(
-    datas: Sequence[IdentData], steps: _Steps, *, target: str, solver: str, ridge: float
-) -> FullFit:
-    """The fit record of the steps of :func:`identify_full`."""
-    stacked, flow, solved, written = steps.stacked, steps.flow, steps.solved, steps.written
-    cols, y3 = stacked.cols, stacked.y3
-    predicted = (stacked.a_flat @ solved.x).reshape(y3.shape)
+def _fit(logs: LogChunks, steps: _Steps, *, solver: Solver, ridge: float) -> FullFit:
+    """The fit record of the steps of :func:`full`."""
+    reg, flow, solved, written = steps.reg, steps.flow, steps.solved, steps.written
+    cols, target = reg.cols, reg.target
     said = Messages()
     if not flow.settled:
         said.warn(
@@ -465,32 +503,30 @@ def _fit(
     said.extend(written.said)
     weighted = solved.weights is not None
     b = cols.n_link
+    regression = steps.evaluation.regression
     return FullFit(
-        **fit_fields(
-            steps.robot,
-            datas,
-            said,
-            samples=int(y3.shape[0]),
-        ),
-        target=target,
-        solver=solver,
+        **vars(fit_fields(steps.robot, logs, said)),
+        target=target.value,
+        solver=solver.value,
         ridge=float(ridge),
         condition=flow.ols.solution.cond,
         power_flow_iterations=flow.iterations,
-        power_flow_mismatch=flow.mismatch,
+        power_flow_mismatch=steps.evaluation.mismatch,
         weights=tuple(solved.weights.tolist()) if solved.weights is not None else None,
         condition_weighted=solved.solution.cond if weighted else None,
-        residual_std=tuple(np.sqrt(np.mean((y3 - predicted) ** 2, axis=0)).tolist()),
-        regression=fit_metrics(y3, predicted),
+        residual_std=tuple(m.rms for m in regression),
+        regression=regression,
         merged=steps.merging.columns,
         parameters=_parameters(solved.x, solved.std, cols.names, cols.group, written.flags),
         base_parameters=_parameters(
-            solved.x, solved.std, steps.base.expressions(), [None] * b, written.flags[:b]
+            solved.x, solved.std, reg.base.expressions(), [None] * b, written.flags[:b]
         ),
-        physical_fit=_physical(stacked, written),
+        physical_fit=_physical(reg, written, steps.evaluation),
         write_back=written.method,
-        drives="currents" if steps.drives else ("regression" if target != "moment" else "model"),
-        scale=SCALE_NOTE if target == "current" and steps.drives else None,
+        drives="currents"
+        if steps.drives
+        else ("regression" if target != Target.MOMENT else "model"),
+        scale=SCALE_NOTE if target == Target.CURRENT and steps.drives else None,
         friction_holding=steps.drives.holding if steps.drives else None,
         links_not_physical_closest=written.links_not_physical_closest,
         links_physical=written.links_physical,
@@ -523,16 +559,17 @@ def identify_full(
     robot: Robot,
     datas: Sequence[IdentData],
     *,
-    target: str = "auto",
-    solver: str = "ols",
+    target: Target | str = Target.AUTO,
+    solver: Solver | str = Solver.OLS,
     ridge: float = 0.0,
     friction: str | None = None,
     currents: bool = True,
 ) -> IdentificationResult:
-    """Identify link base parameters, rotor inertias and friction in one regression.
+    """Identify link base parameters, rotor inertias and friction in one regression:
+    :func:`full` on prepared logs held in memory (each one chunk).
 
-    Solves, stacked over every sample and joint of every log, the linear model (module docstring,
-    eq (1)) ``tau = Y_b pi_b + N^T diag(J) N qdd + N^T F(wm) phi`` with ``pi_b`` the links' base
+    Solves, over every sample and joint of every log, the linear model (module docstring, eq
+    (1)) ``tau = Y_b pi_b + N^T diag(J) N qdd + N^T F(wm) phi`` with ``pi_b`` the links' base
     parameters (nursing eqs 15-16), ``J = J_m + J_r`` the rotor inertias (motor side, kg m^2;
     UR5e eq 2) and ``phi`` the friction models' linear parameters (motor side), then writes
     physically consistent standard link parameters back into the model
@@ -586,27 +623,49 @@ def identify_full(
     """
     if not datas:
         raise KinergyError("no log to identify from")
-    _check_options(solver, ridge, friction)
-    target = _pick_target(datas, target)
-    with_currents = currents and all(d.current is not None for d in datas)
+    parsed_target, parsed_solver = _parsed(target, solver)
+    _check_options(parsed_solver, ridge, friction)
+    options = IdentifyOptions(Method.FULL, friction, parsed_target, parsed_solver, ridge)
+    return full(robot, LogChunks.of(datas), options, currents=currents)
+
+
+@one_blas_thread
+def full(
+    robot: Robot,
+    logs: LogChunks,
+    options: IdentifyOptions | None = None,
+    *,
+    currents: bool = True,
+) -> IdentificationResult:
+    """The full method (module docstring) by passes over ``logs``' chunks: the regression's
+    rows folded into per-joint triangles, a pass per power-flow iteration, one to evaluate the
+    fit, the drives from the currents as the sequential method fits them; as
+    :func:`identify_full` with its ``target``, ``solver``, ``ridge`` and ``friction`` from
+    ``options``."""
+    options = options or IdentifyOptions(Method.FULL)
+    friction = options.friction
+    _check_options(options.solver, options.ridge, friction)
+    target = _pick_target(logs, options.target)
+    with_currents = currents and logs.every("current")
     start = robot
-    if with_currents and target == "current":  # drives from the model's links first
-        start = drives_from_currents(robot, datas, friction=friction).robot
+    if with_currents and target == Target.CURRENT:  # drives from the model's links first
+        start = drives_from_currents(robot, logs, CurrentOptions(friction)).robot
         friction = None
     base = base_parameters(start)
-    stacked = _stack(start, base, datas, target, friction)
-    flow = fit_power_flow(start, stacked, base.expressions())
-    solved = solve(stacked, flow.ols, solver, ridge)
-    merging = merged_columns(flow.ols, stacked.cols)
-    written = write_back(start, base, solved, stacked, target == "moment", merging.rotor)
+    reg = _regression(start, base, logs, target, friction)
+    flow = fit_power_flow(reg, logs, base.expressions())
+    solved = solve(flow.ols, reg.cols.prior, options.solver, options.ridge)
+    merging = merged_columns(flow.ols, reg.cols)
+    written = write_back(start, base, solved, reg, target == Target.MOMENT, merging.rotor)
+    evaluation = _evaluate(reg, logs, flow, solved, written)
     drives = None
     if with_currents:
-        drives = drives_from_currents(written.robot, datas, friction=friction)
+        drives = drives_from_currents(written.robot, logs, CurrentOptions(friction))
     out = drives.robot if drives is not None else written.robot
-    if with_currents and target == "current":  # the common scale from the published masses
-        gravity = scale_row(robot, base, stacked.q) @ base.project(inertial_parameters(out))
+    if with_currents and target == Target.CURRENT:  # the common scale from the published masses
+        gravity = scale_row(robot, base, evaluation.q) @ base.project(inertial_parameters(out))
         out = rescaled(out, 1.0 / float(gravity))
-    steps = _Steps(stacked, base, flow, solved, merging, written, drives, out)
-    fit = _fit(datas, steps, target=target, solver=solver, ridge=ridge)
-    joints = _joints(out, written, solved, stacked, drives)
+    steps = _Steps(reg, flow, solved, merging, written, evaluation, drives, out)
+    fit = _fit(logs, steps, solver=options.solver, ridge=options.ridge)
+    joints = _joints(out, written, solved, reg, drives)
     return IdentificationResult(out, "full", joints, fit)

@@ -43,26 +43,19 @@ class JointMetrics:
 
 
 def fit_metrics(measured: ArrayLike, predicted: ArrayLike) -> tuple[JointMetrics, ...]:
-    """Per joint (column of ``measured`` and ``predicted``, both (N, n)): :class:`JointMetrics`."""
-    y = np.asarray(measured, dtype=float)
-    p = np.asarray(predicted, dtype=float)
-    err = y - p
-    r2 = r_squared(y, p)
-    return tuple(
-        JointMetrics(
-            mean=float(np.mean(err[:, j])),
-            max=float(np.max(np.abs(err[:, j]))),
-            rms=float(np.sqrt(np.mean(err[:, j] ** 2))),
-            r2=float(r2[j]),
-        )
-        for j in range(y.shape[1])
-    )
+    """Per joint (column of ``measured`` and ``predicted``, both (N, n)): :class:`JointMetrics`
+    (:class:`MetricSums` of one block)."""
+    sums = MetricSums(np.shape(measured)[1])
+    sums.add(measured, predicted)
+    return sums.metrics()
 
 
 class MetricSums:
-    """:func:`fit_metrics` accumulated block by block (the same figures to round-off): per
-    joint the count, sum, largest ``|.|`` and sum of squares of the error, and the measured
-    signal's mean and sum of squared deviations (merged by Chan's formula, no cancellation)."""
+    """UR5e Tables V and VII's statistics accumulated block by block (the same figures to
+    round-off, whatever the blocks): per joint the count, sum, largest ``|.|`` and sum of
+    squares of the error, and the measured signal's mean and sum of squared deviations (merged
+    by Chan's formula, no cancellation); R^2 is NaN where the measured signal does not vary
+    (as :func:`r_squared`)."""
 
     def __init__(self, n: int):
         self.count = 0
@@ -93,7 +86,7 @@ class MetricSums:
         self.count = total
 
     def metrics(self) -> tuple[JointMetrics, ...]:
-        """Per joint :class:`JointMetrics`, as :func:`fit_metrics` of all the blocks."""
+        """Per joint :class:`JointMetrics` of all the blocks."""
         with np.errstate(divide="ignore", invalid="ignore"):
             varies = self.dev_sq > 1e-20 * np.maximum(self.sq, 1e-300)
             r2 = np.where(varies, 1.0 - self.err_sq / self.dev_sq, np.nan)

@@ -23,6 +23,19 @@ steps:
 4. **Write-back.** The links with the identified base parameters
    (:func:`kinergy.identify.physical.standard_from_base`); a link that is not physical keeps the
    model's data.
+
+Passes over the logs' chunks (:class:`~kinergy.identify.chunks.LogChunks`): the first finds each
+log's moving joints; the filtered, cycle-averaged signals of the excitation logs are folded
+chunk by chunk (the zero-phase filter on windows reaching :data:`~kinergy.logs.prepare.FILTER_REACH`
+periods of its cutoff into the neighbouring chunks, :func:`~kinergy.identify.chunks.windowed`;
+eq 24 as sums per sample of the period, :class:`~kinergy.identify.cycles.CycleAverage`: the same
+bits as whole). Three things take a log's samples of a few signals instead, because their maths
+needs them all at once: a friction run's odd part pairs each forward sample with the backward
+run's torque at the same position (the moving joint's position, torque, commanded speed and
+acceleration: 4 numbers a sample); the period of an excitation is the first dip of the
+autocorrelation over every shift (its time stamps and commanded positions, 1 + n a sample; none
+when ``period`` is given); and an excitation that does not repeat is regressed on its own
+samples (its filtered signals, 1 + 4 n a sample: there is nothing to average).
 """
 
 from __future__ import annotations
@@ -46,9 +59,11 @@ from kinergy.drives.transmission import reflected_inertia, transmission_matrix
 from kinergy.dynamics.regressor import inertial_parameters
 from kinergy.errors import KinergyError
 from kinergy.friction.makkar import PARAMETERS as MAKKAR_PARAMETERS
-from kinergy.identify.cycles import cycle_average, find_period
+from kinergy.identify.chunks import LogChunks, one_blas_thread, windowed
+from kinergy.identify.cycles import CycleAverage, find_period
 from kinergy.identify.friction_points import FrictionPoints, constant_speed_runs, friction_points
 from kinergy.identify.makkar_fit import MakkarFit, fit_makkar_lsq, fit_makkar_pso
+from kinergy.identify.options import FILTER_CUTOFF, MakkarMethod, NursingOptions
 from kinergy.identify.physical import (
     link_consistency,
     link_from_standard,
@@ -64,7 +79,7 @@ from kinergy.identify.result import (
 )
 from kinergy.identify.ridge import RidgeFit, ridge_minimal
 from kinergy.jsonable import OPTIONAL
-from kinergy.logs.prepare import IdentData, lowpass
+from kinergy.logs.prepare import FILTER_REACH, IdentData, lowpass
 from kinergy.messages import Messages
 from kinergy.model.robot import Friction, Joint, Link, Robot, Source
 
@@ -78,13 +93,11 @@ __all__ = [
     "NursingJoint",
     "RidgeSummary",
     "identify_nursing",
+    "nursing",
 ]
 
 #: a Makkar fit of joint-side friction points: ``(speeds, friction) -> MakkarFit``
 Fitter = Callable[[Array, Array], MakkarFit]
-
-#: the doc's low-pass cutoff for the motor currents, Hz
-FILTER_CUTOFF = 15.0
 
 
 # ---------------------------------------------------------------------------------------------
@@ -183,34 +196,50 @@ class NursingFit(Fit):
 # 1. Friction from runs
 
 
-def _moving_joint(data: IdentData, still: float = 1e-3, share: float = 0.1) -> int | None:
-    """The one joint that moves in a log, else None: max |qd_cmd| above ``still`` rad/s and above
-    ``share`` of the fastest joint's (a measured, filtered speed is never exactly still)."""
-    peak = np.max(np.abs(data.qd_cmd), axis=0)
+def _moving_joint(peak: Array, still: float = 1e-3, share: float = 0.1) -> int | None:
+    """The one joint that moves in a log, else None: its largest |qd_cmd| (``peak``, (n,))
+    above ``still`` rad/s and above ``share`` of the fastest joint's (a measured, filtered
+    speed is never exactly still)."""
     moving = np.flatnonzero(peak > max(still, share * float(peak.max())))
     return int(moving[0]) if moving.size == 1 else None
 
 
+def _gathered(logs: LogChunks, take: dict[int, Callable[[IdentData], Array]]) -> dict[int, Array]:
+    """One pass: for each segment ``k`` of ``take``, ``take[k]`` of its chunks, joined."""
+    parts: dict[int, list[Array]] = {k: [] for k in take}
+    for k, chunk in logs.chunks():
+        if k in take:  # a copy: a view would keep the whole chunk
+            parts[k].append(np.array(take[k](chunk)))
+    return {k: np.concatenate(p) for k, p in parts.items()}
+
+
 def _sort_logs(
-    robot: Robot, datas: Sequence[IdentData], eta: float, trim: int
-) -> tuple[dict[int, list[FrictionPoints]], list[IdentData]]:
+    robot: Robot, logs: LogChunks, eta: float, trim: int
+) -> tuple[dict[int, list[FrictionPoints]], list[int]]:
     """The friction points of every friction run, by joint, and the other (excitation) logs."""
+    moving = {k: _moving_joint(s.peak_cmd) for k, s in enumerate(logs.summaries)}
+
+    def run(j: int) -> Callable[[IdentData], Array]:
+        def columns(d: IdentData) -> Array:
+            assert d.current is not None
+            tau = joint_torques_from_current(robot, d.current, eta=eta)[:, j]
+            return np.column_stack([d.qd_cmd[:, j], d.qdd_cmd[:, j], d.q[:, j], tau])
+
+        return columns
+
+    signals = _gathered(logs, {k: run(j) for k, j in moving.items() if j is not None})
     runs: dict[int, list[FrictionPoints]] = {}
-    excitation: list[IdentData] = []
-    for d in datas:
-        j = _moving_joint(d)
+    excitation: list[int] = []
+    for k, j in moving.items():
         if j is None:
-            excitation.append(d)
+            excitation.append(k)
             continue
-        speeds, fwd, bwd = constant_speed_runs(d.qd_cmd[:, j], d.qdd_cmd[:, j])
+        qd_cmd, qdd_cmd, q, tau = signals.pop(k).T
+        speeds, fwd, bwd = constant_speed_runs(qd_cmd, qdd_cmd)
         if speeds.size == 0:
-            excitation.append(d)
+            excitation.append(k)
             continue
-        assert d.current is not None
-        tau = joint_torques_from_current(robot, d.current, eta=eta)
-        runs.setdefault(j, []).append(
-            friction_points(d.q[:, j], tau[:, j], speeds, fwd, bwd, joint=j, trim=trim)
-        )
+        runs.setdefault(j, []).append(friction_points(q, tau, speeds, fwd, bwd, joint=j, trim=trim))
     return runs, excitation
 
 
@@ -329,52 +358,78 @@ def _with_friction(robot: Robot, new_friction: dict[int, Friction], said: Messag
 
 
 def _excitation_arrays(
-    robot: Robot, data: IdentData, *, eta: float, period: float | None, cutoff: float | None
-) -> tuple[dict[str, Array], ExcitationLog]:
-    """Filtered (Butterworth), cycle-averaged (eq 24) motion and joint torques from currents."""
-    assert data.current is not None
-    current = data.current
-    fs = 1.0 / data.dt
-    used_cutoff = None
-    if cutoff is not None and cutoff < fs / 2.0:
-        current = lowpass(current, fs, cutoff)
-        used_cutoff = cutoff
-    found = period if period is not None else find_period(data.t, data.q_cmd)
-    signals = {"q": data.q, "qd": data.qd, "qdd": data.qdd, "current": current}
-    averaged, cycles = None, None
-    if found is not None and (data.t[-1] - data.t[0]) >= 2 * found - 1.5 * data.dt:
-        _, signals = cycle_average(data.t, signals, found)
-        averaged = found
-        cycles = int(np.floor((data.t[-1] - data.t[0] + data.dt) / found + 1e-9))
-    signals["tau"] = joint_torques_from_current(robot, signals["current"], eta=eta)
-    return signals, ExcitationLog(data.path, len(data), used_cutoff, averaged, cycles)
+    robot: Robot, logs: LogChunks, excitation: list[int], options: NursingOptions
+) -> tuple[list[dict[str, Array]], list[ExcitationLog]]:
+    """Each excitation log's motion and currents, filtered (Butterworth) and cycle-averaged
+    (eq 24), and the joint torques from the currents; folded in one pass (module docstring)."""
+    n = robot.n
+    need_q = options.period is None
+    stamps = _gathered(
+        logs,
+        {
+            k: (lambda d: np.column_stack([d.t, d.q_cmd])) if need_q else (lambda d: d.t[:, None])
+            for k in excitation
+        },
+    )
+    averages: dict[int, CycleAverage] = {}
+    whole: dict[int, list[dict[str, Array]]] = {}
+    notes: dict[int, ExcitationLog] = {}
+    rate: dict[int, float] = {}
+    reach = 2
+    for k in excitation:
+        t = stamps[k][:, 0]
+        dt = float(t[1] - t[0])
+        rate[k] = 1.0 / dt
+        cutoff = options.cutoff
+        used = cutoff if cutoff is not None and cutoff < 0.5 / dt else None
+        if used is not None:
+            reach = max(reach, int(np.ceil(FILTER_REACH / (used * dt))) + 2)
+        found = options.period if not need_q else find_period(t, stamps[k][:, 1 : 1 + n])
+        cycles = None
+        if found is not None and (t[-1] - t[0]) >= 2 * found - 1.5 * dt:
+            averages[k] = CycleAverage(t, found)
+            cycles = int(np.floor((t[-1] - t[0] + dt) / found + 1e-9))
+        else:
+            whole[k], found = [], None
+        notes[k] = ExcitationLog(logs.segments[k].path, t.size, used, found, cycles)
+    chunks = ((k, c) for k, c in logs.chunks() if k in notes)
+    for k, chunk, window, at in windowed(chunks, reach):
+        assert window.current is not None
+        current = window.current[at : at + len(chunk)]
+        used = notes[k].cutoff
+        if used is not None:
+            filtered = lowpass(window.current, rate[k], used)
+            current = filtered[at : at + len(chunk)]
+        signals = {"q": chunk.q, "qd": chunk.qd, "qdd": chunk.qdd, "current": current}
+        if k in averages:
+            averages[k].add(signals)
+        else:  # copies: views would keep the whole chunks
+            whole[k].append({name: np.array(x) for name, x in signals.items()})
+    parts = []
+    for k in excitation:
+        if k in averages:
+            _, signals = averages[k].result()
+        else:
+            signals = {name: np.concatenate([p[name] for p in whole[k]]) for name in whole[k][0]}
+        signals["tau"] = joint_torques_from_current(robot, signals["current"], eta=options.eta)
+        parts.append(signals)
+    return parts, [notes[k] for k in excitation]
 
 
 def _regress_links(
-    robot: Robot,
-    excitation: Sequence[IdentData],
-    *,
-    eta: float,
-    period: float | None,
-    cutoff: float | None,
-    split: float,
-    alphas: ArrayLike | None,
+    robot: Robot, logs: LogChunks, excitation: list[int], options: NursingOptions
 ) -> tuple[RidgeFit, RidgeSummary]:
     """Joint torques less friction and drive inertia (eq 25) regressed on the minimal set."""
-    parts, notes = [], []
-    for d in excitation:
-        sig, note = _excitation_arrays(robot, d, eta=eta, period=period, cutoff=cutoff)
-        parts.append(sig)
-        notes.append(note)
+    parts, notes = _excitation_arrays(robot, logs, excitation, options)
     q, qd, qdd, tau = (np.vstack([p[key] for p in parts]) for key in ("q", "qd", "qdd", "tau"))
     tau_links = tau - joint_friction(robot, qd) - qdd @ reflected_inertia(robot).T
-    rf = ridge_minimal(robot, q, qd, qdd, tau_links, split=split, alphas=alphas)
+    rf = ridge_minimal(robot, q, qd, qdd, tau_links, split=options.split, alphas=options.alphas)
     test = tau_links[rf.split :] if rf.split < len(tau_links) else tau_links
     summary = RidgeSummary(
         alpha=rf.alpha,
         intercept=rf.intercept,
         condition=rf.condition,
-        split=split,
+        split=options.split,
         rows_train=rf.split,
         rmse_test=tuple(rf.rmse_test.tolist()),
         rmse_train=tuple(rf.rmse_train.tolist()),
@@ -426,19 +481,15 @@ def _write_links(robot: Robot, rf: RidgeFit, said: Messages) -> tuple[Robot, tup
 # The whole procedure
 
 
-def _check_inputs(datas: Sequence[IdentData], fit: str) -> None:
-    if not datas:
-        raise KinergyError("no log to identify from")
-    if fit not in ("lsq", "pso"):
-        raise KinergyError(f"unknown Makkar fit {fit!r} (known: lsq, pso)")
-    for d in datas:
-        if d.current is None:
-            raise KinergyError(f"{d.path}: the nursing method needs actual_current")
+def _check_inputs(logs: LogChunks) -> None:
+    for segment, summary in zip(logs.segments, logs.summaries, strict=True):
+        if "current" not in summary.has:
+            raise KinergyError(f"{segment.path}: the nursing method needs actual_current")
 
 
-def _fitter(fit: str, seed: int) -> Fitter:
+def _fitter(fit: MakkarMethod, seed: int) -> Fitter:
     """The Makkar fit ``fit`` names: :func:`fit_makkar_pso` (seeded) or :func:`fit_makkar_lsq`."""
-    if fit == "pso":
+    if fit == MakkarMethod.PSO:
         return lambda v, f: fit_makkar_pso(v, f, rng=seed)
     return fit_makkar_lsq
 
@@ -473,7 +524,7 @@ def identify_nursing(
     datas: Sequence[IdentData],
     *,
     eta: float = 1.0,
-    fit: str = "lsq",
+    fit: MakkarMethod | str = MakkarMethod.LSQ,
     period: float | None = None,
     cutoff: float | None = FILTER_CUTOFF,
     split: float = 0.7,
@@ -481,27 +532,33 @@ def identify_nursing(
     trim: int = 10,
     seed: int = 0,
 ) -> IdentificationResult:
+    """:func:`nursing` on prepared logs held in memory (each one chunk), its options
+    (:class:`~kinergy.identify.options.NursingOptions`) as keywords."""
+    try:
+        method = MakkarMethod(fit)
+    except ValueError:
+        raise KinergyError(f"unknown Makkar fit {fit!r} (known: lsq, pso)") from None
+    candidates = None if alphas is None else tuple(np.asarray(alphas, dtype=float).ravel())
+    options = NursingOptions(eta, method, period, cutoff, split, candidates, trim, seed)
+    return nursing(robot, LogChunks.of(datas), options)
+
+
+@one_blas_thread
+def nursing(
+    robot: Robot, logs: LogChunks, options: NursingOptions | None = None
+) -> IdentificationResult:
     """The nursing doc's identification (sections 4.1-4.2) from prepared logs.
 
     The four steps of the module docstring. Logs in which one joint moves (the others below a
     tenth of its peak speed) at back-and-forth constant speeds are friction runs; motors without
-    runs keep the model's friction. The other (excitation) logs are low-pass filtered (``cutoff``
-    Hz; None: not filtered), each averaged over its periods (``period`` s, else
-    :func:`find_period`) and joined in order; the first ``split`` in time trains the ridge
-    regression on the weights ``alphas`` (:func:`~kinergy.identify.ridge.ridge_minimal`).
-
-    Parameters
-    ----------
-    robot : Robot
-        The starting model (kinematics, coupling, gear ratios, torque constants, rotor inertias).
-    datas : sequence of IdentData
-        Prepared logs with ``actual_current``.
-    eta : float
-        Eq 21's efficiency (the twin: 1; the doc's robot: 0.82).
-    fit : {"lsq", "pso"}
-        Makkar fit: :func:`fit_makkar_lsq` or :func:`fit_makkar_pso` (seeded by ``seed``).
-    trim : int
-        Samples dropped at each end of a constant-speed run.
+    runs keep the model's friction. The other (excitation) logs are low-pass filtered
+    (``options.cutoff`` Hz; None: not filtered), each averaged over its periods
+    (``options.period`` s, else :func:`find_period`) and joined in order; the first
+    ``options.split`` in time trains the ridge regression on the weights ``options.alphas``
+    (:func:`~kinergy.identify.ridge.ridge_minimal`); Makkar's curves are fitted as
+    ``options.fit`` says (:func:`fit_makkar_lsq`, or :func:`fit_makkar_pso` seeded by
+    ``options.seed``) to runs trimmed by ``options.trim`` samples, the currents converted with
+    eq 21's efficiency ``options.eta``.
 
     Returns
     -------
@@ -512,27 +569,26 @@ def identify_nursing(
     Raises
     ------
     KinergyError
-        No logs, a log without ``actual_current``, an unknown ``fit``.
+        A log without ``actual_current``.
     """
-    _check_inputs(datas, fit)
+    options = options or NursingOptions()
+    _check_inputs(logs)
     said = Messages()
-    fitter = _fitter(fit, seed)
-    runs, excitation = _sort_logs(robot, datas, eta, trim)
+    fitter = _fitter(options.fit, options.seed)
+    runs, excitation = _sort_logs(robot, logs, options.eta, options.trim)
     joint_fits, pooled = _joint_fits(robot, runs, fitter, said)
     new_friction, motor_fits = _motor_fits(robot, pooled, fitter)
     staged = _with_friction(robot, new_friction, said)
     identified, rf, summary, kept = staged, None, None, None
     if excitation:
-        rf, summary = _regress_links(
-            staged, excitation, eta=eta, period=period, cutoff=cutoff, split=split, alphas=alphas
-        )
+        rf, summary = _regress_links(staged, logs, excitation, options)
         identified, kept = _write_links(staged, rf, said)
     else:
         said.note("no excitation log (every log moves one joint): link data kept from the model")
     links = kept is not None and len(kept) < robot.n
     identified = _sources(identified, friction=bool(new_friction), links=links)
     fit_out = NursingFit(
-        **fit_fields(identified, datas, said),
+        **vars(fit_fields(identified, logs, said)),
         friction_runs=tuple(joint_fits),
         friction_motors=tuple(motor_fits),
         ridge=summary,

@@ -15,7 +15,18 @@ from dataclasses import dataclass
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import MODELS
 
-__all__ = ["AUTO", "IdentifyOptions", "Method", "Solver", "Target"]
+__all__ = [
+    "AUTO",
+    "FILTER_CUTOFF",
+    "CurrentOptions",
+    "Hold",
+    "IdentifyOptions",
+    "MakkarMethod",
+    "Method",
+    "NursingOptions",
+    "Solver",
+    "Target",
+]
 
 #: ``friction``: per joint, the model with the lowest cross-validated current RMS
 AUTO = "auto"
@@ -49,6 +60,46 @@ class Solver(enum.StrEnum):
     RIDGE = "ridge"
 
 
+class Hold(enum.Enum):
+    """How much of its friction a stopped joint holds through standstill, as the current fit
+    tries it (:mod:`kinergy.identify.sequential`): each fraction of
+    :data:`~kinergy.identify.drive_steps.HOLDINGS`, keeping whichever explains the currents best
+    (``SEARCH``), none (the UR5e doc's model) or all of it."""
+
+    SEARCH = "search"
+    NONE = "none"
+    FULL = "full"
+
+
+def _check_friction(friction: str | None) -> None:
+    if friction is not None and friction != AUTO and friction not in MODELS:
+        known = ", ".join([*sorted(MODELS), AUTO])
+        raise KinergyError(f"--friction: unknown model {friction!r}; known: {known}")
+
+
+@dataclass(frozen=True)
+class CurrentOptions:
+    """What the torque constants and friction are fitted with on the currents (UR5e eqs 17-18).
+
+    Attributes
+    ----------
+    friction : str or None
+        A friction model of the registry for every joint, :data:`AUTO` (per joint, the model
+        with the lowest cross-validated current RMS) or None (each joint's own model).
+    hold : Hold
+    """
+
+    friction: str | None = None
+    hold: Hold = Hold.SEARCH
+
+    def __post_init__(self) -> None:
+        _check_friction(self.friction)
+
+    @property
+    def auto(self) -> bool:
+        return self.friction == AUTO
+
+
 @dataclass(frozen=True)
 class IdentifyOptions:
     """The options of an identification.
@@ -73,9 +124,61 @@ class IdentifyOptions:
     solver: Solver = Solver.OLS
     ridge: float = 0.0
 
+    def record(self) -> dict[str, str | float]:
+        """The options as a model file records them (``friction`` only when given)."""
+        out: dict[str, str | float] = {"method": self.method.value}
+        if self.friction is not None:
+            out["friction"] = self.friction
+        out.update(target=self.target.value, solver=self.solver.value, ridge=self.ridge)
+        return out
+
     def __post_init__(self) -> None:
-        if self.friction is not None and self.friction != AUTO and self.friction not in MODELS:
-            known = ", ".join([*sorted(MODELS), AUTO])
-            raise KinergyError(f"--friction: unknown model {self.friction!r}; known: {known}")
+        _check_friction(self.friction)
         if not 0.0 <= self.ridge < float("inf"):
             raise KinergyError(f"--ridge must be >= 0 and finite, got {self.ridge}")
+
+
+#: the nursing doc's low-pass cutoff for the motor currents, Hz
+FILTER_CUTOFF = 15.0
+
+
+class MakkarMethod(enum.StrEnum):
+    """How the nursing method fits Makkar's friction curve (nursing eq 13): least squares or
+    the doc's particle swarm."""
+
+    LSQ = "lsq"
+    PSO = "pso"
+
+
+@dataclass(frozen=True)
+class NursingOptions:
+    """The options of the nursing method (:func:`kinergy.identify.nursing.nursing`).
+
+    Attributes
+    ----------
+    eta : float
+        Nursing eq 21's efficiency (the twin: 1; the doc's robot: 0.82).
+    fit : MakkarMethod
+    period : float or None
+        The excitation's period, s; None: found from each log.
+    cutoff : float or None
+        The currents' low-pass cutoff, Hz (the doc's 15); None: not filtered.
+    split : float
+        The share of the excitation samples (in time) that trains the ridge regression, in
+        (0, 1].
+    alphas : tuple of float or None
+        The ridge weights tried (default ``logspace(-12, 0, 49)``).
+    trim : int
+        Samples dropped at each end of a constant-speed run.
+    seed : int
+        The particle swarm's seed.
+    """
+
+    eta: float = 1.0
+    fit: MakkarMethod = MakkarMethod.LSQ
+    period: float | None = None
+    cutoff: float | None = FILTER_CUTOFF
+    split: float = 0.7
+    alphas: tuple[float, ...] | None = None
+    trim: int = 10
+    seed: int = 0

@@ -19,12 +19,18 @@ from a delete-one-block jackknife over :data:`BLOCKS` contiguous time blocks (th
 two is stated): a motion whose parts disagree about the payload gets the wide error bars it
 deserves, and a centre of mass whose error exceeds :data:`MAX_COM_STD` is reported as not
 identifiable from this motion, with the motion that would fix it.
+
+Every pass over the logs folds their rows into triangles (:class:`kinergy.linalg.Reduced`), one
+per *cell*: the samples that share a time block of all the logs stacked, a log, and a time
+block of that log. The whole fit, each jackknife fit without one block and each log's own fit
+(and its jackknife) are those cells' triangles joined, so nothing is held but them.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import itertools
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,13 +40,25 @@ from kinergy.drives.electrics import torque_constants
 from kinergy.drives.transmission import joint_torque
 from kinergy.dynamics.regressor import regressor
 from kinergy.errors import KinergyError
+from kinergy.identify.chunks import LogChunks, data_history, one_blas_thread
+from kinergy.identify.columns import ROWS
+from kinergy.identify.drive_steps import joined
+from kinergy.identify.options import Target
 from kinergy.identify.physical import inertia_vector, link_from_standard
-from kinergy.linalg import scaled_lstsq
+from kinergy.linalg import Reduced, scaled_solution
 from kinergy.logs.prepare import IdentData
 from kinergy.model.robot import Payload, Robot
 from kinergy.predict import drive_state
 
-__all__ = ["BLOCKS", "MAX_COM_STD", "PayloadEstimate", "block_std", "identify_payload"]
+__all__ = [
+    "BLOCKS",
+    "MAX_COM_STD",
+    "PayloadEstimate",
+    "block_std",
+    "identify_payload",
+    "jackknife_std",
+    "payload",
+]
 
 
 #: inertia terms are reported only when their relative standard deviation is below this
@@ -96,26 +114,40 @@ class PayloadEstimate:
 
 
 def identify_payload(
-    robot: Robot, datas: list[IdentData], *, signal: str = "auto"
+    robot: Robot, datas: Sequence[IdentData], *, signal: Target | str = Target.AUTO
 ) -> tuple[Payload, PayloadEstimate]:
-    """Identify the payload at the flange.
+    """:func:`payload` from prepared logs held in memory (each one chunk)."""
+    try:
+        parsed = Target(signal)
+    except ValueError:
+        raise KinergyError(
+            f"unknown signal {signal!r} (known: auto, current, torque, moment)"
+        ) from None
+    return payload(robot, LogChunks.of(datas), signal=parsed)
+
+
+@one_blas_thread
+def payload(
+    robot: Robot, logs: LogChunks, *, signal: Target = Target.AUTO
+) -> tuple[Payload, PayloadEstimate]:
+    """Identify the payload at the flange from logs taken with it.
 
     Parameters
     ----------
     robot : Robot
         The model identified without the payload (its own payload, if any, is ignored).
-    datas : list of IdentData
+    logs : LogChunks
         Logs taken with the payload.
-    signal : {"auto", "current", "torque", "moment"}
-        What measures the joint torques: motor currents (default when present), measured joint
-        torques, or ``target_moment`` (only if the controller was told about the payload).
+    signal : Target
+        What measures the joint torques: motor currents (``AUTO``: them when present), measured
+        joint torques, or ``target_moment`` (only if the controller was told about the payload).
 
     Returns
     -------
     payload : Payload
         Mass (kg), centre of mass in the flange frame (m) and inertia about it (kg m^2, zeros
         when not excited).
-    report : dict
+    report : PayloadEstimate
         Values with standard deviations, the condition number, and notes.
 
     Raises
@@ -124,10 +156,12 @@ def identify_payload(
         No usable signal, a negative mass, or a motion that does not excite the payload.
     """
     bare = robot.with_payload(None)
-    signal = _pick_signal(datas) if signal == "auto" else signal
-    a, b, x, std, cond = _point_mass(robot, bare, datas, signal)
-    full, full_std, cond_full = scaled_lstsq(a, b)
-    full_std = np.maximum(full_std, block_std(a, b, robot.n))
+    signal = _pick_signal(logs) if signal == Target.AUTO else signal
+    cells, x, std, cond = _point_mass(robot, bare, logs, signal)
+    every = [c.problem for c in cells]
+    full, full_std, cond_full = scaled_solution(joined(every))
+    blocks = _parts(cells, lambda c: c.block)
+    full_std = np.maximum(full_std, jackknife_std(blocks))
     inertia_ok = bool(
         np.all(full_std[4:] < MAX_INERTIA_SPREAD * np.maximum(np.abs(full[4:]), 1e-3))
     )
@@ -135,27 +169,54 @@ def identify_payload(
     if inertia_ok:
         x, std, cond = full, full_std, cond_full
     else:
-        std = np.maximum(std, block_std(a[:, :4], b, robot.n))
+        std = np.maximum(std, jackknife_std([_four(b) for b in blocks]))
         x = np.concatenate([x, np.zeros(6)])
         std = np.concatenate([std, np.zeros(6)])
-    payload, report = _finish(robot, x, std, cond, inertia_ok, signal, datas)
-    disagree, disputed = _disagreement(_log_fits(robot, a, b, datas))
+    samples = sum(s.samples for s in logs.summaries)
+    found, report = _finish(robot, x, std, cond, inertia_ok, signal, samples)
+    disagree, disputed = _disagreement(_log_fits(robot, cells, len(logs.segments)))
     notes = _uncertainty_notes(report, float(white), disputed) + disagree
-    return payload, dataclasses.replace(report, notes=report.notes + notes)
+    return found, dataclasses.replace(report, notes=report.notes + notes)
 
 
-def _log_fits(
-    robot: Robot, a: Array, b: Array, datas: list[IdentData]
-) -> list[tuple[Array, Array]]:
+@dataclass(frozen=True, eq=False)
+class _Cell:
+    """The rows of the samples in time block ``block`` of all the logs stacked, log ``log`` and
+    time block ``log_block`` of that log, folded into a triangle (``[regressor | torque]``,
+    10 unknowns, unit column scale)."""
+
+    block: int
+    log: int
+    log_block: int
+    problem: Reduced
+
+
+def _four(problem: Reduced) -> Reduced:
+    """The point-mass problem ``[m, m c]`` (the first 4 unknowns) of a 10-unknown one."""
+    pick = np.zeros((11, 5))
+    pick[[0, 1, 2, 3, 10], [0, 1, 2, 3, 4]] = 1.0
+    return problem.combine(pick)
+
+
+def _parts(cells: Sequence[_Cell], key: object) -> list[Reduced]:
+    """The cells' triangles joined by ``key(cell)`` (in order of the key)."""
+    by: dict[int, list[Reduced]] = {}
+    for c in cells:
+        by.setdefault(key(c), []).append(c.problem)  # type: ignore[operator]
+    return [joined(by[k]) for k in sorted(by)]
+
+
+def _log_fits(robot: Robot, cells: Sequence[_Cell], logs: int) -> list[tuple[Array, Array]]:
     """Each log's own point-mass fit: centre of mass (flange frame, m) and its standard errors
-    (jackknife), from the stacked rows ``a`` (N n, 10) and ``b`` (N n,); empty for one log."""
-    if len(datas) < 2:
+    (jackknife over its own time blocks); empty for one log."""
+    if logs < 2:
         return []
-    edges = np.cumsum([0] + [robot.n * len(d) for d in datas])
     fits = []
-    for lo, hi in itertools.pairwise(edges):
-        x, std, _ = scaled_lstsq(a[lo:hi, :4], b[lo:hi])
-        std = np.maximum(std, block_std(a[lo:hi, :4], b[lo:hi], robot.n))
+    for k in range(logs):
+        mine = [c for c in cells if c.log == k]
+        x, std, _ = scaled_solution(_four(joined([c.problem for c in mine])))
+        blocks = _parts(mine, lambda c: c.log_block)
+        std = np.maximum(std, jackknife_std([_four(b) for b in blocks]))
         fits.append((_com(robot, x), std[1:4] / max(float(x[0]), 1e-12)))
     return fits
 
@@ -193,23 +254,40 @@ def _disagreement(fits: list[tuple[Array, Array]]) -> tuple[tuple[str, ...], set
     return tuple(notes), axes
 
 
-def block_std(a: Array, b: Array, n: int, blocks: int = BLOCKS) -> Array:
-    """Standard errors of the least-squares ``x`` of ``a x = b`` from a delete-one-block
-    jackknife: ``sqrt((K - 1) / K * sum_k (x_k - mean x_k)^2)``, ``x_k`` the solution without
-    block ``k`` of ``K`` contiguous blocks of samples; rows are samples x ``n`` joints, (N n, p)
-    and (N n,) -> (p,). Zeros when there are fewer samples than ``2 K``."""
-    samples = len(b) // n
-    if samples < 2 * blocks:
-        return np.zeros(a.shape[1])
-    edges = n * np.linspace(0, samples, blocks + 1).astype(int)
-    keep = np.ones(len(b), dtype=bool)
-    fits = []
-    for lo, hi in itertools.pairwise(edges):
-        keep[:] = True
-        keep[lo:hi] = False
-        fits.append(scaled_lstsq(a[keep], b[keep])[0])
+def jackknife_std(blocks: Sequence[Reduced]) -> Array:
+    """Standard errors of a least-squares solution from a delete-one-block jackknife:
+    ``sqrt((K - 1) / K * sum_k (x_k - mean x_k)^2)``, ``x_k`` the solution without block ``k``
+    of the ``K`` blocks' triangles (:meth:`kinergy.linalg.Reduced.stack`, unit column scale),
+    shape (p,). Zeros when there are fewer than :data:`BLOCKS` blocks (too few samples)."""
+    p = blocks[0].r.shape[1] - 1 if blocks else 0
+    if len(blocks) < BLOCKS:
+        return np.zeros(p)
+    fits = [
+        scaled_solution(joined([b for i, b in enumerate(blocks) if i != k]))[0]
+        for k in range(len(blocks))
+    ]
     x = np.array(fits)
-    return np.sqrt((blocks - 1) / blocks * np.sum((x - x.mean(axis=0)) ** 2, axis=0))
+    k = len(blocks)
+    return np.sqrt((k - 1) / k * np.sum((x - x.mean(axis=0)) ** 2, axis=0))
+
+
+def _block_edges(samples: int, blocks: int = BLOCKS) -> Array:
+    """Where :data:`BLOCKS` contiguous time blocks of ``samples`` samples begin and end (none when
+    there are fewer samples than ``2 blocks``: no jackknife)."""
+    if samples < 2 * blocks:
+        return np.array([0, samples])
+    return np.linspace(0, samples, blocks + 1).astype(int)
+
+
+def block_std(a: Array, b: Array, n: int, blocks: int = BLOCKS) -> Array:
+    """:func:`jackknife_std` of the least-squares ``x`` of ``a x = b`` over ``blocks``
+    contiguous blocks of samples; rows are samples x ``n`` joints, (N n, p) and (N n,) -> (p,).
+    Zeros when there are fewer samples than ``2 blocks``."""
+    edges = n * _block_edges(len(b) // n, blocks)
+    parts = [
+        Reduced.empty(a.shape[1]).stack(a[lo:hi], b[lo:hi]) for lo, hi in itertools.pairwise(edges)
+    ]
+    return jackknife_std(parts) if len(parts) == blocks else np.zeros(a.shape[1])
 
 
 def _uncertainty_notes(
@@ -236,10 +314,14 @@ def _uncertainty_notes(
     return tuple(notes)
 
 
-def _pick_signal(datas: list[IdentData]) -> str:
+def _pick_signal(logs: LogChunks) -> Target:
     """The signal every log has: currents, else measured torques, else ``target_moment``."""
-    for name, attr in (("current", "current"), ("torque", "torque"), ("moment", "tau_ref")):
-        if all(getattr(d, attr) is not None for d in datas):
+    for name, attr in (
+        (Target.CURRENT, "current"),
+        (Target.TORQUE, "torque"),
+        (Target.MOMENT, "tau_ref"),
+    ):
+        if logs.every(attr):
             return name
     raise KinergyError(
         "payload identification needs actual_current, measured torques or target_moment"
@@ -247,23 +329,23 @@ def _pick_signal(datas: list[IdentData]) -> str:
 
 
 def _point_mass(
-    robot: Robot, bare: Robot, datas: list[IdentData], signal: str
-) -> tuple[Array, Array, Array, Array, float]:
+    robot: Robot, bare: Robot, logs: LogChunks, signal: Target
+) -> tuple[list[_Cell], Array, Array, float]:
     """Mass and first moment ``[m, m c]`` (4,) by least squares, iterated to a fixed point because
-    the payload moves the friction's power-flow direction (UR5e eqs 12-13): the last pass's
-    regressor (rows samples x joints, 10 columns) and unexplained torque, the estimate, its
-    standard errors and the condition number."""
+    the payload moves the friction's power-flow direction (UR5e eqs 12-13), a pass over the logs
+    each: the last pass's cells (:class:`_Cell`), the estimate, its standard errors and the
+    condition number."""
     guess: Robot = bare
     x = np.zeros(4)
     for _ in range(30):
-        a, b = _residuals(bare, guess, datas, signal)
-        x_new, std, cond = scaled_lstsq(a[:, :4], b)
+        cells = _cells(bare, guess, logs, signal)
+        x_new, std, cond = scaled_solution(_four(joined([c.problem for c in cells])))
         change = float(np.max(np.abs(x_new - x)))
         x = x_new
         guess = bare.with_payload(Payload(mass=max(float(x[0]), 1e-6), com=_com(robot, x)))
         if change < 1e-9 * max(abs(float(x[0])), 1.0):
             break
-    return a, b, x, std, cond
+    return cells, x, std, cond
 
 
 def _com(robot: Robot, x: Array) -> Array:
@@ -273,35 +355,74 @@ def _com(robot: Robot, x: Array) -> Array:
 
 
 def _residuals(
-    bare: Robot, guess: Robot, datas: list[IdentData], signal: str
+    bare: Robot, guess: Robot, data: IdentData, signal: Target, skip: int
 ) -> tuple[Array, Array]:
-    """Stacked payload regressor (rows: samples x joints, 10 columns) and the torque the bare
-    model leaves unexplained, with friction evaluated on the loaded ``guess``."""
+    """The payload regressor of ``data``'s samples after the first ``skip`` (rows: samples x
+    joints, 10 columns) and the torque the bare model leaves unexplained, with friction
+    evaluated on the loaded ``guess`` (held through standstill as the ``skip`` samples before
+    say)."""
     n = bare.n
-    rows_a, rows_b = [], []
-    for d in datas:
-        if signal == "moment":
-            if d.tau_ref is None:
-                raise KinergyError(f"{d.path}: no target_moment")
-            predicted = drive_state(bare, d.q_cmd, d.qd_cmd, d.qdd_cmd).tau_sim
-            measured = d.tau_ref
-            y = regressor(bare, d.q_cmd, d.qd_cmd, d.qdd_cmd)
+    if signal == Target.MOMENT:
+        if data.tau_ref is None:
+            raise KinergyError(f"{data.path}: no target_moment")
+        q, qd, qdd = data.q_cmd[skip:], data.qd_cmd[skip:], data.qdd_cmd[skip:]
+        predicted = drive_state(bare, q, qd, qdd).tau_sim
+        measured = data.tau_ref[skip:]
+    else:
+        q, qd, qdd = data.q[skip:], data.qd[skip:], data.qdd[skip:]
+        state = drive_state(bare, q, qd, qdd)
+        loaded = drive_state(guess, data.q, data.qd, data.qdd).tau_friction[skip:]
+        predicted = joint_torque(bare, state.tau_load + loaded)
+        if signal == Target.CURRENT:
+            if data.current is None:
+                raise KinergyError(f"{data.path}: no actual_current")
+            measured = joint_torque(bare, data.current[skip:] * torque_constants(bare))
         else:
-            state = drive_state(bare, d.q, d.qd, d.qdd)
-            loaded = drive_state(guess, d.q, d.qd, d.qdd)
-            predicted = joint_torque(bare, state.tau_load + loaded.tau_friction)
-            if signal == "current":
-                if d.current is None:
-                    raise KinergyError(f"{d.path}: no actual_current")
-                measured = joint_torque(bare, d.current * torque_constants(bare))
-            else:
-                if d.torque is None:
-                    raise KinergyError(f"{d.path}: no measured joint torques")
-                measured = d.torque
-            y = regressor(bare, d.q, d.qd, d.qdd)
-        rows_a.append(y[:, :, 10 * (n - 1) :].reshape(-1, 10))
-        rows_b.append((measured - predicted).reshape(-1))
-    return np.vstack(rows_a), np.concatenate(rows_b)
+            if data.torque is None:
+                raise KinergyError(f"{data.path}: no measured joint torques")
+            measured = data.torque[skip:]
+    y = regressor(bare, q, qd, qdd)
+    return y[:, :, 10 * (n - 1) :].reshape(-1, 10), (measured - predicted).reshape(-1)
+
+
+def _cells(bare: Robot, guess: Robot, logs: LogChunks, signal: Target) -> list[_Cell]:
+    """One pass: every cell's triangle (:class:`_Cell`) of the payload's regression with
+    friction evaluated on ``guess``."""
+    n = bare.n
+    sizes = [s.samples for s in logs.summaries]
+    starts = np.cumsum([0, *sizes])
+    edges = _block_edges(int(starts[-1]))
+    cuts = sorted(
+        {int(e) for e in edges}
+        | {int(v) for v in starts}
+        | {int(starts[k] + e) for k, size in enumerate(sizes) for e in _block_edges(size)}
+    )
+    problems = [Reduced.empty(10) for _ in cuts[:-1]]
+    held = data_history(guess)
+    at = 0
+    for k, chunk in logs.chunks():
+        for lo in range(0, len(chunk), ROWS):
+            part = chunk.sliced(lo, min(lo + ROWS, len(chunk)))
+            data, skip = held.ahead(k, part)
+            a, b = _residuals(bare, guess, data, signal, skip)
+            held.update(data, skip)
+            size = len(part)
+            for c, (lo, hi) in enumerate(itertools.pairwise(cuts)):
+                lo, hi = max(lo, at), min(hi, at + size)
+                if lo < hi:
+                    rows = slice(n * (lo - at), n * (hi - at))
+                    problems[c] = problems[c].stack(a[rows], b[rows])
+            at += size
+    out = []
+    for c, (lo, _) in enumerate(itertools.pairwise(cuts)):
+        log = int(np.searchsorted(starts, lo, side="right")) - 1
+        block = int(np.searchsorted(edges, lo, side="right")) - 1
+        own = _block_edges(sizes[log])
+        log_block = int(np.searchsorted(own, lo - starts[log], side="right")) - 1
+        out.append(
+            _Cell(min(block, len(edges) - 2), log, min(log_block, len(own) - 2), problems[c])
+        )
+    return out
 
 
 def _inertia(robot: Robot, x: Array) -> tuple[Array, str | None]:
@@ -325,8 +446,8 @@ def _finish(
     std: Array,
     cond: float,
     inertia_ok: bool,
-    signal: str,
-    datas: list[IdentData],
+    signal: Target,
+    samples: int,
 ) -> tuple[Payload, PayloadEstimate]:
     """The payload and its report from ``[m, m c, I_o]`` (10,) and standard errors."""
     mass = float(x[0])
@@ -340,14 +461,14 @@ def _finish(
         note = "the motion does not excite the payload's inertia enough: point mass"
     inertia_ok = inertia_ok and note is None
     report = PayloadEstimate(
-        signal=signal,
+        signal=signal.value,
         mass=mass,
         mass_std=float(std[0]),
         com=tuple(com.tolist()),
         com_std=tuple((std[1:4] / mass).tolist()),
         inertia=tuple(inertia6.tolist()) if inertia_ok else None,
         condition=cond,
-        samples=int(sum(len(d) for d in datas)),
+        samples=samples,
         notes=() if note is None else (note,),
     )
     return Payload(mass=mass, com=com, inertia=inertia6), report

@@ -1,19 +1,24 @@
-"""The full method's least squares (:mod:`kinergy.identify.full`, its eq (1)) on the stacked columns.
+"""The full method's least squares (:mod:`kinergy.identify.full`, its eq (1)), from its triangles.
 
-- Column dependence (Gautier's numerical rank by pivoted QR, :func:`kinergy.linalg.pivoted_rank`):
+Eq (1)'s rows are folded chunk by chunk into one QR triangle per joint
+(:meth:`kinergy.identify.columns.Regression.rows`, :meth:`kinergy.linalg.Reduced.stack`);
+everything here works on those small triangles, whatever the number of samples:
+
+- column dependence (Gautier's numerical rank by pivoted QR, :func:`kinergy.linalg.pivoted_rank`):
   link base columns that the logs do not excite are an error; rotor and friction columns that
   depend on the link columns or on each other are dropped, keep the model's values, and are
-  described as combinations of the kept columns (:class:`MergedColumn`).
-- The ``power_flow`` friction's directions: the fit is repeated with the load torques of the
-  fitted friction until the directions settle (:func:`fit_power_flow`).
-- Solvers, each from one QR factorisation of the column-scaled ``[A | y]``
-  (:func:`kinergy.linalg.reduce`): ordinary least squares, Gautier's weighted least squares
-  (rows of joint ``j`` weighted by ``1 / sigma_j`` from an OLS pass's residuals) and ridge
-  regression toward the model's values (:func:`solve`).
+  described as combinations of the kept columns (:class:`MergedColumn`);
+- the friction's load torques (``power_flow``'s directions, load-proportional friction): the fit
+  is repeated, one pass over the chunks each, with the load torques of the fitted friction until
+  they settle (:func:`fit_power_flow`);
+- solvers: ordinary least squares on the joints' triangles together, Gautier's weighted least
+  squares (joint ``j``'s triangle weighted by ``1 / sigma_j``, ``sigma_j`` from the OLS fit's
+  residual on it) and ridge regression toward the model's values (:func:`solve`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,18 +26,12 @@ from numpy.typing import NDArray
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.friction import get_model
-from kinergy.identify.columns import (
-    LOAD_DEPENDENT,
-    Columns,
-    Stacked,
-    power_flow_load,
-    set_friction,
-)
-from kinergy.linalg import Reduced, ReducedSolution, pivoted_rank, reduce, solve_reduced
+from kinergy.identify.chunks import LogChunks, Store
+from kinergy.identify.columns import Columns, Regression
+from kinergy.identify.drive_steps import joined
+from kinergy.identify.options import Solver
+from kinergy.linalg import Reduced, ReducedSolution, pivoted_rank, solve_reduced
 from kinergy.messages import Messages
-from kinergy.model.robot import Robot
-from kinergy.predict import drive_state
 
 __all__ = [
     "DEPENDENT_TOL",
@@ -55,7 +54,7 @@ __all__ = [
 
 Index = NDArray[np.intp]
 
-#: the column-scaled stacked regressor, after merged columns are dropped, is singular beyond this
+#: the column-scaled regressor, after merged columns are dropped, is singular beyond this
 MAX_CONDITION = 1e10
 #: a column whose part independent of the kept ones is below this fraction of its norm is dependent
 DEPENDENT_TOL = 1e-8
@@ -112,29 +111,39 @@ def _fixed_target(red: Reduced, dropped: Index, prior: Array) -> Array:
     return red.r_y - red.r_a[:, dropped] @ (prior * red.scale)[dropped]
 
 
+def _together(joints: Sequence[Reduced], weights: Array | None = None) -> Reduced:
+    """The joints' triangles (unit column scale) as one problem, each times its weight
+    (default 1), with the columns scaled to unit norm (:meth:`Reduced.unit_columns`)."""
+    w = np.ones(len(joints)) if weights is None else weights
+    scaled = [Reduced(wj * t.r, t.scale, t.rows) for wj, t in zip(w, joints, strict=True)]
+    return joined(scaled).unit_columns()
+
+
 # ---------------------------------------------------------------------------------------------
 # Ordinary least squares and the power-flow fixed point
 
 
 @dataclass(frozen=True, eq=False)
 class OlsFit:
-    """Ordinary least squares on the stacked columns: the reduced problem, the dropped and kept
-    columns (indices into all ``p``), the solution (scaled) and all unknowns ``x`` (p,), dropped
-    ones at the model's values."""
+    """Ordinary least squares on eq (1): the reduced problem, the joints' triangles it is made of
+    (unit column scale), the dropped and kept columns (indices into all ``p``), the solution
+    (scaled) and all unknowns ``x`` (p,), dropped ones at the model's values."""
 
     reduced: Reduced
+    joints: list[Reduced]
     dropped: Index
     kept: Index
     solution: ReducedSolution
     x: Array
 
 
-def fit_ols(stacked: Stacked, expressions: list[str], check_links: bool) -> OlsFit:
-    """OLS with the friction block as it stands; ``check_links`` raises for unexcited link
-    base parameters (:func:`check_link_rank`, their ``expressions`` name them)."""
-    cols = stacked.cols
+def fit_ols(
+    joints: list[Reduced], cols: Columns, expressions: list[str], check_links: bool
+) -> OlsFit:
+    """OLS from the joints' triangles; ``check_links`` raises for unexcited link base
+    parameters (:func:`check_link_rank`, their ``expressions`` name them)."""
     n_link, n_cols = cols.n_link, cols.prior.size
-    red = reduce(stacked.a_flat, stacked.y)
+    red = _together(joints)
     if check_links:
         check_link_rank(red.r[:n_link, :n_link], expressions)
     dropped = n_link + dependent_extras(red.r[n_link:n_cols, n_link:n_cols])
@@ -144,89 +153,73 @@ def fit_ols(stacked: Stacked, expressions: list[str], check_links: bool) -> OlsF
         raise _singular(red.r_a[:, kept], ols.cond, [cols.names[k] for k in kept])
     x = cols.prior.copy()
     x[kept] = ols.x / red.scale[kept]
-    return OlsFit(red, dropped, kept, ols, x)
+    return OlsFit(red, joints, dropped, kept, ols, x)
 
 
 @dataclass(frozen=True, eq=False)
 class FlowFit:
-    """The OLS fit with settled power-flow directions: the fit, the load torques used (N, n,
-    motor side), passes made, whether the directions settled, and on how many samples the fitted
-    model's own load torque disagrees with the direction used (0 without power-flow friction)."""
+    """The OLS fit with settled load torques: the fit, the load torques it used (a record per
+    piece of rows, :meth:`Regression.rows`; None without load-dependent friction), the passes
+    made and whether the loads settled."""
 
     ols: OlsFit
-    load: Array
+    loads: Store | None
     iterations: int
     settled: bool
-    mismatch: int
 
 
-def _own_load(stacked: Stacked, x: Array) -> Array:
-    """The load torques a model with unknowns ``x`` predicts itself (motor side, (N, n))."""
-    n_fixed = stacked.n_fixed
-    tau_sim = (stacked.a_flat[:, :n_fixed] @ x[:n_fixed]).reshape(stacked.y3.shape)
-    return np.asarray(np.linalg.solve(stacked.n_mat.T, tau_sim.T).T)
+def _pass(
+    reg: Regression, logs: LogChunks, previous: tuple[Store, Array] | None
+) -> tuple[list[Reduced], Store | None, bool]:
+    """One pass over the chunks: the joints' triangles of eq (1) with the loads of the model
+    (``previous`` None) or those after a fit (``previous`` = (the loads it used, its unknowns
+    ``x``), :meth:`Regression.rows`); the loads used, kept; and whether they settled against
+    ``previous``'s: no power-flow direction changed and the other load-dependent models' loads
+    moved by at most :data:`LOAD_RTOL` of their largest value."""
+    n, p = reg.robot.n, reg.cols.prior.size
+    joints = [Reduced.empty(p) for _ in range(n)]
+    store = logs.derived() if reg.needs_load else None
+    loads, x = (iter(previous[0]), previous[1]) if previous is not None else (None, None)
+    same_signs, moved, largest = True, 0.0, 0.0
+    own = reg.own_load
+    for _, rows in reg.rows(logs, loads, x):
+        for j in range(n):
+            joints[j] = joints[j].stack(rows.a[:, j, :], rows.y3[:, j])
+        if store is not None:
+            store.put([rows.load])
+        if previous is not None:
+            same_signs &= bool(
+                np.array_equal(np.sign(rows.wm * rows.load), np.sign(rows.wm * rows.previous))
+            )
+            if own and len(rows.load):
+                moved = max(moved, float(np.max(np.abs(rows.load - rows.previous)[:, own])))
+                largest = max(largest, float(np.max(np.abs(rows.load[:, own]))))
+    settled = same_signs and moved <= LOAD_RTOL * max(largest, 1e-300)
+    return joints, store, settled
 
 
-def _initial_load(robot: Robot, stacked: Stacked) -> Array:
-    """The load torques the friction columns start from (motor side, (N, n)): the model's own
-    for load-dependent friction (``load_coulomb``, ``load_thermal_power_law``: the load is the
-    link side's, which friction does not change), and for ``power_flow`` the measurement less the
-    model's friction (directions from the model's own load where the measurement is ambiguous);
-    zeros where no model takes a load."""
-    if not stacked.needs_load:
-        return np.zeros_like(stacked.q)
-    predicted = np.asarray(drive_state(robot, stacked.q, stacked.qd, stacked.qdd).tau_load)
-    if not stacked.needs_flow:
-        return predicted
-    cols = stacked.cols
-    values = [cols.friction(cols.prior, m) for m in range(robot.n)]
-    return power_flow_load(stacked, values, predicted)
-
-
-def _next_load(stacked: Stacked, x: Array, load: Array) -> tuple[Array, bool]:
-    """The loads for the next pass after a fit with unknowns ``x``, and whether they settled:
-    ``power_flow`` directions from the measurement less the fitted friction
-    (:func:`kinergy.identify.columns.power_flow_load`; settled when no direction changes), the
-    other load-dependent models the fitted model's own load torque (settled when it moves by less
-    than :data:`LOAD_RTOL` of its largest value)."""
-    values = [stacked.cols.friction(x, m) for m in range(len(stacked.models))]
-    new = power_flow_load(stacked, values, load) if stacked.needs_flow else load.copy()
-    wm = stacked.wm
-    settled = bool(np.array_equal(np.sign(wm * new), np.sign(wm * load)))
-    own_models = [m for m, name in enumerate(stacked.models) if name not in LOAD_DEPENDENT]
-    own_models = [m for m in own_models if get_model(stacked.models[m]).needs_load]
-    if own_models:
-        own = _own_load(stacked, x)[:, own_models]
-        moved = float(np.max(np.abs(own - load[:, own_models])))
-        settled &= moved <= LOAD_RTOL * max(float(np.max(np.abs(own))), 1e-300)
-        new[:, own_models] = own
-    return new, settled
-
-
-def fit_power_flow(robot: Robot, stacked: Stacked, expressions: list[str]) -> FlowFit:
+def fit_power_flow(reg: Regression, logs: LogChunks, expressions: list[str]) -> FlowFit:
     """OLS with the friction's load torques settled (at most :data:`MAX_FLOW_ITERATIONS`
-    passes, :func:`_next_load`): ``power_flow`` directions from the measurement less the fitted
-    friction, load-proportional friction (``load_coulomb``, ``load_thermal_power_law``) from the
-    fitted model's own load torque, a fixed point that converges because friction is a few
-    per cent of the load. ``stacked``'s friction block is left at the load used."""
-    load = _initial_load(robot, stacked)
-    iterations, settled = 0, not stacked.needs_load
-    while True:
-        iterations += 1
-        set_friction(stacked, load)
-        fit = fit_ols(stacked, expressions, iterations == 1)
-        if settled or iterations >= MAX_FLOW_ITERATIONS:
-            break
-        new, settled = _next_load(stacked, fit.x, load)
+    passes): ``power_flow`` directions from the measurement less the fitted friction,
+    load-proportional friction (``load_coulomb``, ``load_thermal_power_law``) from the fitted
+    model's own load torque, a fixed point that converges because friction is a few per cent
+    of the load. Each pass makes the next loads from the last fit and folds the rows with them;
+    a pass whose loads settled is not solved (the fit before it stands)."""
+    joints, loads, _ = _pass(reg, logs, None)
+    fit = fit_ols(joints, reg.cols, expressions, True)
+    iterations, settled = 1, not reg.needs_load
+    while not settled and iterations < MAX_FLOW_ITERATIONS:
+        assert loads is not None
+        joints, new, settled = _pass(reg, logs, (loads, fit.x))
+        assert new is not None
         if settled:
+            new.close()
             break
-        load = new
-    mismatch = 0
-    if stacked.needs_flow:  # how often the fitted model's own load torque disagrees
-        flow = [m in LOAD_DEPENDENT for m in stacked.models]
-        own, wm = _own_load(stacked, fit.x)[:, flow], stacked.wm[:, flow]
-        mismatch = int(np.sum(np.sign(wm * own) != np.sign(wm * load[:, flow])))
-    return FlowFit(fit, load, iterations if stacked.needs_load else 0, settled, mismatch)
+        loads.close()
+        loads = new
+        fit = fit_ols(joints, reg.cols, expressions, False)
+        iterations += 1
+    return FlowFit(fit, loads, iterations if reg.needs_load else 0, settled)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -268,33 +261,32 @@ class Solved:
         return self.solution.sse / max(self.reduced.rows - self.kept.size, 1)
 
 
-def _wls(stacked: Stacked, ols: OlsFit) -> tuple[Reduced, ReducedSolution, Array]:
+def _wls(ols: OlsFit, prior: Array) -> tuple[Reduced, ReducedSolution, Array]:
     """Gautier's weighted least squares: the rows of joint ``j`` weighted by ``1 / sigma_j``,
-    ``sigma_j`` its residual standard deviation after the OLS pass. Returns the weighted reduced
-    problem, its solution and the weights ``1 / sigma_j^2``."""
-    n, samples = stacked.y3.shape[1], stacked.y3.shape[0]
-    rows_joint = np.tile(np.arange(n), samples)
-    resid = stacked.y - stacked.a_flat @ ols.x
+    ``sigma_j`` its residual standard deviation after the OLS pass (from its triangle). Returns
+    the weighted reduced problem, its solution and the weights ``1 / sigma_j^2``."""
+    n = len(ols.joints)
+    samples = ols.reduced.rows // n
+    resid2 = np.array([t.norm2(np.append(-ols.x, 1.0)) for t in ols.joints])
     dof_share = max(1.0 - ols.kept.size / ols.reduced.rows, 1e-9)
-    sigma = np.sqrt(np.bincount(rows_joint, resid**2, minlength=n) / (samples * dof_share))
+    sigma = np.sqrt(resid2 / (samples * dof_share))
     if np.any(sigma > 0.0):
         w_j = 1.0 / np.maximum(sigma, 1e-9 * float(sigma.max()))
     else:  # noise-free data: nothing to weigh
         w_j = np.ones(n)
-    w = w_j[rows_joint]
-    used = reduce(stacked.a_flat * w[:, None], stacked.y * w)
-    r_y = _fixed_target(used, ols.dropped, stacked.cols.prior)
+    used = _together(ols.joints, w_j)
+    r_y = _fixed_target(used, ols.dropped, prior)
     return used, solve_reduced(used.r_a[:, ols.kept], r_y, used.rows), w_j**2
 
 
-def solve(stacked: Stacked, ols: OlsFit, solver: str, ridge: float) -> Solved:
-    """The regression by ``solver`` (``"ols"``, ``"wls"`` or ``"ridge"`` with weight ``ridge``),
-    with the OLS fit's dropped columns at the model's values."""
-    red, kept, dropped, prior = ols.reduced, ols.kept, ols.dropped, stacked.cols.prior
+def solve(ols: OlsFit, prior: Array, solver: Solver, ridge: float) -> Solved:
+    """The regression by ``solver`` (ridge with weight ``ridge``), with the OLS fit's dropped
+    columns at the model's values ``prior``."""
+    red, kept, dropped = ols.reduced, ols.kept, ols.dropped
     used, lam, sol, weights = red, 0.0, ols.solution, None
-    if solver == "wls":
-        used, sol, weights = _wls(stacked, ols)
-    elif solver == "ridge":
+    if solver == Solver.WLS:
+        used, sol, weights = _wls(ols, prior)
+    elif solver == Solver.RIDGE:
         lam = float(ridge)
         z_prior = prior * red.scale
         sol = solve_reduced(

@@ -14,15 +14,14 @@ Results are frozen dataclasses, written as JSON by :mod:`kinergy.jsonable`:
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
-
-import numpy as np
+from typing import Any, TypedDict
 
 from kinergy.arrays import Array
 from kinergy.drives.transmission import joint_torque
-from kinergy.identify.metrics import JointMetrics, fit_metrics
+from kinergy.identify.chunks import LogChunks, data_history
+from kinergy.identify.metrics import JointMetrics, MetricSums
 from kinergy.jsonable import to_jsonable
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs
@@ -36,6 +35,7 @@ __all__ = [
     "IDENTIFIED",
     "KEPT",
     "DriveEstimate",
+    "DriveFields",
     "Fit",
     "IdentificationResult",
     "Prediction",
@@ -43,6 +43,7 @@ __all__ = [
     "drive_fields",
     "fit_fields",
     "predict",
+    "predictions",
     "validation_metrics",
 ]
 
@@ -82,24 +83,34 @@ class Fit(Validation):
     notes: tuple[str, ...] = ()
 
 
-def friction_entry(joint: Joint) -> dict[str, Any]:
+def friction_entry(joint: Joint) -> dict[str, str | float]:
     """``{"model": name, **parameters}`` of a joint's friction, as results report it."""
     return {"model": joint.drive.friction.model, **joint.drive.friction.params}
 
 
-def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> dict[str, Any]:
+class DriveFields(TypedDict):
+    """The fields every method's per-joint result starts from (:func:`drive_fields`)."""
+
+    name: str
+    rotor_inertia: float
+    motor_inertia: float
+    torque_constant: float
+    friction: dict[str, str | float]
+
+
+def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> DriveFields:
     """A joint's drive as the model holds it, as :class:`DriveEstimate` fields (``name``,
     ``rotor_inertia``, ``motor_inertia``, ``torque_constant``, ``friction``): keyword arguments
     of a method's per-joint result. ``rotor_inertia`` (kg m^2, motor side) replaces the drive's
     J_m + J_r where a method estimates it on its own."""
     drive = joint.drive
-    return {
-        "name": joint.name,
-        "rotor_inertia": drive.rotor_inertia if rotor_inertia is None else rotor_inertia,
-        "motor_inertia": drive.motor_inertia,
-        "torque_constant": drive.torque_constant,
-        "friction": friction_entry(joint),
-    }
+    return DriveFields(
+        name=joint.name,
+        rotor_inertia=drive.rotor_inertia if rotor_inertia is None else rotor_inertia,
+        motor_inertia=drive.motor_inertia,
+        torque_constant=drive.torque_constant,
+        friction=friction_entry(joint),
+    )
 
 
 @dataclass(frozen=True)
@@ -178,6 +189,10 @@ class Prediction:
     current: Array | None
     joint_torque: Array | None
 
+    def after(self, skip: int) -> Prediction:
+        """The predictions from row ``skip`` on."""
+        return Prediction(*(None if x is None else x[skip:] for x in vars(self).values()))
+
 
 def predict(robot: Robot, data: IdentData) -> Prediction:
     """Predict what ``data``'s log recorded: reference torques on the commanded motion, currents
@@ -193,47 +208,57 @@ def predict(robot: Robot, data: IdentData) -> Prediction:
     return Prediction(torque, current, joint)
 
 
+def predictions(
+    robot: Robot, logs: LogChunks, *fields: str
+) -> Iterator[tuple[int, IdentData, Prediction]]:
+    """:func:`predict` over every chunk (of the logs that have ``fields``): (segment number,
+    chunk, predictions), friction held through standstill as in each whole log."""
+    held = data_history(robot)
+    for k, chunk in logs.chunks(*fields):
+        data, skip = held.ahead(k, chunk)
+        pred = predict(robot, data)
+        held.update(data, skip)
+        yield k, chunk, pred.after(skip)
+
+
 def fit_fields(
     robot: Robot,
-    datas: Sequence[IdentData],
+    logs: LogChunks,
     said: Messages,
-    *,
-    samples: int | None = None,
-) -> dict[str, Any]:
-    """The :class:`Fit` fields every method reports, as keyword arguments of its fit: the
-    identified ``robot``'s :func:`validation_metrics` on ``datas``, the samples used (all the
-    logs' unless given), the logs, their lags (s) and what the fit ``said``."""
-    return {
-        **vars(validation_metrics(robot, datas)),
-        "samples": int(sum(len(d) for d in datas)) if samples is None else samples,
-        "logs": tuple(d.path for d in datas),
-        "lag": tuple(d.lag for d in datas),
-        "warnings": tuple(said.warnings),
-        "notes": tuple(said.notes),
-    }
+) -> Fit:
+    """The :class:`Fit` every method reports (its own fit extends it, ``**vars(fit)``): the
+    identified ``robot``'s :func:`validation_metrics` on ``logs``, the samples, the logs, their
+    lags (s) and what the fit ``said``."""
+    return Fit(
+        **vars(validation_metrics(robot, logs)),
+        samples=sum(s.samples for s in logs.summaries),
+        logs=logs.paths,
+        lag=logs.lags,
+        warnings=tuple(said.warnings),
+        notes=tuple(said.notes),
+    )
 
 
-def validation_metrics(robot: Robot, datas: Sequence[IdentData]) -> Validation:
+def validation_metrics(robot: Robot, logs: LogChunks | Sequence[IdentData]) -> Validation:
     """UR5e Tables V and VII over several logs (pooled): per joint mean, max, RMS error and R^2
     of the torque (against ``target_moment``), the current (against ``actual_current``) and, for
-    arms with torque sensors, the joint torque."""
-    pairs: dict[str, tuple[list[Array], list[Array]]] = {
-        "torque": ([], []),
-        "current": ([], []),
-        "joint_torque": ([], []),
-    }
-    for data in datas:
-        pred = predict(robot, data)
+    arms with torque sensors, the joint torque. Where every log has joint voltages, the
+    predicted currents are kept (:attr:`LogChunks.currents`) for the electrics' fit."""
+    logs = logs if isinstance(logs, LogChunks) else LogChunks.of(logs)
+    sums: dict[str, MetricSums] = {}
+    keep = logs.every("voltage", "current")
+    kept = logs.derived() if keep else None
+    for _, chunk, pred in predictions(robot, logs):
         for key, measured, predicted in (
-            ("torque", data.tau_ref, pred.torque),
-            ("current", data.current, pred.current),
-            ("joint_torque", data.torque, pred.joint_torque),
+            ("torque", chunk.tau_ref, pred.torque),
+            ("current", chunk.current, pred.current),
+            ("joint_torque", chunk.torque, pred.joint_torque),
         ):
             if measured is not None and predicted is not None:
-                pairs[key][0].append(measured)
-                pairs[key][1].append(predicted)
-    found = {
-        key: fit_metrics(np.vstack(meas), np.vstack(preds)) if meas else None
-        for key, (meas, preds) in pairs.items()
-    }
-    return Validation(**found)
+                sums.setdefault(key, MetricSums(robot.n)).add(measured, predicted)
+        if kept is not None:
+            kept.put([pred.current])
+    if kept is not None:
+        logs.currents = (robot, kept)
+    names = ("torque", "current", "joint_torque")
+    return Validation(**{k: sums[k].metrics() if k in sums else None for k in names})

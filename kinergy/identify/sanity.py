@@ -48,16 +48,16 @@ def check_signals(datas: Sequence[IdentData]) -> None:
                 )
 
 
-def check_motion(datas: Sequence[IdentData]) -> None:
-    """Raise when no joint moves in any log (every position spans less than
-    :data:`STILL_SPAN`): no method can identify anything from a static log.
+def check_motion(span: float) -> None:
+    """Raise when no joint moves in any log: ``span`` (rad), the largest range of a joint's
+    position within one log, is below :data:`STILL_SPAN` (no method can identify anything from
+    a static log).
 
     Raises
     ------
     KinergyError
         One line naming the largest span found.
     """
-    span = max(float(np.max(np.ptp(d.q, axis=0))) for d in datas)
     if span < STILL_SPAN:
         raise KinergyError(
             f"no joint moves in these logs (largest position span {span:.2g} rad, below "

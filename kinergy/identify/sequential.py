@@ -13,9 +13,13 @@
 4. Motor inertia = rotor inertia - the model's reducer inertia (Table IV).
 
 Real controllers add one thing the seed does not model: a joint that stops stays in stiction,
-and its current keeps part of the friction of the direction it stopped in. With ``hold="auto"``
-each joint's fit is made holding 0, 25, 50, 75 and 100 % of its friction through standstill (the
-``standstill`` and ``holding`` friction parameters) and keeps the best.
+and its current keeps part of the friction of the direction it stopped in. With
+``Hold.SEARCH`` each joint's fit is made holding 0, 25, 50, 75 and 100 % of its friction through
+standstill (the ``standstill`` and ``holding`` friction parameters) and keeps the best.
+
+Every step is a fold over the logs' prepared chunks (:mod:`kinergy.identify.chunks`): step 2's
+triangle in one pass, step 3's trials in one pass per batch (:mod:`kinergy.identify.drive_steps`),
+the fit statistics in one more; logs held in memory are one chunk each.
 """
 
 from __future__ import annotations
@@ -23,31 +27,23 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Protocol
 
 import numpy as np
-from numpy.typing import NDArray
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import (
-    get_model,
-)
+from kinergy.friction.registry import get_model
+from kinergy.identify.chunks import STILL_SPEED, LogChunks, Summary, one_blas_thread
 from kinergy.identify.drive_steps import (
     AUTO_CANDIDATES,
-    STILL_SPEED,
     CurrentStats,
     FrictionChoice,
-    JointFitter,
-    current_fitter,
     current_step,
-    fit_joints,
-    rotor_inertias,
     rotor_problem,
     rotor_step,
-    stack,
     with_rotor_inertias,
 )
+from kinergy.identify.options import CurrentOptions, Hold
 from kinergy.identify.result import (
     AT_BOUND,
     IDENTIFIED,
@@ -55,12 +51,10 @@ from kinergy.identify.result import (
     DriveEstimate,
     Fit,
     IdentificationResult,
-    Validation,
     drive_fields,
-    validation_metrics,
+    fit_fields,
 )
 from kinergy.jsonable import OPTIONAL
-from kinergy.linalg import Reduced
 from kinergy.logs.prepare import IdentData
 from kinergy.messages import Messages
 from kinergy.model.robot import Joint, Robot, Source
@@ -69,16 +63,12 @@ __all__ = [
     "AUTO_CANDIDATES",
     "DrivesFromCurrents",
     "FrictionChoice",
-    "LogsInMemory",
-    "MotionSummary",
     "SequentialFit",
     "SequentialJoint",
-    "SequentialLogs",
     "drives_from_currents",
     "identify_sequential",
     "motion_problems",
-    "rotor_inertias",
-    "sequential_from",
+    "sequential",
 ]
 
 
@@ -107,38 +97,9 @@ class SequentialFit(Fit):
     )
 
 
-@dataclass(frozen=True)
-class MotionSummary:
-    """What :func:`motion_problems` needs of the real joint speeds: the samples, and per joint
-    the largest ``|qd|`` (rad/s) and the samples faster than :data:`STILL_SPEED` forward and
-    backward; :meth:`of` one block of speeds, :meth:`merged` with the next."""
-
-    samples: int
-    peak: Array
-    forward: NDArray[np.int_]
-    backward: NDArray[np.int_]
-
-    @classmethod
-    def of(cls, qd: Array) -> MotionSummary:
-        """The summary of joint speeds ``qd`` (N, n), rad/s."""
-        return cls(
-            qd.shape[0],
-            np.abs(qd).max(axis=0) if qd.shape[0] else np.zeros(qd.shape[1]),
-            (qd > STILL_SPEED).sum(axis=0),
-            (qd < -STILL_SPEED).sum(axis=0),
-        )
-
-    def merged(self, other: MotionSummary) -> MotionSummary:
-        return MotionSummary(
-            self.samples + other.samples,
-            np.maximum(self.peak, other.peak),
-            self.forward + other.forward,
-            self.backward + other.backward,
-        )
-
-
-def motion_problems(robot: Robot, summary: MotionSummary) -> dict[int, str]:
-    """What the logs cannot identify, per joint (index -> reason), from their speeds' summary.
+def motion_problems(robot: Robot, summary: Summary) -> dict[int, str]:
+    """What the logs cannot identify, per joint (index -> reason), from the summary of their
+    real joint speeds.
 
     Raises
     ------
@@ -164,11 +125,6 @@ def motion_problems(robot: Robot, summary: MotionSummary) -> dict[int, str]:
     if len(problems) == robot.n:
         raise KinergyError("cannot identify from these logs: " + "; ".join(problems.values()))
     return problems
-
-
-def _diagnose_motion(robot: Robot, datas: Sequence[IdentData]) -> dict[int, str]:
-    """:func:`motion_problems` of the logs' real joint speeds."""
-    return motion_problems(robot, MotionSummary.of(stack(datas, "qd")))
 
 
 def _sources(robot: Robot, has_ref: bool, has_current: bool) -> dict[str, Source]:
@@ -238,9 +194,10 @@ def identify_sequential(
     datas: Sequence[IdentData],
     *,
     friction: str | None = None,
-    hold: str | bool = "auto",
+    hold: Hold = Hold.SEARCH,
 ) -> IdentificationResult:
-    """Identify rotor inertias, torque constants and friction with the UR5e doc's procedure.
+    """Identify rotor inertias, torque constants and friction with the UR5e doc's procedure:
+    :func:`sequential` on prepared logs held in memory (each one chunk).
 
     Parameters
     ----------
@@ -254,9 +211,8 @@ def identify_sequential(
         linear in its parameters (all of kinergy's are, given their shape parameters).
         ``"auto"``: per joint, the model of :data:`AUTO_CANDIDATES` the logs support with the
         lowest cross-validated current RMS (``fit.friction_choice`` says which won, by how much).
-    hold : {"auto", True, False}
-        Hold friction through standstill (see the module docstring); ``auto`` keeps whichever
-        fits the currents better.
+    hold : Hold
+        Hold friction through standstill (see the module docstring).
 
     Returns
     -------
@@ -270,103 +226,43 @@ def identify_sequential(
         Logs that cannot identify a parameter (a joint that never moves or never reverses, too few
         samples, a singular regression), naming the joints.
     """
-    if not datas:
-        raise KinergyError("no log to identify from")
-    return sequential_from(robot, LogsInMemory(datas), friction=friction, hold=hold)
+    return sequential(robot, LogChunks.of(datas), CurrentOptions(friction, hold))
 
 
-class SequentialLogs(Protocol):
-    """What the sequential method needs of its logs, however they are held: in memory
-    (:class:`LogsInMemory`) or read in chunks (:mod:`kinergy.identify.streamed`)."""
-
-    paths: tuple[str, ...]
-    lags: tuple[float, ...]
-    samples: int
-    has_ref: bool
-    has_current: bool
-
-    def summary(self) -> MotionSummary:
-        """The real joint speeds' summary (:func:`motion_problems`)."""
-
-    def rotor_problem(self, robot: Robot) -> Reduced | None:
-        """Step 2's triangle over the logs with ``target_moment`` (None: no such log)."""
-
-    def fitter(
-        self, staged: Robot, rotor: Array, options: tuple[str | None, str | bool]
-    ) -> JointFitter:
-        """Step 3's per-joint fit of eq 18 over the logs with ``actual_current``."""
-
-    def validation(self, robot: Robot) -> Validation:
-        """:func:`~kinergy.identify.result.validation_metrics` of ``robot`` on the logs."""
-
-
-class LogsInMemory:
-    """Prepared logs held whole (:class:`SequentialLogs`)."""
-
-    def __init__(self, datas: Sequence[IdentData]):
-        self.datas = list(datas)
-        self.paths = tuple(d.path for d in datas)
-        self.lags = tuple(d.lag for d in datas)
-        self.samples = int(sum(len(d) for d in datas))
-        self.has_ref = any(d.tau_ref is not None for d in datas)
-        self.has_current = any(d.current is not None for d in datas)
-
-    def summary(self) -> MotionSummary:
-        return MotionSummary.of(stack(self.datas, "qd"))
-
-    def rotor_problem(self, robot: Robot) -> Reduced | None:
-        ref_logs = [d for d in self.datas if d.tau_ref is not None]
-        return rotor_problem(robot, ref_logs) if ref_logs else None
-
-    def fitter(
-        self, staged: Robot, rotor: Array, options: tuple[str | None, str | bool]
-    ) -> JointFitter:
-        logs = [d for d in self.datas if d.current is not None]
-        return current_fitter(staged, rotor, logs, options)
-
-    def validation(self, robot: Robot) -> Validation:
-        return validation_metrics(robot, self.datas)
-
-
-def sequential_from(
-    robot: Robot,
-    logs: SequentialLogs,
-    *,
-    friction: str | None = None,
-    hold: str | bool = "auto",
+@one_blas_thread
+def sequential(
+    robot: Robot, logs: LogChunks, options: CurrentOptions | None = None
 ) -> IdentificationResult:
-    """:func:`identify_sequential` on logs however held (:class:`SequentialLogs`)."""
+    """The sequential identification (module docstring) by passes over ``logs``' chunks; as
+    :func:`identify_sequential`, ``options`` saying how step 3 fits the currents."""
+    options = options or CurrentOptions()
+    rotor_triangle = rotor_problem(robot, logs)  # the first pass, when none was made yet
     problems = motion_problems(robot, logs.summary())
     said = Messages([f"{text}; kept the model's values" for text in problems.values()])
-    if not (logs.has_ref or logs.has_current):
+    has_ref, has_current = logs.any("tau_ref"), logs.any("current")
+    if not (has_ref or has_current):
         raise KinergyError(
             "identification needs target_moment (rotor inertia) or actual_current (torque "
             "constant and friction); the logs have neither"
         )
     active = [j for j in range(robot.n) if j not in problems]
-    rotor, rotor_std, cond = rotor_step(robot, logs.rotor_problem(robot), active, said)
+    rotor, rotor_std, cond = rotor_step(robot, rotor_triangle, active, said)
     staged = with_rotor_inertias(robot, rotor, said)
     stats: list[CurrentStats] = [CurrentStats() for _ in range(robot.n)]
     held = choices = None
-    if logs.has_current:
-        fitter = logs.fitter(staged, rotor, (friction, hold))
-        staged, stats, held, choices = fit_joints(staged, problems, fitter, said)
+    if has_current:
+        staged, stats, held, choices = current_step(staged, rotor, logs, problems, options, said)
     else:
         said.note(
             "the logs have no actual_current: torque constants and friction kept from the model"
         )
-    sources = _sources(staged, logs.has_ref, logs.has_current)
+    sources = _sources(staged, has_ref, has_current)
     identified = dataclasses.replace(staged, sources=sources)
     fit = SequentialFit(
-        **vars(logs.validation(identified)),
-        samples=logs.samples,
-        logs=logs.paths,
-        lag=logs.lags,
-        warnings=tuple(said.warnings),
-        notes=tuple(said.notes),
+        **vars(fit_fields(identified, logs, said)),
         condition_rotor_inertia=cond,
         friction_holding=held,
-        friction_choice=choices if friction == "auto" else None,
+        friction_choice=choices if options.auto else None,
     )
     joints = _joints(identified, (rotor, rotor_std), problems, stats)
     return IdentificationResult(identified, "sequential", joints, fit)
@@ -386,12 +282,9 @@ class DrivesFromCurrents:
     said: Messages
 
 
+@one_blas_thread
 def drives_from_currents(
-    robot: Robot,
-    logs: Sequence[IdentData],
-    *,
-    friction: str | None = None,
-    hold: str | bool = "auto",
+    robot: Robot, logs: LogChunks, options: CurrentOptions | None = None
 ) -> DrivesFromCurrents:
     """Torque constants and friction of every motor from ``actual_current`` (UR5e eqs 17-18),
     ``robot``'s links and rotor inertias taken as they are (the full method's drives).
@@ -402,12 +295,13 @@ def drives_from_currents(
         As :func:`identify_sequential`: too few samples, no joint that moves, a singular
         current regression.
     """
-    problems = _diagnose_motion(robot, logs)
+    problems = motion_problems(robot, logs.summary())
     said = Messages(
         [f"{text}; kept the model's torque constant and friction" for text in problems.values()]
     )
     rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
-    out, stats, held, _ = current_step(robot, rotor, logs, problems, (friction, hold), said)
+    options = options or CurrentOptions()
+    out, stats, held, _ = current_step(robot, rotor, logs, problems, options, said)
     flags, std = [], []
     for joint, stat in zip(out.joints, stats, strict=True):
         f, s = _drive_flags(joint, float(joint.drive.rotor_inertia), np.nan, stat)

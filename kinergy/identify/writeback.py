@@ -26,7 +26,7 @@ from kinergy.arrays import Array
 from kinergy.dynamics.regressor import BaseParameters, inertial_parameters, parameter_names
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import get_model, with_linear_parameters
-from kinergy.identify.columns import Columns, Stacked
+from kinergy.identify.columns import Columns, Regression
 from kinergy.identify.constrained import ConstrainedFit, bounds, physical_fit
 from kinergy.identify.physical import (
     inertia_vector,
@@ -119,25 +119,23 @@ def _links(
     robot: Robot,
     base: BaseParameters,
     problem: Solved,
-    stacked: Stacked,
+    reg: Regression,
     merged_rotor: dict[int, Array],
     said: Messages,
 ) -> _Links:
     """Steps 1 and 2 of the module docstring (what the constrained fit did, said)."""
-    cols = stacked.cols
+    cols = reg.cols
     n_link, x = cols.n_link, problem.x
     pi0 = inertial_parameters(robot)
     payload = pi0 - inertial_parameters(robot, include_payload=False)  # the last link's part
     scale = parameter_scale(robot)
     pi = standard_from_base(base, x[:n_link], pi0, scale=scale)
     flagged = {j: p for j, p in enumerate(link_consistency(pi - payload)) if p is not None}
-    outside = _out_of_bounds(cols, x, *bounds(cols, stacked.models))
+    outside = _out_of_bounds(cols, x, *bounds(cols, reg.models))
     if not (flagged or outside):
         return _Links(pi - payload, x, CLOSEST, None, flagged)
     names = robot.joint_names
-    refit = physical_fit(
-        problem, base, cols, stacked.models, pi0, scale, payload, names, merged_rotor
-    )
+    refit = physical_fit(problem, base, cols, reg.models, pi0, scale, payload, names, merged_rotor)
     if refit is None:
         for col, phrase in outside.items():  # never written: the model's value instead
             said.warn(f"{phrase}: kept the model's value (the constrained fit failed)")
@@ -254,15 +252,15 @@ def _flags(cols: Columns, problem: Solved, written: _Links) -> tuple[str, ...]:
 
 
 def _with_drive(
-    m: int, joint: Joint, stacked: Stacked, x: Array, commanded: bool, said: Messages
+    m: int, joint: Joint, reg: Regression, x: Array, commanded: bool, said: Messages
 ) -> Joint:
     """``joint`` with motor ``m``'s rotor inertia and friction (not ``commanded``) from the
     unknowns ``x``."""
-    cols = stacked.cols
+    cols = reg.cols
     drive = _with_rotor(m, joint, float(x[cols.n_link + m]), said)
     joint = dataclasses.replace(joint, drive=drive)
     if not commanded:
-        friction = (stacked.models[m], stacked.params[m])
+        friction = (reg.models[m], reg.params[m])
         drive = _with_friction(m, joint, friction, cols.friction(x, m), said)
         joint = dataclasses.replace(joint, drive=drive)
     return joint
@@ -272,20 +270,20 @@ def write_back(
     robot: Robot,
     base: BaseParameters,
     problem: Solved,
-    stacked: Stacked,
+    reg: Regression,
     commanded: bool,
     merged_rotor: dict[int, Array],
 ) -> WriteBack:
-    """The identified robot from the solved regression ``problem`` of ``stacked`` (module
+    """The identified robot from the solved regression ``problem`` of ``reg`` (module
     docstring). ``commanded``: a fit against ``target_moment``, which keeps the model's
     friction; ``merged_rotor`` gives each merged rotor inertia's column in link base columns
     (motor -> (b,)), which the constrained fit may move."""
     said = Messages()
-    cols = stacked.cols
-    written = _links(robot, base, problem, stacked, merged_rotor, said)
+    cols = reg.cols
+    written = _links(robot, base, problem, reg, merged_rotor, said)
     link_joints, links, physical = _with_links(robot, written.links, said)
     final = [
-        _with_drive(m, joint, stacked, written.x, commanded, said)
+        _with_drive(m, joint, reg, written.x, commanded, said)
         for m, joint in enumerate(link_joints)
     ]
     sources = _sources(robot, written.method, physical, commanded)

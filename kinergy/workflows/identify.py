@@ -1,28 +1,32 @@
-"""``kinergy identify``: a model (or a payload) from logs, written as a robot file."""
+"""``kinergy identify``: a model (or a payload) from logs, written as a robot file.
+
+Every identification reads its logs in chunks (:func:`~kinergy.workflows.logs.chunked_logs`)
+and runs as folds over them (:class:`~kinergy.identify.chunks.LogChunks`), whatever the method;
+logs already prepared in memory (:func:`identify_model`) are one chunk each of the same folds.
+"""
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import datetime
 import os
-from collections.abc import Mapping, Sequence
-from typing import Any, Protocol
+from collections.abc import Sequence
 
 import numpy as np
 
-from kinergy.drives.electrics import equivalent_voltage
+from kinergy.drives.bus import supply_power
+from kinergy.drives.electrics import electrical_power, equivalent_voltage, torque_constants
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.errors import KinergyError
-from kinergy.identify.electrics import ElectricsFit, fit_electrics, fit_standby, with_electrics
-from kinergy.identify.full import identify_full
-from kinergy.identify.nursing import identify_nursing
-from kinergy.identify.options import IdentifyOptions, Method
-from kinergy.identify.payload import PayloadEstimate, identify_payload
-from kinergy.identify.result import IDENTIFIED, IdentificationResult
-from kinergy.identify.sanity import check_motion, check_signals
-from kinergy.identify.sequential import identify_sequential, sequential_from
-from kinergy.identify.streamed import LogsInChunks, streams
+from kinergy.identify.chunks import LogChunks, Summary, data_history
+from kinergy.identify.electrics import ElectricsFit, ElectricsSums, with_electrics
+from kinergy.identify.full import full
+from kinergy.identify.nursing import nursing
+from kinergy.identify.options import CurrentOptions, IdentifyOptions, Method
+from kinergy.identify.payload import PayloadEstimate, payload
+from kinergy.identify.result import IDENTIFIED, IdentificationResult, validation_metrics
+from kinergy.identify.sanity import check_motion
+from kinergy.identify.sequential import sequential
 from kinergy.io.columns import compact_columns
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
@@ -32,12 +36,12 @@ from kinergy.logs.reading import InputLogs, LogReading
 from kinergy.model import Payload, Robot, save_robot
 from kinergy.model.robot import Identified, InputRecord, Source
 from kinergy.predict import drive_state
-from kinergy.workflows.logs import chunked_logs, prepared_logs
+from kinergy.workflows.logs import chunked_logs
 
 __all__ = [
     "METHODS",
     "MIN_SECONDS",
-    "ElectricsLogs",
+    "identify_chunks",
     "identify_logs",
     "identify_model",
     "identify_payload_model",
@@ -58,8 +62,17 @@ def _header(what: str, logs: Sequence[str | os.PathLike[str]]) -> str:
     return f"kinergy {__version__}: {what} from {', '.join(os.fspath(p) for p in logs)} on {stamp}"
 
 
-def _check_seconds(seconds: float) -> None:
-    """Raise when the logs span less than :data:`MIN_SECONDS` together."""
+def _checks(summaries: list[Summary]) -> None:
+    """What every identification asks of its logs, checked at the end of their first pass:
+    some joint moves, and the logs span :data:`MIN_SECONDS` together.
+
+    Raises
+    ------
+    KinergyError
+        Logs without motion (:func:`kinergy.identify.sanity.check_motion`) or too short.
+    """
+    check_motion(max(float(np.max(s.span)) for s in summaries))
+    seconds = sum(s.seconds for s in summaries)
     if seconds < MIN_SECONDS:
         raise KinergyError(
             f"the logs span {seconds:.2f} s: identification needs at least {MIN_SECONDS:g} s of "
@@ -67,13 +80,27 @@ def _check_seconds(seconds: float) -> None:
         )
 
 
+def identify_chunks(
+    robot: Robot, logs: LogChunks, options: IdentifyOptions | None = None
+) -> IdentificationResult:
+    """Identify ``robot`` from ``logs`` as ``options`` say, then the motor electrics and the
+    standby power where the logs have voltages and the supply (:func:`measured_electrics`)."""
+    options = options or IdentifyOptions()
+    if options.method == Method.SEQUENTIAL:
+        result = sequential(robot, logs, CurrentOptions(options.friction))
+    elif options.method == Method.NURSING:
+        result = nursing(robot, logs)
+    else:
+        result = full(robot, logs, options)
+    return measured_electrics(result, logs)
+
+
 def identify_model(
     robot: Robot,
     datas: Sequence[IdentData],
     options: IdentifyOptions | None = None,
 ) -> IdentificationResult:
-    """Identify ``robot`` from prepared logs as ``options`` say, then the motor electrics and the
-    standby power where the logs have voltages and the supply (:func:`measured_electrics`).
+    """:func:`identify_chunks` of prepared logs held in memory (each one chunk).
 
     Raises
     ------
@@ -81,24 +108,7 @@ def identify_model(
         Logs spanning less than :data:`MIN_SECONDS` together, with signals no robot logs or
         without motion (:mod:`kinergy.identify.sanity`).
     """
-    options = options or IdentifyOptions()
-    check_signals(datas)
-    check_motion(datas)
-    _check_seconds(sum(float(d.t[-1] - d.t[0]) for d in datas))
-    if options.method == Method.SEQUENTIAL:
-        result = identify_sequential(robot, list(datas), friction=options.friction)
-    elif options.method == Method.NURSING:
-        result = identify_nursing(robot, list(datas))
-    else:
-        result = identify_full(
-            robot,
-            list(datas),
-            target=options.target,
-            solver=options.solver,
-            ridge=options.ridge,
-            friction=options.friction,
-        )
-    return measured_electrics(result, datas)
+    return identify_chunks(robot, LogChunks.of(datas, check=_checks), options)
 
 
 def unsupported_fit(result: IdentificationResult) -> str:
@@ -129,14 +139,20 @@ def unsupported_fit(result: IdentificationResult) -> str:
 
 
 def _record(
-    robot: Robot, inputs: InputLogs, options: Mapping[str, Any], accepted: Sequence[str]
+    robot: Robot,
+    inputs: InputLogs,
+    options: IdentifyOptions,
+    columns: str | None,
+    accepted: Sequence[str],
 ) -> Robot:
     """``robot`` with where it was identified from (:class:`~kinergy.model.robot.Identified`)."""
     from kinergy import __version__
 
-    plain = {k: v for k, v in options.items() if isinstance(v, str | float | int | bool)}
+    settings: dict[str, str | float] = options.record()
+    if columns:
+        settings["columns"] = columns
     records = tuple(InputRecord(p.path, p.sha256, p.size, p.rows) for p in inputs.provenance)
-    ident = Identified(__version__, "identify", plain, records, tuple(accepted))
+    ident = Identified(__version__, "identify", settings, records, tuple(accepted))
     return dataclasses.replace(robot, identified=ident)
 
 
@@ -153,10 +169,9 @@ def identify_logs(
     write the model to ``out`` when given.
 
     ``reading`` says how to read the logs (:class:`~kinergy.logs.reading.LogReading`),
-    ``options`` what to identify. When the method streams
-    (:func:`kinergy.identify.streamed.streams`: the sequential method with a fixed friction
-    model) the logs are read in chunks of ``rows`` samples and never held whole
-    (:func:`~kinergy.workflows.logs.chunked_logs`); other methods prepare them in memory.
+    ``options`` what to identify. The logs are read in chunks of ``rows`` samples and never held
+    whole (:func:`~kinergy.workflows.logs.chunked_logs`, :func:`identify_chunks`; the files
+    themselves are read in chunks of at least 2 rows).
 
     Raises
     ------
@@ -167,15 +182,12 @@ def identify_logs(
     """
     reading = reading or LogReading()
     options = options or IdentifyOptions()
-    if not streams(robot, options.method, options.friction):
-        datas, inputs = prepared_logs(logs, robot, reading)
-        result = identify_model(robot, datas, options)
-    else:
-        with chunked_logs(logs, robot, reading, rows=rows) as (segments, inputs):
-            with contextlib.closing(LogsInChunks(robot, segments, rows)) as chunked:
-                _check_seconds(chunked.seconds)
-                result = sequential_from(robot, chunked, friction=options.friction)
-                result = measured_electrics(result, chunked)
+    with chunked_logs(logs, robot, reading, rows=max(rows, 2)) as (segments, inputs):
+        chunks = LogChunks(segments, rows, check=_checks)
+        try:
+            result = identify_chunks(robot, chunks, options)
+        finally:
+            chunks.close()
     accepted = [a for c in inputs.checks for a in c.accepted]
     problem = unsupported_fit(result)
     if problem:
@@ -188,117 +200,83 @@ def identify_logs(
     result = dataclasses.replace(result, inputs=inputs, accepted=tuple(accepted))
     if out is not None:
         columns = compact_columns(reading.columns) if reading.columns else None
-        settings = {**vars(options), "columns": columns}
-        model = _record(result.robot, inputs, settings, accepted)
+        model = _record(result.robot, inputs, options, columns, accepted)
         what = f"{robot.name} identified ({result.method} method)"
         save_robot(model, out, header=_header(what, [p.path for p in inputs.provenance]))
         result = dataclasses.replace(result, robot=model)
     return result
 
 
-class ElectricsLogs(Protocol):
-    """What :func:`measured_electrics` needs of the logs, however they are held (in memory,
-    :class:`_InMemory`, or in chunks, :class:`~kinergy.identify.streamed.LogsInChunks`)."""
-
-    @property
-    def has_voltage(self) -> bool:
-        """Every log has joint voltages and currents."""
-
-    @property
-    def has_supply(self) -> bool:
-        """Every log has the supply's voltage and current."""
-
-    def electrics(self, robot: Robot) -> list[ElectricsFit | KinergyError]:
-        """Per motor, eq 19's fit with ``robot``'s predicted current as the instrument, or why
-        it cannot be made."""
-
-    def standby(self, robot: Robot) -> float:
-        """The mean supply power the motors of ``robot`` leave over, W."""
-
-
-class _InMemory:
-    """Prepared logs held whole (:class:`ElectricsLogs`)."""
-
-    def __init__(self, logs: Sequence[IdentData]):
-        self.logs = list(logs)
-        self.has_voltage = bool(logs) and all(
-            d.voltage is not None and d.current is not None for d in logs
-        )
-        self.has_supply = bool(logs) and all(
-            d.supply_voltage is not None and d.supply_current is not None for d in logs
-        )
-
-    def _motion(self) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray | None]:
-        """The logs' real motion (q, qd, qdd), stacked, and their joint temperatures (None
-        unless every log has them)."""
-        logs = self.logs
-        q, qd, qdd = (np.vstack([getattr(d, k) for d in logs]) for k in ("q", "qd", "qdd"))
-        temps = [d.temperature for d in logs if d.temperature is not None]
-        return (q, qd, qdd), (np.vstack(temps) if len(temps) == len(logs) else None)
-
-    def electrics(self, robot: Robot) -> list[ElectricsFit | KinergyError]:
-        n_mat = transmission_matrix(robot)
-        current = np.vstack([d.current for d in self.logs if d.current is not None])
-        voltage = equivalent_voltage(
-            np.vstack([d.voltage for d in self.logs if d.voltage is not None])
-        )
-        (q, qd, qdd), temperature = self._motion()
-        # the identified model's current, free of the log's noise: the instrument of the fit
-        predicted = drive_state(robot, q, qd, qdd, temperature=temperature).current
-        wm = qd @ n_mat.T
-        fits: list[ElectricsFit | KinergyError] = []
-        for m in range(robot.n):
-            try:
-                fits.append(
-                    fit_electrics(
-                        current[:, m], voltage[:, m], wm[:, m], instrument=predicted[:, m]
-                    )
-                )
-            except KinergyError as exc:
-                fits.append(exc)
-        return fits
-
-    def standby(self, robot: Robot) -> float:
-        motion, temperature = self._motion()
-        supply = np.concatenate([_supply_power(d) for d in self.logs])
-        fit = fit_standby(robot, motion, supply, temperature=temperature, dt=self.logs[0].dt)
-        return fit.standby
+def _predicted_currents(robot: Robot, logs: LogChunks) -> list[np.ndarray]:
+    """The currents ``robot`` predicts on every chunk, as its validation kept them
+    (:attr:`~kinergy.identify.chunks.LogChunks.currents`; validated now when it did not)."""
+    if logs.currents is None or logs.currents[0] is not robot:
+        validation_metrics(robot, logs)
+    assert logs.currents is not None
+    return [current for (current,) in logs.currents[1]]  # type: ignore[misc]
 
 
 def _electrics_fits(
-    robot: Robot, logs: ElectricsLogs, notes: list[str]
+    robot: Robot, logs: LogChunks, currents: list[np.ndarray], notes: list[str]
 ) -> list[ElectricsFit | None]:
-    """Each motor's R and k_b from the logs' voltages, currents and motor speeds (None where
-    they cannot separate the two, with a note)."""
+    """Each motor's R and k_b from the logs' voltages, currents and motor speeds, the currents
+    ``robot`` predicts as the instrument (UR5e eq 19, :class:`ElectricsSums`); None where they
+    cannot separate the two, with a note."""
+    n_mat = transmission_matrix(robot)
+    motors = [ElectricsSums() for _ in range(robot.n)]
+    for (_, chunk), predicted in zip(logs.chunks(), currents, strict=True):
+        assert chunk.current is not None and chunk.voltage is not None
+        voltage, wm = equivalent_voltage(chunk.voltage), chunk.qd @ n_mat.T
+        for m, motor in enumerate(motors):
+            motor.add(chunk.current[:, m], voltage[:, m], wm[:, m], instrument=predicted[:, m])
     fits: list[ElectricsFit | None] = []
-    for m, (joint, fit) in enumerate(zip(robot.joints, logs.electrics(robot), strict=True)):
-        if isinstance(fit, KinergyError):
-            notes.append(f"joint {m + 1} ({joint.name}): electrics kept from the model: {fit}")
+    for m, (joint, motor) in enumerate(zip(robot.joints, motors, strict=True)):
+        try:
+            fits.append(motor.fit())
+        except KinergyError as exc:
+            notes.append(f"joint {m + 1} ({joint.name}): electrics kept from the model: {exc}")
             fits.append(None)
-        else:
-            fits.append(fit)
     return fits
 
 
-def _supply_power(data: IdentData) -> np.ndarray:
-    """``actual_robot_voltage * actual_robot_current`` of a log that has both, W."""
-    assert data.supply_voltage is not None and data.supply_current is not None
-    return np.asarray(data.supply_voltage * data.supply_current, dtype=float)
+def _standby(robot: Robot, logs: LogChunks, currents: list[np.ndarray] | None) -> float:
+    """The mean of the supply power less the motors' draw (W; UR5e eq 23 on the ``currents``
+    ``robot`` predicts, else on its :func:`~kinergy.predict.drive_state`;
+    :func:`~kinergy.identify.electrics.fit_standby`'s ``standby``)."""
+    n_mat, kt = transmission_matrix(robot), torque_constants(robot)
+    held = data_history(robot)
+    total, count = 0.0, 0
+    for c, (k, chunk) in enumerate(logs.chunks()):
+        assert chunk.supply_voltage is not None and chunk.supply_current is not None
+        if currents is not None:
+            power = electrical_power(robot, currents[c] * kt, chunk.qd @ n_mat.T)
+        else:
+            data, skip = held.ahead(k, chunk)
+            state = drive_state(robot, data.q, data.qd, data.qdd, temperature=data.temperature)
+            held.update(data, skip)
+            power = state.power[skip:]
+        supply = np.asarray(chunk.supply_voltage * chunk.supply_current, dtype=float)
+        total += float(np.sum(supply - supply_power(power).motors))
+        count += len(chunk)
+    return total / count
 
 
-def measured_electrics(
-    result: IdentificationResult, datas: Sequence[IdentData] | ElectricsLogs
-) -> IdentificationResult:
+def measured_electrics(result: IdentificationResult, logs: LogChunks) -> IdentificationResult:
     """``result`` with the motor electrics fitted to the logs' joint voltages (UR5e eq 19,
-    :func:`kinergy.identify.electrics.fit_electrics`) and the standby power to their supply
-    power (:func:`kinergy.identify.electrics.fit_standby`), when every log has them; the fit's
-    warnings say what was written into the model. Unchanged for logs without them. ``datas``
-    are prepared logs or logs read in chunks (:class:`ElectricsLogs`)."""
-    logs = _InMemory(datas) if isinstance(datas, Sequence) else datas
+    :class:`kinergy.identify.electrics.ElectricsSums`) and the standby power to their supply
+    power, when every log has them, the currents its robot predicts (friction held per log) as
+    the instrument and the motors' draw; the fit's notes say what was written into the model.
+    Unchanged for logs without them."""
     robot, notes = result.robot, list[str]()
     sources = dict(robot.sources)
-    if logs.has_voltage:
-        fits = _electrics_fits(robot, logs, notes)
+    has_voltage = logs.every("voltage", "current")
+    has_supply = logs.every("supply_voltage", "supply_current")
+    if not (has_voltage or has_supply):
+        return result
+    currents = _predicted_currents(robot, logs) if has_voltage else None
+    if has_voltage:
+        assert currents is not None
+        fits = _electrics_fits(robot, logs, currents, notes)
         robot = with_electrics(robot, fits)
         ref = "kinergy identify: R and k_b from actual_joint_voltage (UR5e eq 19)"
         sources["motor_constant"] = Source("identified", ref)
@@ -309,8 +287,8 @@ def measured_electrics(
                     f"k_b = {motor.back_emf:.4g} V s/rad from the logged joint voltages (voltage "
                     f"RMS error {motor.rms:.3g} V), written into the model"
                 )
-    if logs.has_supply:
-        standby = max(logs.standby(robot), 0.0)
+    if has_supply:
+        standby = max(_standby(robot, logs, currents), 0.0)
         robot = dataclasses.replace(robot, standby_power=standby)
         sources["supply"] = Source(
             "identified", "kinergy identify: standby power from actual_robot_current"
@@ -319,8 +297,6 @@ def measured_electrics(
             f"standby power {standby:.3g} W from the logged supply power (actual_robot_voltage "
             "x actual_robot_current, less the motors' predicted draw), written into the model"
         )
-    if not notes:
-        return result
     robot = dataclasses.replace(robot, sources=sources)
     fit = dataclasses.replace(result.fit, notes=(*result.fit.notes, *notes))
     return dataclasses.replace(result, robot=robot, fit=fit)
@@ -331,12 +307,18 @@ def identify_payload_model(
     logs: Sequence[str | os.PathLike[str] | Log],
     out: str | os.PathLike[str],
     reading: LogReading | None = None,
+    *,
+    rows: int = CHUNK_ROWS,
 ) -> tuple[Payload, PayloadEstimate, InputLogs]:
     """Identify the payload of ``robot`` (the model without it) from ``logs`` taken with it
-    (read through the checks) and write the model with it."""
-    datas, inputs = prepared_logs(logs, robot, reading or LogReading())
-    check_signals(datas)
-    payload, report = identify_payload(robot, list(datas))
+    (read through the checks, in chunks of ``rows`` samples) and write the model with it."""
+    reading = reading or LogReading()
+    with chunked_logs(logs, robot, reading, rows=max(rows, 2)) as (segments, inputs):
+        chunks = LogChunks(segments, rows)
+        try:
+            found, report = payload(robot, chunks)
+        finally:
+            chunks.close()
     what = f"{robot.name} with the payload identified"
-    save_robot(robot.with_payload(payload), out, header=_header(what, [d.path for d in datas]))
-    return payload, report, inputs
+    save_robot(robot.with_payload(found), out, header=_header(what, list(chunks.paths)))
+    return found, report, inputs

@@ -35,6 +35,7 @@ from kinergy.friction.makkar import makkar
 from kinergy.identify.friction_points import FrictionPoints, friction_points
 from kinergy.identify.makkar_fit import MakkarFit, fit_makkar_lsq, fit_makkar_pso
 from kinergy.identify.nursing import MotorFrictionFit, NursingFit, identify_nursing
+from kinergy.identify.options import MakkarMethod
 from kinergy.logs.prepare import IdentData, prepare
 from kinergy.model.robot import Robot
 from kinergy.simulate import TwinSettings, simulate
@@ -250,7 +251,7 @@ def nursing_study(
     datas.append(_twin_log(robot, "twin:excitation-table6", motion, settings(robot.n)))
     t2 = time.perf_counter()
     say("identifying (nursing method: Makkar friction per motor, ridge on the minimal set)")
-    result = identify_nursing(robot, datas, fit="lsq", seed=seed)
+    result = identify_nursing(robot, datas, fit=MakkarMethod.LSQ, seed=seed)
     t3 = time.perf_counter()
     assert isinstance(result.fit, NursingFit)
     return NursingStudy(
