@@ -57,9 +57,10 @@ def _rule(where: str, tol: dict[str, Tolerance]) -> Tolerance:
     """The tolerance of the value at ``where``: its own key's, else the nearest enclosing key's
     (``physical_fit`` covers everything under it), else :data:`RTOL`."""
     names = [re.sub(r"(\[\d+\])+$", "", part) for part in where.split(".")]
-    for name in reversed(names):
-        if name in tol:
-            return tol[name]
+    for end in range(len(names), 0, -1):
+        for key, rule in tol.items():  # a dotted key (``a.b``) names a key under another
+            if key.split(".") == names[max(0, end - key.count(".") - 1) : end]:
+                return rule
     return RTOL
 
 
@@ -237,9 +238,21 @@ def test_identify_and_validate(
             ],
             capsys,
         ),
-        # a conic solver's optimum: its last digits (about 1e-4 of the flattest parameters)
-        # follow the arithmetic, e.g. the dynamics' sines and cosines (issue 16, one ulp)
-        tol={**NOISE_FREE, "physical_fit": 1e-3, "standard_parameters": 1e-3},
+        # the physically consistent fit (a conic problem) has flat directions on this log: the
+        # same objective (chi2_increase to 1e-6) is reached at parameters that differ by up to
+        # 10 % (Iyy1) in its completion and 2 % in one base parameter when the sums it is
+        # built from change in their last digits (the fold's summation order against the whole
+        # log's). The objective and every prediction (R², residuals) stay tight; the flat
+        # parameters are checked to 20 % (completion) and 5 % (base), the rotor inertias to 1e-3.
+        tol={
+            **NOISE_FREE,
+            "physical_fit": 1e-3,
+            "physical_fit.base_parameters": 0.05,
+            "chi2_increase": 1e-6,
+            "standard_parameters": 0.2,
+            "rotor_inertia": 1e-3,
+            "motor_inertia": 1e-3,
+        },
     )
 
 
