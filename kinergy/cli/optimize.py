@@ -16,6 +16,7 @@ from kinergy.cli.common import load, output_file_option, payload_option, progres
 from kinergy.errors import KinergyError
 from kinergy.jsonable import dumps
 from kinergy.optimize import ParetoPoint, ProgramResult, TimingResult
+from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
 from kinergy.optimize.programs import Lever, supply
 from kinergy.workflows.optimize import OptimizeRun, run_optimize
 from kinergy.workflows.optimize_program import ProgramRun, run_program_optimize
@@ -162,14 +163,14 @@ def _levers_table(levers: Sequence[Lever]) -> str:
             f"{supply(lv.result):.1f}",
             f"{lv.result.e_elec:.1f}",
             "yes" if lv.result.ok else "NO",
-            "yes" if lv.kept else "no",
+            "" if lv.name in ("program", "timing only") else f"{lv.saved:+.1f}",
+            lv.status.value + (f" ({lv.repaired})" if lv.repaired else ""),
             lv.note,
         ]
         for lv in levers
     ]
-    return table(
-        ["lever", "cycle [s]", "supply [J]", "motors [J]", "limits ok", "used", "note"], rows
-    )
+    headers = ["lever", "cycle [s]", "supply [J]", "motors [J]", "limits ok", "saved [J]"]
+    return table([*headers, "used", "note"], rows)
 
 
 def program_text(run: ProgramRun) -> str:
@@ -247,7 +248,7 @@ def program_text(run: ProgramRun) -> str:
 )
 @click.option(
     "--configurations",
-    type=click.Choice(["keep", "free"]),
+    type=click.Choice([c.value for c in Configurations]),
     default="keep",
     show_default=True,
     help="URScript programs: the IK branch of a movej's pose target (free: any of the eight).",
@@ -255,10 +256,19 @@ def program_text(run: ProgramRun) -> str:
 @click.option(
     "--tool-symmetry",
     "tool_symmetry",
-    type=click.Choice(["none", "z", "z2", "z4"]),
+    type=click.Choice([s.value for s in ToolSymmetry]),
     default="none",
     show_default=True,
     help="URScript programs: the tool may turn about its z axis (any angle, 180 or 90 deg).",
+)
+@click.option(
+    "--via",
+    type=click.Choice([v.value for v in ViaPoints]),
+    default="keep",
+    show_default=True,
+    help="URScript programs: joint-space via points (a movej's target followed by a movej, "
+    "nothing at rest between; e.g. a home pose passed every cycle) stay on the route, or "
+    "free: the route may leave them out.",
 )
 @click.option("--no-blends", is_flag=True, help="URScript programs: no blend radii on via points.")
 @click.option(
@@ -290,6 +300,7 @@ def optimize(
     fixed_shares: bool,
     configurations: str,
     tool_symmetry: str,
+    via: str,
     no_blends: bool,
     standby: float | None,
     motions: str | None,
@@ -307,20 +318,24 @@ def optimize(
     _cap("--v-max", v_max)
     _cap("--a-max", a_max)
     if task_name.endswith(".script"):
+        options = ProgramOptions(
+            configurations=Configurations(configurations),
+            tool_symmetry=ToolSymmetry(tool_symmetry),
+            via=ViaPoints(via),
+            blends=not no_blends,
+            standby=standby,
+            cycle_time=budget,
+            v_max=v_max,
+            a_max=a_max,
+        )
         with progress() as say:
             program = run_program_optimize(
                 load(model, payload),
                 task_name,
                 urscript=urscript,
                 motions=motions,
+                options=options,
                 progress=say,
-                configurations=configurations,
-                tool_symmetry=tool_symmetry,
-                blends=not no_blends,
-                standby=standby,
-                cycle_time=budget,
-                v_max=v_max,
-                a_max=a_max,
             )
         click.echo(dumps(program.to_dict()) if as_json else program_text(program))
         if not as_json:

@@ -14,13 +14,13 @@ times fixed. :func:`path_problem` states it as a
 - the cycle time: the moves' durations (less the blends' overlaps) plus the events' fixed times.
 
 :func:`retime` solves it at a budget and verifies the optimum at 500 Hz
-(:func:`kinergy.optimize.timing.best_verified`: caps tightened by any excess found there).
+(:func:`kinergy.optimize.timing.best_verified`: caps tightened by any excess found there); it
+stops on iterations and tolerances, never on a clock.
 :func:`scaled_to` is uniform time scaling of the moves to a budget (the events keep their time).
 """
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,11 +33,15 @@ from kinergy.optimize.objectives import Objective
 from kinergy.optimize.problem import Evaluator, TimingProblem, fastest_acceleration, uniform_scaling
 from kinergy.optimize.program_samples import path_schedule, sample_path_programs
 from kinergy.optimize.program_verify import PathRun, simulate_path
-from kinergy.optimize.timing import best_verified
+from kinergy.optimize.timing import Verified, best_verified
 from kinergy.optimize.verify import ProgramResult
 from kinergy.trajectory.program_path import ProgramPath, line_joints
 
 __all__ = ["PathChecks", "path_caps", "path_problem", "retime", "scaled_to"]
+
+
+#: SLSQP iterations per attempt of the program's timing solver
+_MAXITER = 15
 
 
 def path_caps(
@@ -173,13 +177,11 @@ def retime(
     budget: float,
     *,
     share_budget: bool = True,
-    maxiter: int = 15,
-    seconds: float = 20.0,
-) -> tuple[ProgramResult, str, int]:
-    """The verified energy-optimal timing at ``budget`` s (from the program uniformly scaled to
-    it; at most ``maxiter`` SLSQP iterations per attempt, and the solver stops where it is after
-    about ``seconds`` s of processor time: a long program's timing is then improved, not optimal): the result, the
-    solver's message and its iterations.
+    maxiter: int = _MAXITER,
+) -> tuple[ProgramResult, Verified]:
+    """The verified energy-optimal timing at ``budget`` s, from the program uniformly scaled to
+    it: at most ``maxiter`` SLSQP iterations per attempt (the solver stops on iterations and
+    tolerances, never on a clock: the same answer on every host), and how it came about.
 
     Raises
     ------
@@ -198,5 +200,4 @@ def retime(
         )
     v0, a0 = scaled_to(problem, path, path.speed, path.accel, budget)
     uniform = checks.run(v0, a0, "uniform")
-    deadline = time.process_time() + seconds
-    return best_verified(checks, budget, v0, a0, uniform, share_budget, maxiter, deadline)
+    return best_verified(checks, budget, v0, a0, uniform, share_budget, maxiter)
