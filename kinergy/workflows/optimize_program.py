@@ -77,7 +77,13 @@ def optimized_script(result: ProgramOptimization) -> str:
         f"levers used: {', '.join(kept) or 'none'}; tool symmetry {options.tool_symmetry.value}, "
         f"configurations {options.configurations.value}, via points {options.via.value}",
     ]
-    return program_script(result.written, header)
+    left = [c.line for c in result.targets if c.left_out]
+    if left:
+        header.append(
+            "via points left out of the route (they take the joints of the target before "
+            f"them): line{'s' if len(left) > 1 else ''} {', '.join(map(str, left))}"
+        )
+    return program_script(result.written, header, original=result.program.path.program)
 
 
 def _motion_signals(motion: Motion) -> dict[str, Any]:
