@@ -171,6 +171,8 @@ class LeverSearch:
         self.robot, self.budget, self.objective, self.caps = robot, budget, objective, caps
         self.best = best
         self.levers: list[Lever] = [Lever("program", best.result, LeverStatus.AS_WRITTEN)]
+        #: which moves' targets the best program leaves out (via points), shape (K,)
+        self.left_out = np.zeros(best.path.moves, dtype=bool)
 
     def run(self, program: RobotProgram, label: str) -> tuple[PathRun, str]:
         """``program`` at the cycle time, repaired if it breaks a limit, and how it was
@@ -194,13 +196,16 @@ class LeverSearch:
         program: RobotProgram,
         note: str,
         fallback: tuple[RobotProgram, str] | None = None,
+        left_out: tuple[NDArray[np.bool_], NDArray[np.bool_]] | None = None,
     ) -> bool:
         """Run ``program`` (then, if it is not kept, ``fallback`` with its note) at the cycle
         time, repaired as needed, and keep it if it beats the best so far; record one lever (the
-        kept run, or the last one tried). Returns whether it was kept."""
+        kept run, or the last one tried). ``left_out``: the via points each of the two leaves
+        out. Returns whether it was kept."""
         before = self.best.result
         lever = Lever(name, before, LeverStatus.NO_CHANGE, note="no target changes")
-        for candidate, text in [(program, note), *([fallback] if fallback is not None else [])]:
+        tries = [(program, note), *([fallback] if fallback is not None else [])]
+        for i, (candidate, text) in enumerate(tries):
             if _same_moves(candidate, self.best.path.program):
                 continue
             try:
@@ -219,6 +224,8 @@ class LeverSearch:
             lever = Lever(name, run.result, status, saved, text, how)
             if status is LeverStatus.KEPT:
                 self.best = run
+                if left_out is not None:
+                    self.left_out = left_out[i].copy()
                 break
         self.levers.append(lever)
         return lever.kept
@@ -239,14 +246,16 @@ class PathLevers:
 
 def _chosen_program(
     path: ProgramPath, states: list[TargetStates], choice: NDArray[np.intp]
-) -> tuple[RobotProgram, str]:
-    """The program with the chosen states as their targets, and how many changed."""
+) -> tuple[RobotProgram, str, NDArray[np.bool_]]:
+    """The program with the chosen states as their targets, how many changed, and which via
+    points it leaves out."""
     changed = sum(int(c != s.own) for c, s in zip(choice, states, strict=True))
-    left = sum(int(s.moved[c]) for c, s in zip(choice, states, strict=True))
+    left_out = np.array([bool(s.moved[c]) for c, s in zip(choice, states, strict=True)])
     note = f"{changed} target states changed"
-    if left:
-        note += f", {left} via point{'s' if left > 1 else ''} left out"
-    return path.program.with_moves(chosen_moves(path, states, choice)), note
+    if np.any(left_out):
+        count = int(left_out.sum())
+        note += f", {count} via point{'s' if count > 1 else ''} left out"
+    return path.program.with_moves(chosen_moves(path, states, choice)), note, left_out
 
 
 def _finer(
@@ -305,14 +314,14 @@ def path_levers(
         found = (states, choice, estimate)
         if turning and levers.symmetry.any_angle:
             found = _finer(search, path, found, levers, via)
-        program, note = _chosen_program(path, found[0], found[1])
-        fallback = None
+        program, note, left = _chosen_program(path, found[0], found[1])
+        fallback, left_coarse = None, left
         if found[0] is not states:  # the finer turns, then the 45 degree ones
             note += " (turns to 5 degrees)"
-            coarse, text = _chosen_program(path, states, choice)
+            coarse, text, left_coarse = _chosen_program(path, states, choice)
             fallback = (coarse, f"{text} (45 degree turns: the finer ones were not better)")
         say(f"{name}: estimated {found[2]:.1f} J, re-simulating")
-        search.judge(name, program, note, fallback)
+        search.judge(name, program, note, fallback, (left, left_coarse))
 
 
 def via_blends(robot: Robot, path: ProgramPath) -> list[Move]:

@@ -35,6 +35,7 @@ from kinergy.optimize.program_samples import path_schedule, sample_path_programs
 from kinergy.optimize.program_verify import PathRun, simulate_path
 from kinergy.optimize.timing import Verified, best_verified
 from kinergy.optimize.verify import ProgramResult
+from kinergy.trajectory.program_motion import line_tables
 from kinergy.trajectory.program_path import ProgramPath, line_joints
 
 __all__ = ["PathChecks", "path_caps", "path_problem", "retime", "scaled_to"]
@@ -101,9 +102,12 @@ def path_problem(
         A move whose torques exceed the limits at any acceleration (naming its line).
     """
     v_cap, a_cap, v_why, a_why = path_caps(robot, path, v_max, a_max)
+    tables = line_tables(robot, path)
 
     def evaluate(t: Array, f: Array) -> tuple[Array, Array]:
-        samples = sample_path_programs(robot, path, np.atleast_2d(t), np.atleast_2d(f))
+        samples = sample_path_programs(
+            robot, path, np.atleast_2d(t), np.atleast_2d(f), tables=tables
+        )
         value, _ = objective(samples)
         return value, torque_ratio(robot, samples)
 

@@ -41,7 +41,6 @@ from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 from kinergy.optimize.objectives import PROGRAM_OBJECTIVE, Objective
 from kinergy.optimize.options import ProgramOptions, ViaPoints
-from kinergy.optimize.path_costs import via_points
 from kinergy.optimize.program import serial
 from kinergy.optimize.program_levers import (
     Lever,
@@ -201,17 +200,6 @@ def _timing_only(
     return Lever("timing only", run.result, LeverStatus.COMPARISON, note=note)
 
 
-def _left_out(program: ProgramPath, optimized: ProgramPath) -> np.ndarray:
-    """Which via points the optimised route leaves out: joint-space via points whose target
-    moved, shape (K,)."""
-    vias = via_points(program)
-    moved = np.any(np.abs(optimized.q_end - program.q_end) > 1e-9, axis=1)
-    same_as_before = np.all(
-        np.abs(optimized.q_end - np.roll(optimized.q_end, 1, axis=0)) < 1e-9, axis=1
-    )
-    return np.asarray(vias & moved & same_as_before)
-
-
 @serial
 def optimize_program(
     robot: Robot,
@@ -280,7 +268,7 @@ def optimize_program(
         path,
         optimized,
         symmetry=options.tool_symmetry,
-        left_out=_left_out(path, optimized.path),
+        left_out=search.left_out,
     )
     settings = ProgramSettings(options, standby, caps, budget)
     return ProgramOptimization(own, optimized, found, targets, settings)
