@@ -225,3 +225,70 @@ def test_a_variable_all_of_whose_moves_change_alike_is_reassigned() -> None:
     out = program_script(program.with_moves(moves), original=program)
     assert "  home = [0.2, -1.7, 1.5, -1.4, -1.5708, 0.1]  # the safe pose" in out
     assert out.count("movej(home, a=1.4, v=1.05)") == 2 and "home_2" not in out
+
+
+def test_the_budget_shared_per_move_is_the_brute_force_optimum() -> None:
+    """The allocation's dynamic programme over the time used equals a brute-force search of
+    every combination of grid durations: the most of the budget used (the whole of it, to its
+    step, where a combination fits it), at the least energy."""
+    import itertools
+
+    from kinergy.optimize import program_timing
+
+    rng = np.random.default_rng(7)
+    total = 3.2
+    unit = total / program_timing._UNITS
+    whole = rng.integers(100, 700, (5, 4)) * unit  # sums that hit the budget exactly exist
+    for durations in (rng.uniform(0.2, 1.5, (5, 4)), whole):  # 5 grid durations of 4 moves
+        energy = rng.uniform(1.0, 9.0, (5, 4))
+        energy[2, 1] = np.inf  # not feasible
+        steps = np.ceil(durations / unit - 1e-9).astype(int)
+        found: dict[int, float] = {}
+        for combo in itertools.product(range(5), repeat=4):
+            used = sum(steps[d, j] for j, d in enumerate(combo))
+            value = sum(energy[d, j] for j, d in enumerate(combo))
+            if used <= program_timing._UNITS and np.isfinite(value):
+                found[used] = min(found.get(used, np.inf), value)
+        best = found[max(found)]  # the most of the budget used, at the least energy
+        chosen = program_timing._share(energy, durations, total)
+        assert chosen is not None
+        assert sum(energy[d, j] for j, d in enumerate(chosen)) == pytest.approx(best)
+
+
+def test_straight_lines_from_tables_match_the_inverse_kinematics() -> None:
+    """A lone tool line's joints from its quintic table against the exact inverse kinematics
+    and Jacobians at 5000 random times of the palletising program."""
+    from kinergy.io.urscript_reader import read_program
+    from kinergy.trajectory.program_motion import line_tables, sample_path, schedule
+
+    robot = load_robot("ur10e")
+    path = program_path(robot, read_program(ROOT / "benchmarks/programs/ur10e_palletising.script"))
+    sched = schedule(path, path.speed, path.accel)
+    t = np.random.default_rng(3).uniform(0.0, float(sched.total[0]), (1, 5000))
+    tables = line_tables(robot, path)
+    assert len(tables) == sum(seg is not None for seg in path.tool)
+    exact = sample_path(robot, path, sched, t)
+    tabled = sample_path(robot, path, sched, t, tables=tables)
+    for a, b, tol in zip(exact, tabled, (1e-12, 1e-9, 1e-6), strict=True):
+        np.testing.assert_allclose(b, a, atol=tol)
+
+
+def test_the_timing_solver_starts_from_the_better_start_and_keeps_the_cycle_time() -> None:
+    from kinergy.optimize.program_repair import timing_checks
+    from kinergy.optimize.program_timing import allocated, retime
+
+    robot = load_robot("ur5e")
+    path = program_path(robot, parse_program(SMALL, path="small.script"))
+    own = simulate_path(robot, path)
+    caps = Caps(float(np.max(np.abs(own.motion.qd))), float(np.max(np.abs(own.motion.qdd))))
+    checks = timing_checks(robot, path, SupplyEnergy(), caps)
+    budget = own.result.cycle_time
+    shared = allocated(checks, budget)
+    assert shared is not None
+    start = checks.run(*shared, "allocated")
+    assert start.cycle_time == pytest.approx(budget, abs=1e-6) and start.ok
+    result, verified = retime(checks, budget)
+    assert result.ok and result.cycle_time == pytest.approx(budget, abs=2e-3)
+    assert result.score is not None and own.result.score is not None
+    assert result.score <= min(start.score, own.result.score) + 1e-9  # type: ignore[type-var]
+    assert verified.outcome is not None and "Iteration limit" not in verified.words

@@ -30,7 +30,7 @@ from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import LIMIT_TOL
 from kinergy.optimize.objectives import Objective
 from kinergy.optimize.problem import uniform_scaling
-from kinergy.optimize.program_timing import PathChecks, path_problem, retime
+from kinergy.optimize.program_timing import PathChecks, path_checks, retime
 from kinergy.optimize.program_verify import PathRun, simulate_path
 from kinergy.trajectory.program_motion import schedule
 from kinergy.trajectory.program_path import ProgramPath
@@ -91,8 +91,7 @@ def timing_checks(robot: Robot, path: ProgramPath, objective: Objective, caps: C
     """The timing problem of ``path`` with the caps ``_SLACK`` below ``caps`` (speed, and its
     square for acceleration: what a uniform rescaling by ``1 + _SLACK`` needs)."""
     v_max, a_max = caps.speed * (1.0 - _SLACK), caps.acceleration * (1.0 - _SLACK) ** 2
-    problem = path_problem(robot, path, objective=objective, v_max=v_max, a_max=a_max)
-    return PathChecks(robot, path, problem, v_max, a_max)
+    return path_checks(robot, path, objective, v_max, a_max)
 
 
 def _excess(run: PathRun) -> tuple[Array, Array]:

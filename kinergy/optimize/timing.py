@@ -343,24 +343,28 @@ def _active(problem: TimingProblem, result: ProgramResult) -> list[str]:
 @dataclass(frozen=True)
 class Verified:
     """How a verified timing came about: why the solver stopped (None at the fastest cycle
-    time, where nothing is left to choose), whether uniform scaling was kept because the solver
-    ended above it, and the solver's iterations (all attempts)."""
+    time, where nothing is left to choose), whether its start (uniform scaling, or another
+    named one) was kept because the solver ended above it, and the solver's iterations (all
+    attempts)."""
 
     outcome: Outcome | None
-    uniform_kept: bool
+    start_kept: bool
     iterations: int
+    start: str = "uniform scaling"
 
     @property
     def words(self) -> str:
         """``optimal``, ``improved, iteration limit``, ... (:attr:`Outcome.words`), and what
-        was kept instead when the solver ended above uniform scaling."""
+        was kept instead when the solver ended above its start."""
         text = (
             "fastest cycle time: every move at its limits"
             if self.outcome is None
             else self.outcome.words
         )
-        if self.uniform_kept:
-            text += "; the solver ended above uniform scaling, which is kept"
+        if self.start_kept:
+            text += f"; the solver ended above {self.start}, which is kept"
+        elif self.start != "uniform scaling":
+            text += f" (from {self.start})"
         return text
 
 
@@ -369,23 +373,24 @@ def best_verified(
     cycle_time: float,
     v0: Array,
     a0: Array,
-    uniform: ProgramResult,
+    start: ProgramResult,
     share_budget: bool,
     maxiter: int = 150,
+    label: str = "uniform scaling",
 ) -> tuple[ProgramResult, Verified]:
     """The verified optimum at ``cycle_time`` from ``(v0, a0)``: solved, re-simulated at 500 Hz
     and re-solved with the caps tightened by any excess found there (up to four attempts of at
-    most ``maxiter`` SLSQP iterations each), or ``uniform`` should the solver end above it; and
-    how it came about. The solver stops on iterations and tolerances only: the same answer on
-    every host."""
+    most ``maxiter`` SLSQP iterations each), or ``start`` (``label``: uniform scaling, by
+    default) should the solver end above it; and how it came about. The solver stops on
+    iterations and tolerances only: the same answer on every host."""
     optimized, sol, iterations = _optimum(
         checks, cycle_time, v0, a0, share_budget=share_budget, maxiter=maxiter
     )
     # uniform scaling to the budget is the program itself at the program's own cycle time
-    kept = uniform_wins(uniform, optimized)
+    kept = uniform_wins(start, optimized)
     if kept:
-        optimized = checks.run(uniform.speeds, uniform.accels, "optimized")
-    return optimized, Verified(None if sol is None else sol.outcome, kept, iterations)
+        optimized = checks.run(start.speeds, start.accels, "optimized")
+    return optimized, Verified(None if sol is None else sol.outcome, kept, iterations, label)
 
 
 def _budget(cycle_time: float | None, program: ProgramResult, fastest: float) -> float:
