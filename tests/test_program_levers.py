@@ -292,3 +292,21 @@ def test_the_timing_solver_starts_from_the_better_start_and_keeps_the_cycle_time
     assert result.score is not None and own.result.score is not None
     assert result.score <= min(start.score, own.result.score) + 1e-9  # type: ignore[type-var]
     assert verified.outcome is not None and "Iteration limit" not in verified.words
+
+
+def test_another_cycle_time_is_kept_by_every_lever() -> None:
+    """With a cycle time 25 % longer than the program's own, the search starts from the program
+    uniformly slowed to it, and the optimum runs at it (never at the program's own)."""
+    robot = load_robot("ur5e")
+    program = parse_program(SMALL, path="small.script")
+    own = simulate_path(robot, program_path(robot, program)).result.cycle_time
+    result = optimize_program(
+        robot, program, ProgramOptions(tool_symmetry=ToolSymmetry.Z, cycle_time=1.25 * own)
+    )
+    names = [lv.name for lv in result.levers]
+    assert names[:2] == ["program", "uniform scaling"]
+    assert result.levers[0].result.cycle_time == pytest.approx(own)
+    for lever in result.levers[1:]:
+        assert lever.result.cycle_time == pytest.approx(1.25 * own, abs=2e-3), lever.name
+    assert result.optimized.result.cycle_time == pytest.approx(1.25 * own, abs=2e-3)
+    assert result.optimized.result.ok and result.targets_met

@@ -202,6 +202,12 @@ def program_text(run: ProgramRun) -> str:
         + ("all met" if result.targets_met else "NOT all met (1 mm, 0.5 deg, at rest)"),
         f"Within limits: {'yes' if opt.ok else 'NO: ' + '; '.join(opt.check.violations())}",
     ]
+    left = [str(c.line) for c in result.targets if c.left_out]
+    if left:
+        lines.append(
+            f"Via points left out of the route (free via points): line{'s' if len(left) > 1 else ''} "
+            f"{', '.join(left)} now take the joints of the target before them"
+        )
     lines += [f"note: {n}" for n in run.notes]
     return "\n".join(lines)
 

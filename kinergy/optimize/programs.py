@@ -246,6 +246,9 @@ def optimize_program(
     search = LeverSearch(robot, budget, objective, caps, own)
     if options.cycle_time is not None:
         _check_cycle_time(robot, path, objective, caps, budget)
+        if abs(budget - own.result.cycle_time) > 1e-9:
+            say("uniform scaling to the cycle time")
+            search.rescale()
     levers = PathLevers(
         free=options.configurations.value == "free",
         symmetry=options.tool_symmetry,
