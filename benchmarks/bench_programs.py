@@ -107,7 +107,7 @@ def run(name: str, via: str) -> dict[str, Any]:
         progress=lambda m: print(f"  {time.perf_counter() - t0:6.1f} s {m}", file=sys.stderr),
     )
     seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
-    text = program_script(result.written, original=program)
+    text = program_script(result.written)
     back = parse_program(text, path=f"{name}_optimized.script")
     again = simulate_path(robot, program_path(robot, back), objective=None)
     own = result.program.result.score

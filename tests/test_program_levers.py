@@ -35,7 +35,7 @@ def _small(**changes: object) -> str:
     options = ProgramOptions(tool_symmetry=ToolSymmetry.Z, **changes)  # type: ignore[arg-type]
     result = optimize_program(robot, program, options)
     energies = [lv.result.score for lv in result.levers]
-    return program_script(result.written, original=program) + repr(energies)
+    return program_script(result.written) + repr(energies)
 
 
 def test_the_same_program_on_a_host_a_thousand_times_slower(
@@ -158,7 +158,7 @@ def test_via_points_left_out_keep_every_job_target() -> None:
     assert "via points" in names
     via = free.levers[names.index("via points")]
     assert via.kept and via.saved > 0.0 and "2 via points left out" in via.note
-    text = program_script(free.written, original=program)
+    text = program_script(free.written)
     assert "  movej(home, a=" in text and "home = [0.0, -1.75" not in text
     back = parse_program(text)
     again = simulate_path(robot, program_path(robot, back))
@@ -193,7 +193,7 @@ def test_written_program_keeps_names_values_and_comments() -> None:
         moves[3],
         moves[4].replaced(target=np.array([0.1, -1.75, 1.6, -1.4208, -1.5708, 0.0])),
     ]
-    text = program_script(program.with_moves(changed), ["hello"], original=program)
+    text = program_script(program.with_moves(changed), ["hello"])
     lines = text.splitlines()
     assert lines[1] == "  # hello"
     # home is read elsewhere (spare = home): it keeps its value; the changed move gets home_2
@@ -222,7 +222,7 @@ def test_a_variable_all_of_whose_moves_change_alike_is_reassigned() -> None:
     new = np.array([0.2, -1.7, 1.5, -1.4, -1.5708, 0.1])
     moves = [m.replaced(target=new) if m.line in (6, 11) else m for m in program.moves]
     assert sum(m.line in (6, 11) for m in program.moves) == 2
-    out = program_script(program.with_moves(moves), original=program)
+    out = program_script(program.with_moves(moves))
     assert "  home = [0.2, -1.7, 1.5, -1.4, -1.5708, 0.1]  # the safe pose" in out
     assert out.count("movej(home, a=1.4, v=1.05)") == 2 and "home_2" not in out
 

@@ -26,7 +26,13 @@ from numpy.typing import ArrayLike
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
-from kinergy.io.urscript_reader import assigned_name, identifiers, split_comment, target_name
+from kinergy.io.urscript_reader import (
+    assigned_name,
+    identifiers,
+    parse_program,
+    split_comment,
+    target_name,
+)
 from kinergy.trajectory.motion import CONTROLLER_DT
 from kinergy.trajectory.movej import check_waypoints, per_move
 from kinergy.trajectory.robot_program import Move, RobotProgram
@@ -263,21 +269,21 @@ def _assignment(raw: str, name: str, value: str) -> str:
 
 
 def _named_targets(
-    program: RobotProgram, original: RobotProgram | None
+    program: RobotProgram,
 ) -> tuple[dict[int, str], dict[int, str], dict[int, list[str]]]:
     """How the moves' variables are written: per move the target's text (a name), the
     assignment lines rewritten (0-based index -> line) and lines added after an assignment (new
-    names for a value the variable cannot hold as well)."""
+    names for a value the variable cannot hold as well). A move goes where its lines say
+    unless its target differs from what they say (the lines read again)."""
     lines = program.lines
     moves = program.moves
+    as_read = parse_program("\n".join(lines), path=program.path, name=program.name).moves
     taken = set().union(*(identifiers(split_comment(raw)[0]) for raw in lines))
     targets: dict[int, str] = {}
     rewritten: dict[int, str] = {}
     added: dict[int, list[str]] = {}
     for var in _variables(program).values():
-        changed = [
-            original is None or not _same_target(moves[k], original.moves[k]) for k in var.moves
-        ]
+        changed = [not _same_target(moves[k], as_read[k]) for k in var.moves]
         if not any(changed):
             targets.update({k: var.name for k in var.moves})
             continue
@@ -305,9 +311,7 @@ def _named_targets(
     return targets, rewritten, added
 
 
-def program_script(
-    program: RobotProgram, header: Sequence[str] = (), *, original: RobotProgram | None = None
-) -> str:
+def program_script(program: RobotProgram, header: Sequence[str] = ()) -> str:
     """A program read from a file written back with its (changed) moves.
 
     Every move's line is replaced by :func:`move_statement` (its indentation and comment kept).
@@ -315,8 +319,8 @@ def program_script(
     value on its own line (its comment kept) and the move names it; where the moves sharing a
     variable now go to different places, or the variable is read elsewhere, the new values get
     new names (``home_2 = ...``) on lines after it. Every other line (events, I/O, comments)
-    stays as it was; with ``original`` (the program as read), a variable whose moves still go
-    where they went keeps its line as written. ``header`` lines go in as comments after the
+    stays as it was, and so does a variable whose moves all still go where its line says (the
+    lines are read again to tell). ``header`` lines go in as comments after the
     ``def`` line (or at the top). A program built in code (no ``lines``) is written as
     ``def name():`` with one move per line and its events' statements.
 
@@ -328,7 +332,7 @@ def program_script(
     if not program.lines:
         body = [move_statement(s) if isinstance(s, Move) else s.text for s in program.steps]
         return _program(program.name, header, body)
-    targets, rewritten, added = _named_targets(program, original)
+    targets, rewritten, added = _named_targets(program)
     lines = list(program.lines)
     for index, line in rewritten.items():
         lines[index] = line

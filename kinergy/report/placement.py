@@ -106,7 +106,7 @@ def placement_map(search: PlacementSearch, *, title: str = "") -> Figure:
     norm = Normalize(vmin=low, vmax=max(high, low + 1e-9))
     ncols = min(3, len(groups))
     nrows = math.ceil(len(groups) / ncols)
-    fig = Figure(figsize=(4.6 * ncols + 1.4, 4.2 * nrows + 1.0), layout="constrained")
+    fig = Figure(figsize=(max(4.6 * ncols + 1.4, 7.0), 4.2 * nrows + 1.4), layout="constrained")
     FigureCanvasAgg(fig)
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
     mesh = None
@@ -124,8 +124,12 @@ def placement_map(search: PlacementSearch, *, title: str = "") -> Figure:
     if axes[0].get_legend_handles_labels()[0]:
         axes[0].legend(loc="upper right", fontsize=8, framealpha=0.9)
     today, best = search.today.e_supply, search.best.e_supply
-    line = "Base placements: grey = not reachable (R reach, C cycle time, L limit, T target)"
+    lines = [f"{title}: supply energy per cycle over base placements" if title else
+             "Supply energy per cycle over base placements"]  # fmt: skip
     if today is not None and best is not None:
-        line += f"; best {best:.1f} J per cycle, today's {today:.1f} J ({100 * (1 - best / today):.1f} % less)"
-    fig.suptitle(f"{title}\n{line}" if title else line, fontsize=11)
+        lines.append(
+            f"best {best:.1f} J, today's {today:.1f} J ({100 * (1 - best / today):.1f} % less)"
+        )
+    lines.append("grey: not reachable (R reach, C cycle time, L limit, T target)")
+    fig.suptitle("\n".join(lines), fontsize=10)
     return fig

@@ -83,7 +83,7 @@ def optimized_script(result: ProgramOptimization) -> str:
             "via points left out of the route (they take the joints of the target before "
             f"them): line{'s' if len(left) > 1 else ''} {', '.join(map(str, left))}"
         )
-    return program_script(result.written, header, original=result.program.path.program)
+    return program_script(result.written, header)
 
 
 def _motion_signals(motion: Motion) -> dict[str, Any]:
