@@ -163,3 +163,22 @@ def test_bad_input_is_one_line_and_writes_nothing(
     out = run_case(args, tmp_path, refuse=True)
     assert match in out.err, out.err
     assert not (tmp_path / "m.png").exists()
+
+
+def test_a_moved_program_is_written_with_its_new_values_under_its_names() -> None:
+    """The moved program written back (no lever changed anything) reads back to the moved
+    targets: every named waypoint's line carries the moved value, the moves still name it."""
+    from kinergy.io.urscript import program_script
+
+    robot = load_robot("ur5e")
+    program = read_program(PROGRAMS / "ur5e_machine_tending.script")
+    moved = moved_program(robot, program, BasePlacement(0.0, 0.2))
+    text = program_script(moved)
+    assert "movej(place1_above, a=1.2, v=1)" in text
+    assert "place1_above = [-0.60000" not in text  # today's value is gone
+    back = parse_program(text, path="moved.script")
+    for a, b in zip(back.moves, moved.moves, strict=True):
+        np.testing.assert_allclose(a.target, b.target, atol=1e-8)
+    np.testing.assert_allclose(
+        program_path(robot, back).q_end, program_path(robot, moved).q_end, atol=1e-8
+    )

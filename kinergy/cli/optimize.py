@@ -215,13 +215,17 @@ def program_text(run: ProgramRun) -> str:
 def lever_options(prefix: str = "") -> Callable[[F], F]:
     """The levers of a URScript program's optimisation as options (``prefix`` starts each help
     text): --configurations, --tool-symmetry, --via, --no-blends, --standby."""
+
+    def said(text: str) -> str:
+        return prefix + text if prefix else text[0].upper() + text[1:]
+
     options = [
         click.option(
             "--configurations",
             type=click.Choice([c.value for c in Configurations]),
             default="keep",
             show_default=True,
-            help=f"{prefix}the IK branch of a movej's pose target (free: any of the eight).",
+            help=said("the IK branch of a movej's pose target (free: any of the eight)."),
         ),
         click.option(
             "--tool-symmetry",
@@ -229,24 +233,25 @@ def lever_options(prefix: str = "") -> Callable[[F], F]:
             type=click.Choice([s.value for s in ToolSymmetry]),
             default="none",
             show_default=True,
-            help=f"{prefix}the tool may turn about its z axis (any angle, 180 or 90 deg).",
+            help=said("the tool may turn about its z axis (any angle, 180 or 90 deg)."),
         ),
         click.option(
             "--via",
             type=click.Choice([v.value for v in ViaPoints]),
             default="keep",
             show_default=True,
-            help=f"{prefix}joint-space via points (a movej's target followed by a movej, nothing "
-            "at rest between; e.g. a home pose passed every cycle) stay on the route, or free: "
-            "the route may leave them out.",
+            help=said(
+                "joint-space via points (a movej's target followed by a movej, nothing "
+                "at rest between; e.g. a home pose passed every cycle) stay on the route, or free: "
+                "the route may leave them out."
+            ),
         ),
-        click.option("--no-blends", is_flag=True, help=f"{prefix}no blend radii on via points."),
+        click.option("--no-blends", is_flag=True, help=said("no blend radii on via points.")),
         click.option(
             "--standby",
             type=click.FloatRange(min=0.0),
             default=None,
-            help=f"{prefix}standby power (W) counted over the cycle time [default: the robot "
-            "file's].",
+            help=said("standby power (W) counted over the cycle time [default: the robot file's]."),
         ),
     ]
 

@@ -121,8 +121,10 @@ def placement_map(search: PlacementSearch, *, title: str = "") -> Figure:
     if mesh is not None:
         bar = fig.colorbar(mesh, ax=list(axes[: len(groups)]), shrink=0.9)  # type: ignore[arg-type]
         bar.set_label("supply energy per cycle, optimised [J]", fontsize=10)
-    if axes[0].get_legend_handles_labels()[0]:
-        axes[0].legend(loc="upper right", fontsize=8, framealpha=0.9)
+    if axes[0].get_legend_handles_labels()[0]:  # below the axes: no cell is hidden
+        axes[0].legend(
+            loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize=8, frameon=False
+        )
     today, best = search.today.e_supply, search.best.e_supply
     lines = [f"{title}: supply energy per cycle over base placements" if title else
              "Supply energy per cycle over base placements"]  # fmt: skip
