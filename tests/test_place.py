@@ -182,3 +182,20 @@ def test_a_moved_program_is_written_with_its_new_values_under_its_names() -> Non
     np.testing.assert_allclose(
         program_path(robot, back).q_end, program_path(robot, moved).q_end, atol=1e-8
     )
+
+
+def test_only_todays_and_the_best_optimisation_are_kept() -> None:
+    """Each optimisation holds its 500 Hz motions: a search keeps today's and the best one's,
+    and only the figures of the others (400 candidates would otherwise hold gigabytes)."""
+    from kinergy.optimize.options import ProgramOptions
+    from kinergy.optimize.placement import place_program
+
+    robot = load_robot("ur5e")
+    grid = PlacementGrid(Range(-0.1, 0.1), Range(0.0, 0.0), step=0.1)
+    search = place_program(robot, parse_program(SMALL, path="small.script"), grid, ProgramOptions())
+    kept = [c for c in search.candidates if c.result is not None]
+    assert search.today.result is not None and search.best.result is not None
+    assert all(c is search.best or c is search.today for c in kept)
+    assert all(c.e_supply is not None and c.cycle_time is not None for c in search.candidates)
+    energies = [c.e_supply for c in search.candidates]
+    assert search.best.e_supply == min([*energies, search.today.e_supply])

@@ -179,30 +179,29 @@ class Candidate:
         target met.
     why : str
         The details ('' when reachable): the line out of reach, the limit broken, ...
+    e_supply : float or None
+        The optimised program's supply energy per cycle, J (None when not reachable).
+    cycle_time : float or None
+        Its cycle time, s (None when the program cannot run there).
     result : ProgramOptimization or None
-        The optimisation (None when the program cannot run there).
+        The whole optimisation, kept for today's placement and the best only (each holds its
+        500 Hz motions: a few MB).
     """
 
     placement: BasePlacement
     reason: Reason
     why: str = ""
+    e_supply: float | None = None
+    cycle_time: float | None = None
     result: ProgramOptimization | None = None
 
     @property
     def reachable(self) -> bool:
         return self.reason is Reason.NONE
 
-    @property
-    def e_supply(self) -> float | None:
-        """The optimised program's supply energy per cycle, J (None when not reachable)."""
-        if not self.reachable or self.result is None:
-            return None
-        return self.result.optimized.result.score
-
-    @property
-    def cycle_time(self) -> float | None:
-        """s (None when the program cannot run there)."""
-        return None if self.result is None else self.result.optimized.result.cycle_time
+    def summary(self) -> Candidate:
+        """The candidate without its optimisation (its figures kept)."""
+        return replace(self, result=None)
 
     def to_dict(self) -> dict[str, Any]:
         p = self.placement
@@ -252,12 +251,14 @@ class PlacementSearch:
 def _judged(placement: BasePlacement, result: ProgramOptimization) -> Candidate:
     """A placement's optimisation: reachable if it holds every limit and meets every target."""
     opt = result.optimized.result
+    cycle = opt.cycle_time
     if not opt.ok:
-        return Candidate(placement, Reason.OVER_LIMIT, "; ".join(opt.check.violations()), result)
+        why = "; ".join(opt.check.violations())
+        return Candidate(placement, Reason.OVER_LIMIT, why, None, cycle, result)
     if not result.targets_met:
         why = "not within 1 mm and 0.5 deg, or not at rest"
-        return Candidate(placement, Reason.TARGET_MISSED, why, result)
-    return Candidate(placement, Reason.NONE, "", result)
+        return Candidate(placement, Reason.TARGET_MISSED, why, None, cycle, result)
+    return Candidate(placement, Reason.NONE, "", opt.score, cycle, result)
 
 
 def _reach(
@@ -343,18 +344,28 @@ def place_program(
         a_max=settings.caps.acceleration,
     )
     today = _judged(BasePlacement(), today_result)
-    candidates = []
+    best = today if today.reachable else None
+    candidates: list[Candidate] = []
     for i, (placement, moved) in enumerate(zip(placements, reached, strict=True)):
         if isinstance(moved, Candidate):
             candidates.append(moved)
             continue
         say(f"placement {i + 1}/{len(placements)}: {placement.label()}")
-        candidates.append(today if placement.today else _optimised(robot, moved, placement, fixed))
+        found = today if placement.today else _optimised(robot, moved, placement, fixed)
+        if found.reachable and (best is None or _better(found, best)):
+            best = found  # the only one whose optimisation is kept, besides today's
+        candidates.append(found if found is best or found is today else found.summary())
     if not any(c.reachable for c in candidates):
         raise _refusal(candidates)
-    reachable = [c for c in (today, *candidates) if c.reachable]
-    best = min(reachable, key=lambda c: (c.e_supply, _distance(c.placement)))
-    return PlacementSearch(today, tuple(candidates), best, fixed)
+    assert best is not None
+    kept = tuple(c if c is best or c is today else c.summary() for c in candidates)
+    return PlacementSearch(today, kept, best, fixed)
+
+
+def _better(a: Candidate, b: Candidate) -> bool:
+    """Less energy, or as much and nearer today's placement."""
+    assert a.e_supply is not None and b.e_supply is not None
+    return (a.e_supply, _distance(a.placement)) < (b.e_supply, _distance(b.placement))
 
 
 def _distance(p: BasePlacement) -> float:
