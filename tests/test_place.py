@@ -9,6 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from clicase import run_case
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from kinergy.dynamics.poses import tcp_pose
 from kinergy.errors import KinergyError
@@ -199,3 +201,21 @@ def test_only_todays_and_the_best_optimisation_are_kept() -> None:
     assert all(c.e_supply is not None and c.cycle_time is not None for c in search.candidates)
     energies = [c.e_supply for c in search.candidates]
     assert search.best.e_supply == min([*energies, search.today.e_supply])
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.text(max_size=30), st.floats(allow_nan=True, allow_infinity=True))
+def test_any_range_text_and_step_is_parsed_or_refused_in_one_line(text: str, step: float) -> None:
+    """Whatever the user types for a range and a step: a checked grid, or a KinergyError of one
+    line (never another exception, never a grid with NaN or more than the cap)."""
+    from kinergy.cli.place import parse_range
+
+    try:
+        r = parse_range(text, "--x", "m")
+        grid = PlacementGrid(r, Range(0.0, 0.0), step=step)
+    except KinergyError as exc:
+        assert "\n" not in str(exc) and str(exc).startswith(("--x", "--step"))
+        return
+    assert math.isfinite(r.low) and math.isfinite(r.high) and r.low <= r.high
+    assert 1 <= grid.count <= MAX_CANDIDATES == 400
+    assert all(math.isfinite(p.x) for p in grid.placements())
