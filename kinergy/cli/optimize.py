@@ -13,9 +13,16 @@ from typing import Any, TypeVar
 
 import click
 
-from kinergy.cli.common import load, output_file_option, payload_option, progress, table, writes
+from kinergy.cli.common import (
+    json_result,
+    load,
+    output_file_option,
+    payload_option,
+    progress,
+    table,
+    writes,
+)
 from kinergy.errors import KinergyError
-from kinergy.jsonable import dumps
 from kinergy.optimize import ParetoPoint, ProgramResult, TimingResult
 from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
 from kinergy.optimize.programs import Lever, supply
@@ -393,7 +400,7 @@ def optimize(
                 options=options,
                 progress=say,
             )
-        click.echo(dumps(program.to_dict()) if as_json else program_text(program))
+        click.echo(json_result(program.to_dict()) if as_json else program_text(program))
         if not as_json:
             for path in program.written:
                 click.echo(f"wrote {path}")
@@ -418,7 +425,7 @@ def optimize(
             plot=plot,
         )
     if as_json:
-        click.echo(dumps(run.to_dict()))
+        click.echo(json_result(run.to_dict()))
         return
     click.echo(optimize_text(run))
     for path in run.written:

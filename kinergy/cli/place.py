@@ -13,10 +13,17 @@ import math
 
 import click
 
-from kinergy.cli.common import load, output_file_option, payload_option, progress, table, writes
+from kinergy.cli.common import (
+    json_result,
+    load,
+    output_file_option,
+    payload_option,
+    progress,
+    table,
+    writes,
+)
 from kinergy.cli.optimize import lever_options, program_options
 from kinergy.errors import KinergyError
-from kinergy.jsonable import dumps
 from kinergy.optimize.placement import Candidate, PlacementGrid, Range
 from kinergy.workflows.place import PlaceRun, run_place
 
@@ -176,7 +183,7 @@ def place(
             robot, program_file, grid, options=options, urscript=urscript, plot=plot, progress=say
         )
     if as_json:
-        click.echo(dumps(run.to_dict()))
+        click.echo(json_result(run.to_dict()))
         return
     click.echo(place_text(run))
     for path in run.written:
