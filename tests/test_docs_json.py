@@ -7,7 +7,7 @@ documents compared are every file in ``tests/golden/`` (which hold the commands'
 runs of the commands that the golden files do not cover: ``--friction auto`` with a joint that
 never moves, the full method against measured joint torques by weighted least squares, a log
 with a gap, a URScript program, a calibration file, an excitation compared with random ones,
-the nursing method (through the Python API, whose ``to_dict()`` is the command's JSON without
+a placement search, the nursing method (through the Python API, whose ``to_dict()`` is the command's JSON without
 the ``kinergy`` record), a fleet and a live monitor against the protocol-level RTDE server.
 
 Checked both ways: every key printed is on the page (under its command's heading), and every
@@ -331,6 +331,13 @@ def documents(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[tuple[
             "URScript": [
                 "optimize", "ur5e", str(ROOT / "tests" / "programs" / "small.script"),
                 "--pareto-points", "0", "--json",
+            ],
+        },
+        "json-place": {
+            "a small grid": [
+                "place", "ur5e", str(ROOT / "tests" / "programs" / "small.script"),
+                "--x", "-0.1:0.1", "--y", "0.0:0.9", "--step", "0.45", "--tool-symmetry", "z",
+                "--json",
             ],
         },
         "json-excite": {

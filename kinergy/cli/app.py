@@ -38,6 +38,7 @@ COMMANDS = {
     "validate": "kinergy.cli.validate:validate",
     "energy": "kinergy.cli.energy:energy",
     "optimize": "kinergy.cli.optimize:optimize",
+    "place": "kinergy.cli.place:place",
     "excite": "kinergy.cli.excite:excite",
     "nursing": "kinergy.cli.nursing:nursing",
     "report": "kinergy.cli.report:report",

@@ -8,19 +8,30 @@ the Pareto front, the URScript and plot files) and prints its result as text or 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any, TypeVar
 
 import click
 
-from kinergy.cli.common import load, output_file_option, payload_option, progress, table, writes
+from kinergy.cli.common import (
+    json_result,
+    load,
+    output_file_option,
+    payload_option,
+    progress,
+    table,
+    writes,
+)
 from kinergy.errors import KinergyError
-from kinergy.jsonable import dumps
 from kinergy.optimize import ParetoPoint, ProgramResult, TimingResult
+from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
 from kinergy.optimize.programs import Lever, supply
 from kinergy.workflows.optimize import OptimizeRun, run_optimize
 from kinergy.workflows.optimize_program import ProgramRun, run_program_optimize
 
-__all__ = ["optimize", "optimize_text", "program_text"]
+__all__ = ["lever_options", "optimize", "optimize_text", "program_options", "program_text"]
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 _PARTS = ("friction", "copper", "inertial", "gravity")
 #: the longest cycle time optimised, s (each is re-simulated at 500 Hz, Pareto points and all)
@@ -162,14 +173,14 @@ def _levers_table(levers: Sequence[Lever]) -> str:
             f"{supply(lv.result):.1f}",
             f"{lv.result.e_elec:.1f}",
             "yes" if lv.result.ok else "NO",
-            "yes" if lv.kept else "no",
+            "" if lv.name in ("program", "timing only") else f"{lv.saved:+.1f}",
+            lv.status.value + (f" ({lv.repaired})" if lv.repaired else ""),
             lv.note,
         ]
         for lv in levers
     ]
-    return table(
-        ["lever", "cycle [s]", "supply [J]", "motors [J]", "limits ok", "used", "note"], rows
-    )
+    headers = ["lever", "cycle [s]", "supply [J]", "motors [J]", "limits ok", "saved [J]"]
+    return table([*headers, "used", "note"], rows)
 
 
 def program_text(run: ProgramRun) -> str:
@@ -198,8 +209,92 @@ def program_text(run: ProgramRun) -> str:
         + ("all met" if result.targets_met else "NOT all met (1 mm, 0.5 deg, at rest)"),
         f"Within limits: {'yes' if opt.ok else 'NO: ' + '; '.join(opt.check.violations())}",
     ]
+    left = [str(c.line) for c in result.targets if c.left_out]
+    if left:
+        lines.append(
+            f"Via points left out of the route (free via points): line{'s' if len(left) > 1 else ''} "
+            f"{', '.join(left)} now take the joints of the target before them"
+        )
     lines += [f"note: {n}" for n in run.notes]
     return "\n".join(lines)
+
+
+def lever_options(prefix: str = "") -> Callable[[F], F]:
+    """The levers of a URScript program's optimisation as options (``prefix`` starts each help
+    text): --configurations, --tool-symmetry, --via, --no-blends, --standby."""
+
+    def said(text: str) -> str:
+        return prefix + text if prefix else text[0].upper() + text[1:]
+
+    options = [
+        click.option(
+            "--configurations",
+            type=click.Choice([c.value for c in Configurations]),
+            default="keep",
+            show_default=True,
+            help=said("the IK branch of a movej's pose target (free: any of the eight)."),
+        ),
+        click.option(
+            "--tool-symmetry",
+            "tool_symmetry",
+            type=click.Choice([s.value for s in ToolSymmetry]),
+            default="none",
+            show_default=True,
+            help=said("the tool may turn about its z axis (any angle, 180 or 90 deg)."),
+        ),
+        click.option(
+            "--via",
+            type=click.Choice([v.value for v in ViaPoints]),
+            default="keep",
+            show_default=True,
+            help=said(
+                "joint-space via points (a movej's target followed by a movej, nothing "
+                "at rest between; e.g. a home pose passed every cycle) stay on the route, or free: "
+                "the route may leave them out."
+            ),
+        ),
+        click.option("--no-blends", is_flag=True, help=said("no blend radii on via points.")),
+        click.option(
+            "--standby",
+            type=click.FloatRange(min=0.0),
+            default=None,
+            help=said("standby power (W) counted over the cycle time [default: the robot file's]."),
+        ),
+    ]
+
+    def decorate(func: F) -> F:
+        for option in reversed(options):
+            func = option(func)
+        return func
+
+    return decorate
+
+
+def program_options(
+    *,
+    configurations: str,
+    tool_symmetry: str,
+    via: str,
+    no_blends: bool,
+    standby: float | None,
+    cycle_time: str,
+    v_max: float | None,
+    a_max: float | None,
+) -> ProgramOptions:
+    """The options of a URScript program's optimisation, parsed once into their types (one
+    line naming the flag for a bad value)."""
+    _cap("--v-max", v_max)
+    _cap("--a-max", a_max)
+    return ProgramOptions(
+        configurations=Configurations.parse(configurations),
+        tool_symmetry=ToolSymmetry.parse(tool_symmetry),
+        via=ViaPoints.parse(via),
+        blends=not no_blends,
+        standby=standby,
+        cycle_time=_cycle_time(cycle_time),
+        v_max=v_max,
+        a_max=a_max,
+    )
 
 
 @click.command()
@@ -245,29 +340,7 @@ def program_text(run: ProgramRun) -> str:
     is_flag=True,
     help="Keep each move's share of the cycle time; choose only speeds and accelerations.",
 )
-@click.option(
-    "--configurations",
-    type=click.Choice(["keep", "free"]),
-    default="keep",
-    show_default=True,
-    help="URScript programs: the IK branch of a movej's pose target (free: any of the eight).",
-)
-@click.option(
-    "--tool-symmetry",
-    "tool_symmetry",
-    type=click.Choice(["none", "z", "z2", "z4"]),
-    default="none",
-    show_default=True,
-    help="URScript programs: the tool may turn about its z axis (any angle, 180 or 90 deg).",
-)
-@click.option("--no-blends", is_flag=True, help="URScript programs: no blend radii on via points.")
-@click.option(
-    "--standby",
-    type=click.FloatRange(min=0.0),
-    default=None,
-    help="URScript programs: standby power (W) counted over the cycle time [default: the robot "
-    "file's].",
-)
+@lever_options("URScript programs: ")
 @click.option(
     "--motions",
     type=click.Path(file_okay=False),
@@ -290,6 +363,7 @@ def optimize(
     fixed_shares: bool,
     configurations: str,
     tool_symmetry: str,
+    via: str,
     no_blends: bool,
     standby: float | None,
     motions: str | None,
@@ -298,31 +372,35 @@ def optimize(
 
     MODEL is a built-in robot or a model file; TASK a task file (TOML: the movej's waypoints),
     test-a / test-b (the UR5e doc's test programs), or a URScript program (*.script: its path
-    as well, with the levers --configurations, --tool-symmetry and blends). Compares the optimum
-    with the program as written and with uniform time scaling to the same cycle time, all
-    re-simulated at 500 Hz with every speed, acceleration, torque and position limit checked at
-    every sample.
+    as well, with the levers --configurations, --tool-symmetry, --via and blends). Compares the
+    optimum with the program as written and with uniform time scaling to the same cycle time,
+    all re-simulated at 500 Hz with every speed, acceleration, torque and position limit
+    checked at every sample.
     """
     budget = _cycle_time(cycle_time)
     _cap("--v-max", v_max)
     _cap("--a-max", a_max)
     if task_name.endswith(".script"):
+        options = program_options(
+            configurations=configurations,
+            tool_symmetry=tool_symmetry,
+            via=via,
+            no_blends=no_blends,
+            standby=standby,
+            cycle_time=cycle_time,
+            v_max=v_max,
+            a_max=a_max,
+        )
         with progress() as say:
             program = run_program_optimize(
                 load(model, payload),
                 task_name,
                 urscript=urscript,
                 motions=motions,
+                options=options,
                 progress=say,
-                configurations=configurations,
-                tool_symmetry=tool_symmetry,
-                blends=not no_blends,
-                standby=standby,
-                cycle_time=budget,
-                v_max=v_max,
-                a_max=a_max,
             )
-        click.echo(dumps(program.to_dict()) if as_json else program_text(program))
+        click.echo(json_result(program.to_dict()) if as_json else program_text(program))
         if not as_json:
             for path in program.written:
                 click.echo(f"wrote {path}")
@@ -347,7 +425,7 @@ def optimize(
             plot=plot,
         )
     if as_json:
-        click.echo(dumps(run.to_dict()))
+        click.echo(json_result(run.to_dict()))
         return
     click.echo(optimize_text(run))
     for path in run.written:

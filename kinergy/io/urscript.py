@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
@@ -25,6 +26,13 @@ from numpy.typing import ArrayLike
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
+from kinergy.io.urscript_reader import (
+    assigned_name,
+    identifiers,
+    parse_program,
+    split_comment,
+    target_name,
+)
 from kinergy.trajectory.motion import CONTROLLER_DT
 from kinergy.trajectory.movej import check_waypoints, per_move
 from kinergy.trajectory.robot_program import Move, RobotProgram
@@ -35,6 +43,7 @@ __all__ = [
     "movej_program",
     "program_script",
     "servoj_program",
+    "target_literal",
     "write_script",
 ]
 
@@ -171,15 +180,19 @@ def movej_program(
     return _program(name, header, body)
 
 
-def move_statement(move: Move) -> str:
+def target_literal(move: Move) -> str:
+    """A move's target as a URScript value: joints ``[...]`` (rad) or a pose ``p[...]``."""
+    return ("p" if move.pose else "") + _vector(move.target)
+
+
+def move_statement(move: Move, target: str | None = None) -> str:
     """One move as URScript: ``movej([...], a=..., v=..., r=...)``, a pose ``p[...]`` (m, rad),
-    ``get_inverse_kin(p[...], qnear=[...])`` for a movej's pose target with ``qnear``."""
-    target = _vector(move.target)
-    if move.pose:
-        target = "p" + target
-        if move.qnear is not None and not move.tool_space:
-            target = f"get_inverse_kin({target}, qnear={_vector(move.qnear)})"
-    args = [target, f"a={_decimal(move.a)}", f"v={_decimal(move.v)}"]
+    ``get_inverse_kin(p[...], qnear=[...])`` for a movej's pose target with ``qnear``;
+    ``target``: the target's text instead of its literal value (a variable's name)."""
+    text = target_literal(move) if target is None else target
+    if move.pose and move.qnear is not None and not move.tool_space:
+        text = f"get_inverse_kin({text}, qnear={_vector(move.qnear)})"
+    args = [text, f"a={_decimal(move.a)}", f"v={_decimal(move.v)}"]
     if move.t > 0.0 and move.kind != "movep":
         args.append(f"t={_decimal(move.t)}")
     if move.r > 0.0:
@@ -187,13 +200,129 @@ def move_statement(move: Move) -> str:
     return f"{move.kind}({', '.join(args)})"
 
 
+def _same_target(a: Move, b: Move) -> bool:
+    return a.pose == b.pose and bool(np.array_equal(a.target, b.target))
+
+
+@dataclass
+class _Variable:
+    """A named target of the program and the moves that use it."""
+
+    name: str
+    line: int  # 0-based index of its assignment
+    moves: list[int] = field(default_factory=list)  # indices into program.moves
+    read_elsewhere: bool = False
+
+
+def _variables(program: RobotProgram) -> dict[str, _Variable]:
+    """The variables the program's moves take as targets, with the lines assigning them."""
+    lines = program.lines
+    assigned = {}
+    for i, raw in enumerate(lines):
+        name = assigned_name(split_comment(raw)[0])
+        if name is not None and name not in assigned:
+            assigned[name] = i
+    found: dict[str, _Variable] = {}
+    move_lines = set()
+    for k, move in enumerate(program.moves):
+        name, _ = target_name(move.text)
+        if name is None or name not in assigned:
+            continue
+        found.setdefault(name, _Variable(name, assigned[name])).moves.append(k)
+        move_lines.add(move.line - 1)
+    for var in found.values():
+        for i, raw in enumerate(lines):
+            if i == var.line or (i in move_lines and _uses_as_target(program, i, var.name)):
+                continue
+            if var.name in identifiers(split_comment(raw)[0]):
+                var.read_elsewhere = True
+    return found
+
+
+def _uses_as_target(program: RobotProgram, index: int, name: str) -> bool:
+    """Whether the move on line ``index`` (0-based) uses ``name`` as its target and nowhere
+    else in the statement."""
+    for move in program.moves:
+        if move.line - 1 == index:
+            target, _ = target_name(move.text)
+            rest = identifiers(move.text) - {target}
+            return target == name and name not in rest
+    return False
+
+
+def _fresh(name: str, taken: set[str]) -> str:
+    """``name_2``, ``name_3``, ...: the first not in ``taken`` (which it joins)."""
+    i = 2
+    while f"{name}_{i}" in taken:
+        i += 1
+    taken.add(f"{name}_{i}")
+    return f"{name}_{i}"
+
+
+def _assignment(raw: str, name: str, value: str) -> str:
+    """The assignment line ``raw`` of ``name`` with another value (its indentation, ``global``
+    or ``local`` and comment kept)."""
+    code, comment = split_comment(raw)
+    indent = raw[: len(raw) - len(raw.lstrip())]
+    prefix = code.split(name, 1)[0]  # '', 'global ' or 'local '
+    return f"{indent}{prefix}{name} = {value}" + (f"  {comment}" if comment else "")
+
+
+def _named_targets(
+    program: RobotProgram,
+) -> tuple[dict[int, str], dict[int, str], dict[int, list[str]]]:
+    """How the moves' variables are written: per move the target's text (a name), the
+    assignment lines rewritten (0-based index -> line) and lines added after an assignment (new
+    names for a value the variable cannot hold as well). A move goes where its lines say
+    unless its target differs from what they say (the lines read again)."""
+    lines = program.lines
+    moves = program.moves
+    as_read = parse_program("\n".join(lines), path=program.path, name=program.name).moves
+    taken = set().union(*(identifiers(split_comment(raw)[0]) for raw in lines))
+    targets: dict[int, str] = {}
+    rewritten: dict[int, str] = {}
+    added: dict[int, list[str]] = {}
+    for var in _variables(program).values():
+        changed = [not _same_target(moves[k], as_read[k]) for k in var.moves]
+        if not any(changed):
+            targets.update({k: var.name for k in var.moves})
+            continue
+        values: dict[str, str] = {}  # new value -> its name
+        # the name keeps its value where a move still goes there or it is read elsewhere
+        name_used = var.read_elsewhere or not all(changed)
+        for k, change in zip(var.moves, changed, strict=True):
+            if not change:
+                targets[k] = var.name
+                continue
+            value = target_literal(moves[k])
+            if value not in values:
+                if not name_used:
+                    values[value] = var.name
+                    rewritten[var.line] = _assignment(lines[var.line], var.name, value)
+                    name_used = True
+                else:
+                    new = _fresh(var.name, taken)
+                    values[value] = new
+                    indent = lines[var.line][: len(lines[var.line]) - len(lines[var.line].lstrip())]
+                    added.setdefault(var.line, []).append(
+                        f"{indent}{new} = {value}  # kinergy: {var.name} for line {moves[k].line}"
+                    )
+            targets[k] = values[value]
+    return targets, rewritten, added
+
+
 def program_script(program: RobotProgram, header: Sequence[str] = ()) -> str:
     """A program read from a file written back with its (changed) moves.
 
-    Every move's line is replaced by :func:`move_statement` (its indentation and comment kept);
-    every other line (events, I/O, variables, comments) stays as it was. ``header`` lines go in
-    as comments after the ``def`` line (or at the top). A program built in code (no ``lines``) is
-    written as ``def name():`` with one move per line and its events' statements.
+    Every move's line is replaced by :func:`move_statement` (its indentation and comment kept).
+    A move whose target was a variable keeps the variable: the variable is assigned the new
+    value on its own line (its comment kept) and the move names it; where the moves sharing a
+    variable now go to different places, or the variable is read elsewhere, the new values get
+    new names (``home_2 = ...``) on lines after it. Every other line (events, I/O, comments)
+    stays as it was, and so does a variable whose moves all still go where its line says (the
+    lines are read again to tell). ``header`` lines go in as comments after the
+    ``def`` line (or at the top). A program built in code (no ``lines``) is written as
+    ``def name():`` with one move per line and its events' statements.
 
     Returns
     -------
@@ -203,15 +332,23 @@ def program_script(program: RobotProgram, header: Sequence[str] = ()) -> str:
     if not program.lines:
         body = [move_statement(s) if isinstance(s, Move) else s.text for s in program.steps]
         return _program(program.name, header, body)
+    targets, rewritten, added = _named_targets(program)
     lines = list(program.lines)
-    for move in program.moves:
+    for index, line in rewritten.items():
+        lines[index] = line
+    for k, move in enumerate(program.moves):
         old = lines[move.line - 1]
         indent = old[: len(old) - len(old.lstrip())]
-        comment = old[old.index("#") :] if "#" in old and "#" not in move.text else ""
-        lines[move.line - 1] = indent + move_statement(move) + (f"  {comment}" if comment else "")
-    at = next((i + 1 for i, line in enumerate(lines) if line.lstrip().startswith("def ")), 0)
-    lines[at:at] = _comments(header, "  " if at else "")
-    return "\n".join(lines) + "\n"
+        _, comment = split_comment(old)
+        statement = move_statement(move, targets.get(k))
+        lines[move.line - 1] = indent + statement + (f"  {comment}" if comment else "")
+    out: list[str] = []
+    for i, line in enumerate(lines):
+        out.append(line)
+        out.extend(added.get(i, []))
+    at = next((i + 1 for i, line in enumerate(out) if line.lstrip().startswith("def ")), 0)
+    out[at:at] = _comments(header, "  " if at else "")
+    return "\n".join(out) + "\n"
 
 
 def write_script(path: str | os.PathLike[str], text: str) -> Path:

@@ -39,7 +39,15 @@ from kinergy.model.robot import Payload
 from kinergy.trajectory.motion import CONTROLLER_DT
 from kinergy.trajectory.robot_program import MOVE_DEFAULTS, Event, Move, RobotProgram, Step
 
-__all__ = ["IO_CALLS", "parse_program", "read_program"]
+__all__ = [
+    "IO_CALLS",
+    "assigned_name",
+    "identifiers",
+    "parse_program",
+    "read_program",
+    "split_comment",
+    "target_name",
+]
 
 #: calls that set an output: events at rest, 0 s
 IO_CALLS = frozenset(
@@ -183,8 +191,9 @@ def _arguments(node: ast.Call, names: tuple[str, ...]) -> dict[str, ast.expr]:
     return out
 
 
-def _strip_comment(line: str) -> str:
-    """The statement of a line without its ``#`` comment (outside strings)."""
+def split_comment(line: str) -> tuple[str, str]:
+    """A line's statement (stripped) and its ``#`` comment (from the ``#``, ``''`` if none),
+    ``#`` inside strings not counting."""
     quote = ""
     for i, c in enumerate(line):
         if quote:
@@ -193,8 +202,55 @@ def _strip_comment(line: str) -> str:
         elif c in "\"'":
             quote = c
         elif c == "#":
-            return line[:i].strip()
-    return line.strip()
+            return line[:i].strip(), line[i:].rstrip()
+    return line.strip(), ""
+
+
+def _strip_comment(line: str) -> str:
+    """The statement of a line without its ``#`` comment (outside strings)."""
+    return split_comment(line)[0]
+
+
+def assigned_name(statement: str) -> str | None:
+    """The variable a statement assigns (``[global|local] name = ...``), or None."""
+    m = _ASSIGN.match(statement)
+    return None if m is None else m.group(1)
+
+
+def identifiers(statement: str) -> set[str]:
+    """The names a statement uses (outside strings), e.g. to tell whether a variable is read."""
+    code = re.sub(r"(\"[^\"]*\"|'[^']*')", "", statement)
+    return set(re.findall(r"[A-Za-z_]\w*", code))
+
+
+def target_name(statement: str) -> tuple[str | None, bool]:
+    """The variable a move statement's target is (``movej(home, ...)``, or the pose of
+    ``get_inverse_kin(pose_name, ...)``), or None for a literal; and whether it is the pose of
+    ``get_inverse_kin``."""
+    try:
+        node = ast.parse(statement, mode="eval").body
+    except SyntaxError:
+        return None, False
+    if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)):
+        return None, False
+    kind = node.func.id
+    if kind not in _MOVE_ARGS:
+        return None, False
+    try:
+        target = _arguments(node, ("pose_or_q", *_MOVE_ARGS[kind])).get("pose_or_q")
+    except KinergyError:
+        return None, False
+    if isinstance(target, ast.Name):
+        return target.id, False
+    if (
+        isinstance(target, ast.Call)
+        and isinstance(target.func, ast.Name)
+        and target.func.id == "get_inverse_kin"
+        and target.args
+        and isinstance(target.args[0], ast.Name)
+    ):
+        return target.args[0].id, True
+    return None, False
 
 
 class _Reader:

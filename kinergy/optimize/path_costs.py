@@ -3,12 +3,14 @@
 Each move's target can be reached in several joint configurations: the inverse-kinematics branch
 (:mod:`kinergy.dynamics.ik`: eight for a pose target of a movej with ``--configurations free``;
 the program's own otherwise) and, for a tool symmetric about its z axis, any turn of the target
-about that axis (:data:`kinergy.optimize.program_verify.SYMMETRIES`: 180 or 90 degree steps, or
+about that axis (:class:`kinergy.optimize.options.ToolSymmetry`: 180 or 90 degree steps, or
 every 45 degrees for ``z``, then finer around the best: :func:`refined_turns`).
 :func:`target_states` lists them per move, each joint at the ``2 pi``
 choice nearest the program's own joints there (so a cycle of states is a cycle of joints: the
 program ends where it starts), and for 180 and 90 degree turns also with the last joint the
-other way round.
+other way round. With free via points (:class:`kinergy.optimize.options.ViaPoints`), a
+joint-space via point (:func:`via_points`) may also take the joints of any state of the target
+before it: the move to it then goes nowhere and the route leaves the via point out.
 
 :func:`move_costs` estimates the energy of every move from each state of its start target to
 each state of its end target: the move alone, from rest to rest, at the program's own ``v`` and
@@ -27,26 +29,27 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.arrays import Array
-from kinergy.dynamics.ik import ik_branches, joint_limits, wrap_choices, wrap_near
+from kinergy.dynamics.ik import branch_of, ik_branches, joint_limits, wrap_choices, wrap_near
 from kinergy.dynamics.poses import rotation_about_z, tcp_pose
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
+from kinergy.optimize.options import ToolSymmetry
 from kinergy.optimize.program import quadrature_nodes
 from kinergy.optimize.program_samples import drive_by_payload
-from kinergy.optimize.program_verify import SYMMETRIES
 from kinergy.trajectory.movej import trapezoid, trapezoid_timing
 from kinergy.trajectory.movel import joints_on_path, tool_motion, tool_segment
 from kinergy.trajectory.program_path import ProgramPath
+from kinergy.trajectory.robot_program import Event, Move
 
-__all__ = ["TargetStates", "move_costs", "refined_turns", "symmetry_angles", "target_states"]
+__all__ = ["TargetStates", "move_costs", "refined_turns", "target_states", "via_points"]
 
 
 #: Gauss-Legendre nodes per phase (ramp up, cruise, braking) of the estimate
 _NODES = 4
 #: samples evaluated at once (memory: about 1 kB each)
 _CHUNK = 60_000
-#: steps of the turn about a fully symmetric tool's axis, rad
-_Z_STEP = np.pi / 4
+#: events that do not make a target a stop of the job (they set the tool or the load)
+_SETUP = ("tcp", "payload")
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,6 +67,9 @@ class TargetStates:
         The TCP pose of each state.
     own : int
         The state of the program as written (its branch, no turn).
+    moved : ndarray of bool, shape (S,)
+        States of a via point that leave it out of the route (the joints of a state of the
+        target before it); all False elsewhere.
     """
 
     q: Array
@@ -71,17 +77,7 @@ class TargetStates:
     turn: Array
     pose: Array
     own: int
-
-
-def symmetry_angles(symmetry: str) -> Array:
-    """The turns about the tool z axis a symmetry allows the search to try, rad."""
-    if symmetry not in SYMMETRIES:
-        raise KinergyError(
-            f"tool symmetry: expected one of {', '.join(SYMMETRIES)}, got {symmetry!r}"
-        )
-    turns = SYMMETRIES[symmetry]
-    step = _Z_STEP if turns == 0 else 2.0 * np.pi / turns
-    return np.arange(0.0, 2.0 * np.pi - 1e-9, step)
+    moved: NDArray[np.bool_]
 
 
 def refined_turns(chosen: Array, step: float) -> list[Array]:
@@ -116,53 +112,121 @@ def _turn_choices(q: Array, own: Array, lo: Array, hi: Array, *, both: bool) -> 
     return [near, other] if lo[-1] <= other[-1] <= hi[-1] else [near]
 
 
+def via_points(program_path: ProgramPath) -> NDArray[np.bool_]:
+    """Which moves' targets are joint-space via points, shape (K,): a movej's target followed
+    (cyclically: the program runs in cycles) by another movej with nothing at rest between them
+    but ``set_tcp`` or ``set_payload`` (:class:`kinergy.optimize.options.ViaPoints`)."""
+    program = program_path.program
+    steps, index = program.steps, program.move_index
+    out = np.zeros(len(index), dtype=bool)
+    for k, i in enumerate(index):
+        move = steps[i]
+        assert isinstance(move, Move)
+        following = steps[i + 1 :] if k + 1 < len(index) else (*steps[i + 1 :], *steps)
+        between = []
+        for step in following:
+            if isinstance(step, Move):
+                nxt = step
+                break
+            between.append(step)
+        out[k] = (
+            not move.tool_space
+            and not nxt.tool_space
+            and all(isinstance(e, Event) and e.kind in _SETUP for e in between)
+        )
+    return out
+
+
+def _own_states(
+    robot: Robot, path: ProgramPath, k: int, free: bool, symmetry: ToolSymmetry, angles: Array
+) -> TargetStates:
+    """Move k's target in every branch and turn the levers allow (module docstring)."""
+    geometry = path.geometry
+    move = path.program.moves[k]
+    own_q = path.q_end[k]
+    if geometry is None:
+        pose = tcp_pose(robot, own_q, path.tcp[k])[None]
+        return TargetStates(own_q[None], np.array([-1]), np.zeros(1), pose, 0, np.zeros(1, bool))
+    lo, hi = joint_limits(robot)
+    base = tcp_pose(robot, own_q, path.tcp[k])
+    poses = rotation_about_z(base, angles)  # (A, 4, 4)
+    sols = ik_branches(geometry, poses @ np.linalg.inv(path.tcp[k]), hint6=own_q[5])
+    any_branch = move.tool_space or (free and move.pose)
+    rows = []
+    for a in range(angles.size):
+        for b in range(8) if any_branch else [int(path.branch[k])]:
+            q = sols[a, b]
+            if not np.any(np.isnan(q)) and _fits(q, lo, hi):
+                for q_s in _turn_choices(
+                    q, own_q, lo, hi, both=symmetry.steps and angles[a] != 0.0
+                ):
+                    rows.append((q_s, b, angles[a], poses[a]))
+    own = next(
+        i
+        for i, row in enumerate(rows)
+        if row[1] == path.branch[k] and row[2] == 0.0 and np.allclose(row[0], own_q, atol=1e-6)
+    )
+    return TargetStates(
+        q=np.array([r[0] for r in rows]),
+        branch=np.array([r[1] for r in rows], dtype=np.intp),
+        turn=np.array([r[2] for r in rows]),
+        pose=np.array([r[3] for r in rows]),
+        own=own,
+        moved=np.zeros(len(rows), dtype=bool),
+    )
+
+
+def _with_moved(
+    robot: Robot, path: ProgramPath, k: int, states: TargetStates, before: TargetStates
+) -> TargetStates:
+    """A via point's states and, after them, the joints of every state of the target before it
+    (the route then leaves the via point out)."""
+    geometry = path.geometry
+    q = before.q
+    pose = tcp_pose(robot, q, path.tcp[k])
+    branch = np.array(
+        [-1 if geometry is None else branch_of(geometry, qi, tcp_pose(robot, qi)) for qi in q],
+        dtype=np.intp,
+    )
+    return TargetStates(
+        q=np.vstack([states.q, q]),
+        branch=np.concatenate([states.branch, branch]),
+        turn=np.concatenate([states.turn, np.zeros(q.shape[0])]),
+        pose=np.concatenate([states.pose, pose]),
+        own=states.own,
+        moved=np.concatenate([states.moved, np.ones(q.shape[0], dtype=bool)]),
+    )
+
+
 def target_states(
     robot: Robot,
     path: ProgramPath,
     *,
     free: bool,
-    symmetry: str,
+    symmetry: ToolSymmetry,
+    via: bool = False,
     turns: list[Array] | None = None,
 ) -> list[TargetStates]:
     """Every move's candidate states (module docstring): ``free`` lets a movej's pose target
     take any branch; ``symmetry`` its turns about the tool axis (``turns``: each target's own,
-    rad, each including 0)."""
-    geometry = path.geometry
-    lo, hi = joint_limits(robot)
-    out = []
-    for k, move in enumerate(path.program.moves):
-        angles = symmetry_angles(symmetry) if turns is None else turns[k]
-        own_q = path.q_end[k]
-        if geometry is None:
-            pose = tcp_pose(robot, own_q, path.tcp[k])[None]
-            out.append(TargetStates(own_q[None], np.array([-1]), np.zeros(1), pose, 0))
-            continue
-        base = tcp_pose(robot, own_q, path.tcp[k])
-        poses = rotation_about_z(base, angles)  # (A, 4, 4)
-        sols = ik_branches(geometry, poses @ np.linalg.inv(path.tcp[k]), hint6=own_q[5])
-        any_branch = move.tool_space or (free and move.pose)
-        few = SYMMETRIES[symmetry] > 1  # 180 or 90 degree steps
-        rows = []
-        for a in range(angles.size):
-            for b in range(8) if any_branch else [int(path.branch[k])]:
-                q = sols[a, b]
-                if not np.any(np.isnan(q)) and _fits(q, lo, hi):
-                    for q_s in _turn_choices(q, own_q, lo, hi, both=few and angles[a] != 0.0):
-                        rows.append((q_s, b, angles[a], poses[a]))
-        own = next(
-            i
-            for i, row in enumerate(rows)
-            if row[1] == path.branch[k] and row[2] == 0.0 and np.allclose(row[0], own_q, atol=1e-6)
+    rad, each including 0); ``via`` lets a joint-space via point take the joints of the target
+    before it (a run of via points in order, each from the states of the one before)."""
+    out = [
+        _own_states(
+            robot, path, k, free, symmetry, symmetry.angles() if turns is None else turns[k]
         )
-        out.append(
-            TargetStates(
-                q=np.array([r[0] for r in rows]),
-                branch=np.array([r[1] for r in rows], dtype=np.intp),
-                turn=np.array([r[2] for r in rows]),
-                pose=np.array([r[3] for r in rows]),
-                own=own,
-            )
-        )
+        for k in range(path.moves)
+    ]
+    if not via:
+        return out
+    vias = via_points(path)
+    if np.all(vias):
+        return out  # a program of via points alone: nothing to leave out
+    first = int(np.flatnonzero(~vias)[-1]) + 1  # after a target that is not a via point
+    for j in range(path.moves):
+        k = (first + j) % path.moves
+        if vias[k]:
+            out[k] = _with_moved(robot, path, k, out[k], out[k - 1])
     return out
 
 

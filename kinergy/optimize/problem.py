@@ -169,10 +169,17 @@ def joint_caps(
     return np.array(v_cap), np.array(a_cap), v_why, a_why
 
 
-def fastest_acceleration(evaluate: Evaluator, travel: Array, v_cap: Array, a_cap: Array) -> Array:
+def fastest_acceleration(
+    evaluate: Evaluator,
+    travel: Array,
+    v_cap: Array,
+    a_cap: Array,
+    where: Callable[[int], str] | None = None,
+) -> Array:
     """Per move the largest acceleration (at most ``a_cap``) at ``v_cap`` whose torques stay
     within the limits (0.1 % margin): a geometric scan of every move at once, then a finer linear
-    scan inside the bracket each move found."""
+    scan inside the bracket each move found. ``where(k)`` names move k in a message (default
+    ``move k + 1``)."""
     moving = travel > 0.0
     safe = 1.0 - 1e-3
     v = np.where(moving, v_cap, 1.0)
@@ -192,7 +199,8 @@ def fastest_acceleration(evaluate: Evaluator, travel: Array, v_cap: Array, a_cap
     idx = last_good(coarse, feasible(coarse))
     for k in np.flatnonzero(moving & (idx < 0)):
         raise KinergyError(
-            f"move {k + 1}: the joint torques exceed their limits even at "
+            f"{f'move {k + 1}' if where is None else where(int(k))}: the joint torques exceed "
+            f"their limits even at "
             f"{coarse[0, k]:g} rad/s^2 (a static overload: the payload or the pose)"
         )
     cols = np.arange(travel.size)

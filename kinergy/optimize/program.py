@@ -20,7 +20,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, TypeVar
+from typing import ParamSpec, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,20 +50,21 @@ _SUB = 4
 _ORDER = 4
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(_ORDER)
 
-_F = TypeVar("_F", bound=Callable[..., Any])
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
 
 
-def serial(func: _F) -> _F:
+def serial(func: Callable[_P, _R]) -> Callable[_P, _R]:
     """Decorate a public entry point: its dynamics run on the calling thread only
     (:func:`kinergy.dynamics.threads.kernel_threads`; small batches evaluated many times run
     faster serially)."""
 
     @functools.wraps(func)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
+    def wrapper(*args: _P.args, **kwargs: _P.kwargs) -> _R:
         with kernel_threads(1):
             return func(*args, **kwargs)
 
-    return wrapper  # type: ignore[return-value]
+    return wrapper
 
 
 def settings(travel: Array, t: Array, f: Array) -> tuple[Array, Array, Array]:

@@ -31,6 +31,7 @@ from kinergy.optimize.program import (
 from kinergy.predict import DriveState, drive_state
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.program_motion import (
+    LineTable,
     Schedule,
     payload_index,
     sample_path,
@@ -118,8 +119,9 @@ def _samples(
     times: Array,
     weights: Array,
     valid: NDArray[np.bool_] | None,
+    tables: dict[int, LineTable] | None = None,
 ) -> ProgramSamples:
-    q, qd, qdd = sample_path(robot, path, sched, times)
+    q, qd, qdd = sample_path(robot, path, sched, times, tables=tables)
     n = path.q0.size
     load = payload_index(path, sched, times).reshape(-1)
     drive = drive_by_payload(
@@ -129,7 +131,14 @@ def _samples(
     return samples_at(times, weights, sched.start, end, drive, valid)
 
 
-def sample_path_programs(robot: Robot, path: ProgramPath, t: Array, f: Array) -> ProgramSamples:
+def sample_path_programs(
+    robot: Robot,
+    path: ProgramPath,
+    t: Array,
+    f: Array,
+    *,
+    tables: dict[int, LineTable] | None = None,
+) -> ProgramSamples:
     """B programs on ``path`` at the quadrature nodes, with the drive model.
 
     Parameters
@@ -138,6 +147,9 @@ def sample_path_programs(robot: Robot, path: ProgramPath, t: Array, f: Array) ->
     path : ProgramPath
     t, f : ndarray, shape (B, K)
         Each program's move durations (s) and ramp fractions.
+    tables : dict of int to LineTable, optional
+        Lone tool moves sampled from their tables
+        (:func:`kinergy.trajectory.program_motion.line_tables`).
 
     Returns
     -------
@@ -147,7 +159,7 @@ def sample_path_programs(robot: Robot, path: ProgramPath, t: Array, f: Array) ->
     """
     sched = path_schedule(path, t, f)
     times, weights, valid = quadrature_nodes(_breaks(path, sched), sub=_SUB)
-    return _samples(robot, path, sched, times, weights, valid)
+    return _samples(robot, path, sched, times, weights, valid, tables)
 
 
 def grid_path_samples(

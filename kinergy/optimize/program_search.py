@@ -66,18 +66,26 @@ def cheapest_cycle(costs: list[Array]) -> tuple[NDArray[np.intp], float]:
 
 
 def lever_mask(
-    path: ProgramPath, states: list[TargetStates], *, branch: bool, turn: bool
+    path: ProgramPath,
+    states: list[TargetStates],
+    *,
+    branch: bool,
+    turn: bool,
+    via: bool = False,
 ) -> list[NDArray[np.bool_]]:
     """Which states each target may take with a set of levers: another branch (a movej's pose
-    target; tool moves follow their line), a turn about the tool axis."""
+    target; tool moves follow their line), a turn about the tool axis, the joints of the target
+    before a via point (``via``: the route leaves the via point out)."""
     out = []
     for k, st in enumerate(states):
         move = path.program.moves[k]
-        ok = np.ones(st.q.shape[0], dtype=bool)
+        ok = ~st.moved
         if not turn:
             ok &= st.turn == 0.0
         if not branch and not move.tool_space:
             ok &= st.branch == st.branch[st.own]
+        if via:
+            ok |= st.moved
         out.append(ok)
     return out
 
@@ -120,18 +128,20 @@ def _moves_at(path: ProgramPath, q_all: Array, poses: Array, same: list[bool]) -
         q = q_all[k]
         if same[k] and np.allclose(q, path.q_end[k], atol=1e-9):
             out.append(move)
-        elif not move.pose and not move.tool_space:
+        elif not move.pose:  # a joint target (of a tool move: the pose of those joints)
             out.append(move.replaced(target=q, qnear=None))
+        elif move.tool_space:
+            out.append(move.replaced(target=pose_vector(poses[k]), pose=True, qnear=None))
         else:
-            pose = pose_vector(poses[k])
-            out.append(move.replaced(target=pose, pose=True, qnear=None if move.tool_space else q))
+            out.append(move.replaced(target=pose_vector(poses[k]), pose=True, qnear=q))
     return out
 
 
 def chosen_moves(
     path: ProgramPath, states: list[TargetStates], choice: NDArray[np.intp]
 ) -> list[Move]:
-    """The program's moves with the chosen states as their targets (module docstring)."""
+    """The program's moves with the chosen states as their targets (module docstring; a via
+    point left out takes the joints of the target before it)."""
     q_all = np.array([st.q[c] for st, c in zip(states, choice, strict=True)])
     poses = np.array([st.pose[c] for st, c in zip(states, choice, strict=True)])
     same = [int(c) == st.own for st, c in zip(states, choice, strict=True)]

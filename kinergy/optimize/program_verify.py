@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from kinergy.accounting.energy import energy
 from kinergy.arrays import Array
@@ -28,18 +29,15 @@ from kinergy.dynamics.poses import tcp_pose
 from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import limit_violations
 from kinergy.optimize.objectives import Objective, SupplyEnergy
+from kinergy.optimize.options import ToolSymmetry
 from kinergy.optimize.program_samples import grid_path_samples
 from kinergy.optimize.verify import ProgramResult
 from kinergy.predict import DriveState
 from kinergy.trajectory.motion import Motion
-from kinergy.trajectory.program_motion import Schedule, payload_index, program_motion
+from kinergy.trajectory.program_motion import Schedule, payload_index, program_motion, sample_path
 from kinergy.trajectory.program_path import ProgramPath
 
-__all__ = ["SYMMETRIES", "PathRun", "TargetCheck", "simulate_path", "target_errors"]
-
-
-#: tool symmetries about the tool z axis: name -> number of equivalent turns (0: any angle)
-SYMMETRIES = {"none": 1, "z2": 2, "z4": 4, "z": 0}
+__all__ = ["PathRun", "TargetCheck", "simulate_path", "target_errors"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,6 +141,9 @@ class TargetCheck:
         The move's line in the program.
     stop : bool
         Whether the move ends at rest (else it is a via point the program blends through).
+    left_out : bool
+        A joint-space via point the route leaves out (free via points): not a target of the
+        job, its figures are those of the move's new end.
     distance : float
         Stops: the tool's distance from the target at the stop, m. Via points: the closest the
         tool passes, m.
@@ -151,6 +152,9 @@ class TargetCheck:
         points.
     speed : float
         Stops: the largest joint speed at the stop, rad/s; NaN at via points.
+
+    A stop is checked at the instant its move ends (the planned motion there, not the next
+    500 Hz sample, which may already lie in the following move).
     """
 
     line: int
@@ -158,25 +162,25 @@ class TargetCheck:
     distance: float
     angle: float
     speed: float
+    left_out: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         return {
             "line": self.line,
             "stop": self.stop,
+            "left_out": self.left_out,
             "distance": self.distance,
             "angle": None if np.isnan(self.angle) else self.angle,
             "speed": None if np.isnan(self.speed) else self.speed,
         }
 
 
-def _angle(want: Array, got: Array, symmetry: str) -> float:
+def _angle(want: Array, got: Array, symmetry: ToolSymmetry) -> float:
     """Rotation angle between two orientations (3, 3), rad, up to turns about the tool z axis."""
-    turns = SYMMETRIES[symmetry]
-    if turns == 0:
+    if symmetry.any_angle:
         return float(np.arccos(np.clip(want[:, 2] @ got[:, 2], -1.0, 1.0)))
     best = np.inf
-    for i in range(turns):
-        a = 2.0 * np.pi * i / turns
+    for a in symmetry.equivalent():
         rz = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
         rel = (want @ rz).T @ got
         best = min(best, float(np.arccos(np.clip(0.5 * (np.trace(rel) - 1.0), -1.0, 1.0))))
@@ -184,9 +188,26 @@ def _angle(want: Array, got: Array, symmetry: str) -> float:
 
 
 def target_errors(
-    robot: Robot, original: ProgramPath, run: PathRun, *, symmetry: str = "none"
+    robot: Robot,
+    original: ProgramPath,
+    run: PathRun,
+    *,
+    symmetry: ToolSymmetry = ToolSymmetry.NONE,
+    left_out: NDArray[np.bool_] | None = None,
 ) -> list[TargetCheck]:
     """Check every target of ``original`` in a re-simulated changed program (same moves).
+
+    Parameters
+    ----------
+    robot : Robot
+    original : ProgramPath
+        The program as written.
+    run : PathRun
+        The changed program at 500 Hz.
+    symmetry : ToolSymmetry
+        Turns about the tool axis that meet a target.
+    left_out : ndarray of bool, shape (K,), optional
+        Via points the changed route leaves out (checked where the move now ends instead).
 
     Returns
     -------
@@ -194,27 +215,32 @@ def target_errors(
         One per move, in order.
     """
     path, motion, sched = run.path, run.motion, run.schedule
+    skipped = np.zeros(path.moves, dtype=bool) if left_out is None else left_out
     want = np.array(
-        [tcp_pose(robot, original.q_end[k], original.tcp[k]) for k in range(original.moves)]
+        [
+            tcp_pose(robot, (path if skipped[k] else original).q_end[k], original.tcp[k])
+            for k in range(original.moves)
+        ]
     )
-    dt = motion.t[1] - motion.t[0]
     out = []
     for k in range(path.moves):
         end = sched.start[0, k] + sched.duration[0, k]
+        line = original.program.moves[k].line
         if path.linked[k]:
             tips = tcp_pose(robot, motion.q, path.tcp[k])[:, :3, 3]
             gap = float(np.min(np.linalg.norm(tips - want[k, :3, 3], axis=1)))
-            out.append(TargetCheck(original.program.moves[k].line, False, gap, np.nan, np.nan))
+            out.append(TargetCheck(line, False, gap, np.nan, np.nan, bool(skipped[k])))
             continue
-        i = min(int(np.ceil(end / dt - 1e-9)), motion.t.size - 1)
-        got = tcp_pose(robot, motion.q[i], path.tcp[k])
+        q, qd, _ = sample_path(robot, path, sched, np.array([[end]]))
+        got = tcp_pose(robot, q[0, 0], path.tcp[k])
         out.append(
             TargetCheck(
-                line=original.program.moves[k].line,
+                line=line,
                 stop=True,
                 distance=float(np.linalg.norm(got[:3, 3] - want[k, :3, 3])),
                 angle=_angle(want[k, :3, :3], got[:3, :3], symmetry),
-                speed=float(np.max(np.abs(motion.qd[i]))),
+                speed=float(np.max(np.abs(qd[0, 0]))),
+                left_out=bool(skipped[k]),
             )
         )
     return out

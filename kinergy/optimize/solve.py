@@ -17,7 +17,7 @@ problem's callables only, whatever its objective.
 
 from __future__ import annotations
 
-import time
+import enum
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -30,25 +30,61 @@ from kinergy.arrays import Array
 from kinergy.optimize.problem import TimingProblem
 from kinergy.optimize.program import durations, settings
 
-__all__ = ["Solution", "solve_timing"]
+__all__ = ["Outcome", "Solution", "solve_timing"]
 
 
 #: relative forward-difference step in the decision variables
 _FD_STEP = 1e-6
 
 
+class Outcome(enum.Enum):
+    """Why the solver stopped: a typed value, never read from the solver's message.
+
+    ``CONVERGED``: the optimality conditions hold to the tolerance; ``ITERATION_LIMIT``: it used
+    its iterations (the result improves on the start but is not proven optimal); ``STALLED``: its
+    line search made no further progress (the result improves on the start); ``INFEASIBLE``: the
+    constraints could not all be met from the start point.
+    """
+
+    CONVERGED = "converged"
+    ITERATION_LIMIT = "iteration limit"
+    STALLED = "stalled"
+    INFEASIBLE = "infeasible"
+
+    @classmethod
+    def of_slsqp(cls, status: int) -> Outcome:
+        """The outcome of SciPy's SLSQP exit ``status`` (0 success, 9 iteration limit, 2 and 4
+        incompatible constraints, others a failed line search or a singular subproblem)."""
+        if status == 0:
+            return cls.CONVERGED
+        if status == 9:
+            return cls.ITERATION_LIMIT
+        if status in (2, 4):
+            return cls.INFEASIBLE
+        return cls.STALLED
+
+    @property
+    def words(self) -> str:
+        """What happened, for a user: ``optimal``, ``improved, iteration limit``, ..."""
+        return {
+            "converged": "optimal",
+            "iteration limit": "improved, iteration limit",
+            "stalled": "improved, no further progress",
+            "infeasible": "infeasible: the limits and the cycle time cannot all be met",
+        }[self.value]
+
+
 @dataclass(frozen=True)
 class Solution:
     """What :func:`solve_timing` found: ``v`` and ``a`` per move (K,), rad/s and rad/s^2, the
-    predicted (quadrature) objective (the electrical energy, J, by default), and the solver's
-    report."""
+    predicted (quadrature) objective (the electrical energy, J, by default), the iterations and
+    why the solver stopped."""
 
     v: Array
     a: Array
     value: float
     iterations: int
-    success: bool
-    message: str
+    outcome: Outcome
 
 
 @dataclass(frozen=True, eq=False)
@@ -212,7 +248,6 @@ def solve_timing(
     share_budget: bool = True,
     torque_margin: float = 0.0,
     maxiter: int = 150,
-    deadline: float | None = None,
 ) -> Solution:
     """Minimise the objective of ``problem`` at ``cycle_time`` with SLSQP, from ``(v0, a0)``.
 
@@ -229,9 +264,8 @@ def solve_timing(
     torque_margin : float
         Keep each move's largest joint torque below ``1 - torque_margin`` times its limit.
     maxiter : int
-        SLSQP iterations.
-    deadline : float, optional
-        ``time.process_time()`` after which SLSQP stops at its current iterate.
+        SLSQP iterations: the solver stops on them and on its tolerance, never on a clock, so
+        every host gets the same answer.
 
     Returns
     -------
@@ -242,11 +276,6 @@ def solve_timing(
     a0 = np.asarray(a0, dtype=float)
     variables, x0 = _variables(problem, cycle_time, v0, a0, share_budget)
     model = _Model(problem, variables, x0)
-
-    def stop(_: Array) -> None:
-        if deadline is not None and time.process_time() > deadline:
-            raise StopIteration
-
     res = minimize(
         lambda x: model.value(x)[0],
         x0,
@@ -255,7 +284,6 @@ def solve_timing(
         bounds=list(zip(variables.lower, variables.upper, strict=True)),
         constraints=_constraints(model, cycle_time, torque_margin),
         options={"maxiter": maxiter, "ftol": 1e-8},
-        callback=stop,
     )
     t, f = variables.timing(np.clip(res.x, variables.lower, variables.upper))
     e, _ = problem.evaluate(t, f)
@@ -266,6 +294,5 @@ def solve_timing(
         a=np.where(moving, np.minimum(a, problem.a_cap), a0),
         value=float(e[0]),
         iterations=int(res.nit),
-        success=bool(res.success),
-        message=str(res.message),
+        outcome=Outcome.of_slsqp(int(res.status)),
     )

@@ -77,13 +77,14 @@ from kinergy.optimize.problem import (
     uniform_scaling,
 )
 from kinergy.optimize.program import durations, serial
-from kinergy.optimize.solve import Solution, solve_timing
+from kinergy.optimize.solve import Outcome, Solution, solve_timing
 from kinergy.optimize.verify import ProgramResult, simulate_program
 
 __all__ = [
     "Checks",
     "ParetoPoint",
     "TimingResult",
+    "Verified",
     "best_verified",
     "optimize_timing",
     "pareto_front",
@@ -110,9 +111,9 @@ class TimingResult:
     iterations : int
         SLSQP iterations (all attempts).
     seconds : float
-        Wall time of the optimisation and its verification, s.
-    message : str
-        The solver's report (and any fallback taken).
+        Wall time of the optimisation and its verification, s (measured, never a budget).
+    solver : Verified
+        Why the solver stopped and whether uniform scaling was kept instead.
     """
 
     cycle_time: float
@@ -125,7 +126,12 @@ class TimingResult:
     active: list[str]
     iterations: int
     seconds: float
-    message: str
+    solver: Verified
+
+    @property
+    def message(self) -> str:
+        """What the solver did, in words (:attr:`Verified.words`)."""
+        return self.solver.words
 
     @property
     def saving(self) -> float:
@@ -155,6 +161,7 @@ class TimingResult:
             "solver": {
                 "iterations": self.iterations,
                 "seconds": self.seconds,
+                "outcome": None if self.solver.outcome is None else self.solver.outcome.value,
                 "message": self.message,
             },
         }
@@ -199,20 +206,39 @@ class _Checks:
         )
 
 
+@dataclass(frozen=True)
+class Caps:
+    """The caps of one comparison besides the robot's limits: every joint's speed (rad/s) and
+    acceleration (rad/s^2), None for none; and whether braking energy returns to the bus."""
+
+    v_max: float | None = None
+    a_max: float | None = None
+    recovery: bool = True
+
+
 def _comparison(
     robot: Robot,
     waypoints: ArrayLike,
     problem: TimingProblem | None,
     written: tuple[ArrayLike | None, ArrayLike | None],
-    options: dict[str, Any],
+    blends: ArrayLike | None,
+    caps: Caps,
     objective: Objective | None,
 ) -> tuple[_Checks, Array, Array]:
     """The checks of one comparison and the program as written (per-move ``v``, ``a`` from the
-    ``written`` speeds and accelerations), building the problem from ``options``
-    (:func:`timing_problem`'s keywords) and ``objective`` unless given."""
+    ``written`` speeds and accelerations), building the problem from the blends, the caps and
+    ``objective`` unless given."""
     if problem is None:
-        problem = timing_problem(robot, waypoints, **options, objective=objective)
-    checks = _Checks(robot, problem, options["v_max"], options["a_max"], options["recovery"])
+        problem = timing_problem(
+            robot,
+            waypoints,
+            blends=blends,
+            v_max=caps.v_max,
+            a_max=caps.a_max,
+            recovery=caps.recovery,
+            objective=objective,
+        )
+    checks = _Checks(robot, problem, caps.v_max, caps.a_max, caps.recovery)
     v_prog, a_prog = program_settings(problem, *written)
     return checks, v_prog, a_prog
 
@@ -251,7 +277,6 @@ def _optimum(
     *,
     share_budget: bool,
     maxiter: int = 150,
-    deadline: float | None = None,
 ) -> tuple[ProgramResult, Solution | None, int]:
     """Solve, re-simulate at 500 Hz, and tighten the bounds by any excess found there (up to
     four attempts). Returns the verified program, the last solution (None at the fastest cycle
@@ -274,7 +299,6 @@ def _optimum(
             share_budget=share_budget,
             torque_margin=margin,
             maxiter=maxiter,
-            deadline=deadline,
         )
         iterations += sol.iterations
         result = checks.run(sol.v, sol.a, "optimized", sol.value)
@@ -283,11 +307,7 @@ def _optimum(
             for kind, (ratio, _, _) in result.check.worst().items()
             if ratio > 1.0 + LIMIT_TOL
         }
-        if (
-            not over
-            or "position" in over
-            or (deadline is not None and time.process_time() > deadline)
-        ):
+        if not over or "position" in over:
             break  # (a movej cannot leave the box its waypoints span: nothing to tighten)
         current = _tightened(current, over)
         if "torque" in over:
@@ -320,34 +340,57 @@ def _active(problem: TimingProblem, result: ProgramResult) -> list[str]:
     return out
 
 
+@dataclass(frozen=True)
+class Verified:
+    """How a verified timing came about: why the solver stopped (None at the fastest cycle
+    time, where nothing is left to choose), whether its start (uniform scaling, or another
+    named one) was kept because the solver ended above it, and the solver's iterations (all
+    attempts)."""
+
+    outcome: Outcome | None
+    start_kept: bool
+    iterations: int
+    start: str = "uniform scaling"
+
+    @property
+    def words(self) -> str:
+        """``optimal``, ``improved, iteration limit``, ... (:attr:`Outcome.words`), and what
+        was kept instead when the solver ended above its start."""
+        text = (
+            "fastest cycle time: every move at its limits"
+            if self.outcome is None
+            else self.outcome.words
+        )
+        if self.start_kept:
+            text += f"; the solver ended above {self.start}, which is kept"
+        elif self.start != "uniform scaling":
+            text += f" (from {self.start})"
+        return text
+
+
 def best_verified(
     checks: Checks,
     cycle_time: float,
     v0: Array,
     a0: Array,
-    uniform: ProgramResult,
+    start: ProgramResult,
     share_budget: bool,
     maxiter: int = 150,
-    deadline: float | None = None,
-) -> tuple[ProgramResult, str, int]:
+    label: str = "uniform scaling",
+) -> tuple[ProgramResult, Verified]:
     """The verified optimum at ``cycle_time`` from ``(v0, a0)``: solved, re-simulated at 500 Hz
-    and re-solved with the caps tightened by any excess found there (up to four attempts), or
-    ``uniform`` should the solver end above it; the solver's message (and the fallback taken)
-    and its iterations (``maxiter``: SLSQP's limit per attempt; ``deadline``: a
-    ``time.process_time()`` after which the solver stops where it is and no further attempt is
-    made)."""
+    and re-solved with the caps tightened by any excess found there (up to four attempts of at
+    most ``maxiter`` SLSQP iterations each), or ``start`` (``label``: uniform scaling, by
+    default) should the solver end above it; and how it came about. The solver stops on
+    iterations and tolerances only: the same answer on every host."""
     optimized, sol, iterations = _optimum(
-        checks, cycle_time, v0, a0, share_budget=share_budget, maxiter=maxiter, deadline=deadline
+        checks, cycle_time, v0, a0, share_budget=share_budget, maxiter=maxiter
     )
-    message = "fastest cycle time: every move at its limits" if sol is None else sol.message
     # uniform scaling to the budget is the program itself at the program's own cycle time
-    if uniform_wins(uniform, optimized):
-        message += (
-            f"; the solver ended above uniform scaling ({optimized.e_elec:.6g} J vs "
-            f"{uniform.e_elec:.6g} J): kept uniform scaling"
-        )
-        optimized = checks.run(uniform.speeds, uniform.accels, "optimized")
-    return optimized, message, iterations
+    kept = uniform_wins(start, optimized)
+    if kept:
+        optimized = checks.run(start.speeds, start.accels, "optimized")
+    return optimized, Verified(None if sol is None else sol.outcome, kept, iterations, label)
 
 
 def _budget(cycle_time: float | None, program: ProgramResult, fastest: float) -> float:
@@ -412,7 +455,7 @@ def optimize_timing(
         The program, uniform scaling to ``cycle_time`` (speeds times ``k``, accelerations times
         ``k^2``) and the optimum, each re-simulated at 500 Hz (energy, and every limit at every
         sample). The optimum never scores worse than uniform scaling when that keeps the limits:
-        should the solver end above it, uniform scaling is returned (and ``message`` says so).
+        should the solver end above it, uniform scaling is returned (and ``solver`` says so).
 
     Raises
     ------
@@ -420,16 +463,15 @@ def optimize_timing(
         Bad inputs, or a cycle time shorter than the fastest feasible.
     """
     started = time.perf_counter()
-    options = {"blends": blends, "v_max": v_max, "a_max": a_max, "recovery": recovery}
     checks, v_prog, a_prog = _comparison(
-        robot, waypoints, problem, (speeds, accels), options, objective
+        robot, waypoints, problem, (speeds, accels), blends, Caps(v_max, a_max, recovery), objective
     )
     problem = checks.problem
     program = checks.run(v_prog, a_prog, "program")
     budget = _budget(cycle_time, program, problem.fastest_cycle_time)
     uniform = checks.run(*uniform_scaling(v_prog, a_prog, program.cycle_time / budget), "uniform")
     v0, a0 = _scaled_to(problem, v_prog, a_prog, budget)
-    optimized, message, iterations = best_verified(checks, budget, v0, a0, uniform, share_budget)
+    optimized, verified = best_verified(checks, budget, v0, a0, uniform, share_budget)
     return TimingResult(
         cycle_time=budget,
         program=program,
@@ -439,9 +481,9 @@ def optimize_timing(
         v_cap=problem.v_cap,
         a_cap=problem.a_cap,
         active=_active(problem, optimized),
-        iterations=iterations,
+        iterations=verified.iterations,
         seconds=time.perf_counter() - started,
-        message=message,
+        solver=verified,
     )
 
 
@@ -511,9 +553,8 @@ def pareto_front(
     list of ParetoPoint
         By increasing cycle time.
     """
-    options = {"blends": blends, "v_max": v_max, "a_max": a_max, "recovery": recovery}
     checks, v_prog, a_prog = _comparison(
-        robot, waypoints, problem, (speeds, accels), options, objective
+        robot, waypoints, problem, (speeds, accels), blends, Caps(v_max, a_max, recovery), objective
     )
     problem = checks.problem
     own = problem.cycle_time(v_prog, a_prog)

@@ -26,7 +26,9 @@ from kinergy.trajectory.movel import ToolSegment, joints_on_path, tool_motion
 from kinergy.trajectory.program_path import ProgramPath
 
 __all__ = [
+    "LineTable",
     "Schedule",
+    "line_tables",
     "payload_index",
     "program_motion",
     "sample_path",
@@ -34,6 +36,10 @@ __all__ = [
     "schedule_profiles",
     "tool_runs",
 ]
+
+
+#: points of a straight tool line's table (:class:`LineTable`)
+_TABLE_POINTS = 129
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,8 +171,105 @@ def _tool_run(
     return dq, dqd, dqdd
 
 
+@dataclass(frozen=True, eq=False)
+class LineTable:
+    """The joints along one straight tool line as a function of the distance along it, for
+    sampling the line at many timings (the optimiser's quadrature): at ``s`` (0 to the line's
+    length, m or rad) the joints ``q(s)``, ``q'(s) = dq/ds`` and ``q''(s)`` from the inverse
+    kinematics and the TCP Jacobian (:func:`kinergy.trajectory.movel.joints_on_path` at unit
+    path speed), interpolated between the points by quintic Hermite polynomials (error of order
+    ``h^6``). Then ``qd = q' sd`` and ``qdd = q' sdd + q'' sd^2`` for any profile ``s(t)``.
+
+    Attributes
+    ----------
+    s : ndarray, shape (P,)
+    q, d1, d2 : ndarray, shape (P, n)
+    """
+
+    s: Array
+    q: Array
+    d1: Array
+    d2: Array
+
+    def at(self, s: Array) -> tuple[Array, Array, Array]:
+        """``q``, ``q'`` and ``q''`` at distances ``s`` (S,): each (S, n)."""
+        h = float(self.s[1] - self.s[0])
+        x = np.clip(np.asarray(s, dtype=float), self.s[0], self.s[-1])
+        i = np.minimum(((x - self.s[0]) / h).astype(np.intp), self.s.size - 2)
+        t = ((x - self.s[i]) / h)[:, None]
+        t2, t3, t4, t5 = t * t, t**3, t**4, t**5
+        q0, q1 = self.q[i], self.q[i + 1]
+        a0, a1 = self.d1[i] * h, self.d1[i + 1] * h
+        b0, b1 = self.d2[i] * h * h, self.d2[i + 1] * h * h
+        basis = (
+            (1 - 10 * t3 + 15 * t4 - 6 * t5, -30 * t2 + 60 * t3 - 30 * t4, -60 * t + 180 * t2 - 120 * t3),
+            (t - 6 * t3 + 8 * t4 - 3 * t5, 1 - 18 * t2 + 32 * t3 - 15 * t4, -36 * t + 96 * t2 - 60 * t3),
+            (0.5 * t2 - 1.5 * t3 + 1.5 * t4 - 0.5 * t5, t - 4.5 * t2 + 6 * t3 - 2.5 * t4,
+             1 - 9 * t + 18 * t2 - 10 * t3),
+            (10 * t3 - 15 * t4 + 6 * t5, 30 * t2 - 60 * t3 + 30 * t4, 60 * t - 180 * t2 + 120 * t3),
+            (-4 * t3 + 7 * t4 - 3 * t5, -12 * t2 + 28 * t3 - 15 * t4, -24 * t + 84 * t2 - 60 * t3),
+            (0.5 * t3 - t4 + 0.5 * t5, 1.5 * t2 - 4 * t3 + 2.5 * t4, 3 * t - 12 * t2 + 10 * t3),
+        )  # fmt: skip
+        values = (q0, a0, b0, q1, a1, b1)
+        q = sum(b[0] * v for b, v in zip(basis, values, strict=True))
+        d1 = sum(b[1] * v for b, v in zip(basis, values, strict=True)) / h
+        d2 = sum(b[2] * v for b, v in zip(basis, values, strict=True)) / (h * h)
+        return np.asarray(q), np.asarray(d1), np.asarray(d2)
+
+
+def line_tables(robot: Robot, path: ProgramPath) -> dict[int, LineTable]:
+    """A :class:`LineTable` of every tool move that runs alone (not blended into another tool
+    move), by move index."""
+    out = {}
+    for run in tool_runs(path):
+        if len(run) != 1:
+            continue
+        k = run[0]
+        segment = path.tool[k]
+        assert segment is not None and path.geometry is not None
+        length = max(segment.length, 1e-12)
+        s = np.linspace(0.0, length, _TABLE_POINTS)
+        one, zero = np.ones((s.size, 1)), np.zeros((s.size, 1))
+        pose, twist, acc = tool_motion(
+            segment.start, segment.shift[None], segment.turn[None], np.array([length]),
+            s[:, None], one, zero,
+        )  # fmt: skip
+        ref = path.q_start[k] + (path.q_end[k] - path.q_start[k]) * (s / length)[:, None]
+        q, d1, d2 = joints_on_path(
+            robot, path.geometry, path.tcp[k], int(path.branch[k]), pose, twist, acc, ref
+        )
+        out[k] = LineTable(s, q, d1, d2)
+    return out
+
+
+def _tabled_run(
+    table: LineTable, path: ProgramPath, sched: Schedule, t: Array, k: int
+) -> tuple[Array, Array, Array]:
+    """The joint displacement, speed and acceleration a lone tool move adds, (B, M, n), from
+    its table."""
+    q_a = path.q_start[k]
+    shape = (*t.shape, q_a.size)
+    dq, dqd, dqdd = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+    end = sched.start[:, k : k + 1] + sched.duration[:, k : k + 1]
+    dq[:] = np.where((t >= end)[..., None], path.q_end[k] - q_a, 0.0)
+    active = (t > sched.start[:, k : k + 1]) & (t < end)
+    if not np.any(active):
+        return dq, dqd, dqdd
+    s, sd, sdd = (x[active] for x in _profiles(sched, t, k))
+    q, d1, d2 = table.at(s)
+    dq[active] = q - q_a
+    dqd[active] = d1 * sd[:, None]
+    dqdd[active] = d1 * sdd[:, None] + d2 * (sd * sd)[:, None]
+    return dq, dqd, dqdd
+
+
 def sample_path(
-    robot: Robot, path: ProgramPath, sched: Schedule, t: ArrayLike
+    robot: Robot,
+    path: ProgramPath,
+    sched: Schedule,
+    t: ArrayLike,
+    *,
+    tables: dict[int, LineTable] | None = None,
 ) -> tuple[Array, Array, Array]:
     """Joint angles, speeds and accelerations of B scheduled programs at times ``t``.
 
@@ -178,6 +281,10 @@ def sample_path(
         B programs on ``path`` (:func:`schedule`).
     t : array_like, shape (B, M)
         Times from each program's start, s.
+    tables : dict of int to LineTable, optional
+        Tool moves sampled from their tables (:func:`line_tables`) rather than by inverse
+        kinematics at every sample: the optimiser's quadrature; the 500 Hz verification does
+        without.
 
     Returns
     -------
@@ -198,7 +305,10 @@ def sample_path(
         qd += sd[..., None] * unit
         qdd += sdd[..., None] * unit
     for run in tool_runs(path):
-        dq, dqd, dqdd = _tool_run(robot, path, sched, times, run)
+        if tables is not None and len(run) == 1 and run[0] in tables:
+            dq, dqd, dqdd = _tabled_run(tables[run[0]], path, sched, times, run[0])
+        else:
+            dq, dqd, dqdd = _tool_run(robot, path, sched, times, run)
         q += dq
         qd += dqd
         qdd += dqdd

@@ -97,17 +97,32 @@ def optimize_task(
         problem = timing_problem(
             robot, task.waypoints, blends=task.blends, v_max=v_max, a_max=a_max
         )
-        common: dict[str, Any] = {
-            "speeds": task.speeds,
-            "accels": task.accels,
-            "blends": task.blends,
-            "v_max": v_max,
-            "a_max": a_max,
-            "share_budget": share_budget,
-            "problem": problem,
-        }
-        result = optimize_timing(robot, task.waypoints, cycle_time=cycle_time, **common)
-        front = pareto_front(robot, task.waypoints, points=points, **common) if points else []
+        result = optimize_timing(
+            robot,
+            task.waypoints,
+            cycle_time=cycle_time,
+            speeds=task.speeds,
+            accels=task.accels,
+            blends=task.blends,
+            v_max=v_max,
+            a_max=a_max,
+            share_budget=share_budget,
+            problem=problem,
+        )
+        front = []
+        if points:
+            front = pareto_front(
+                robot,
+                task.waypoints,
+                points=points,
+                speeds=task.speeds,
+                accels=task.accels,
+                blends=task.blends,
+                v_max=v_max,
+                a_max=a_max,
+                share_budget=share_budget,
+                problem=problem,
+            )
     except KinergyError as exc:
         raise exc.prefixed(f"{task.name}") from None
     return result, front

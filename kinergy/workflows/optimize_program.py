@@ -23,6 +23,7 @@ from kinergy.io.urscript import program_script, write_script
 from kinergy.io.urscript_reader import parse_program, read_program
 from kinergy.model.robot import Robot
 from kinergy.optimize.objectives import PROGRAM_OBJECTIVE
+from kinergy.optimize.options import ProgramOptions
 from kinergy.optimize.program_verify import simulate_path
 from kinergy.optimize.programs import ProgramOptimization, optimize_program, supply
 from kinergy.trajectory.motion import Motion
@@ -68,13 +69,20 @@ def optimized_script(result: ProgramOptimization) -> str:
     """The optimised program as URScript, with a header saying what changed and its figures."""
     own, opt = result.program.result, result.optimized.result
     kept = [lv.name for lv in result.levers if lv.kept and lv.name not in ("program",)]
+    options = result.settings.options
     header = [
         f"kinergy optimize: {100 * result.saving:.1f} % less supply energy (model-predicted) "
         f"than the program as written: {own.score:.1f} J -> {opt.score:.1f} J per cycle of "
         f"{opt.cycle_time:.3f} s",
-        f"levers used: {', '.join(kept) or 'none'}; tool symmetry "
-        f"{result.settings['tool_symmetry']}, configurations {result.settings['configurations']}",
+        f"levers used: {', '.join(kept) or 'none'}; tool symmetry {options.tool_symmetry.value}, "
+        f"configurations {options.configurations.value}, via points {options.via.value}",
     ]
+    left = [c.line for c in result.targets if c.left_out]
+    if left:
+        header.append(
+            "via points left out of the route (they take the joints of the target before "
+            f"them): line{'s' if len(left) > 1 else ''} {', '.join(map(str, left))}"
+        )
     return program_script(result.written, header)
 
 
@@ -106,11 +114,11 @@ def run_program_optimize(
     *,
     urscript: str | os.PathLike[str] | None = None,
     motions: str | os.PathLike[str] | None = None,
+    options: ProgramOptions | None = None,
     progress: Callable[[str], None] | None = None,
-    **options: Any,
 ) -> ProgramRun:
-    """``kinergy optimize ROBOT PROGRAM.script``: read, optimise (``options``: those of
-    :func:`kinergy.optimize.programs.optimize_program`), read the result back, write.
+    """``kinergy optimize ROBOT PROGRAM.script``: read, optimise with ``options``
+    (:func:`kinergy.optimize.programs.optimize_program`), read the result back, write.
 
     Raises
     ------
@@ -121,13 +129,13 @@ def run_program_optimize(
     source = Path(program_file)
     check_outputs([("--urscript", urscript), ("--motions", motions)], [source])
     program = read_program(source)
-    result = optimize_program(robot, program, progress=progress, **options)
+    result = optimize_program(robot, program, options, progress=progress)
     script = optimized_script(result)
     back = parse_program(script, path=f"{source.stem}_optimized.script", name=program.name)
     again = simulate_path(
         robot,
         program_path(robot, back),
-        objective=PROGRAM_OBJECTIVE(float(result.settings["standby"])),
+        objective=PROGRAM_OBJECTIVE(result.settings.standby),
     )
     readback = supply(again.result)
     written = _write((result, script), urscript, motions)
