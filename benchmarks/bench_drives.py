@@ -7,7 +7,7 @@ Each part prints its figures and a markdown-ready line; ``--part`` runs one of t
   voltage against the measured ``U``.
 - ``ur10e``: identify the UR10e on its unloaded Fourier runs with ``--friction auto`` and with
   Coulomb + viscous, predict the held-out ``ptp_10_points`` log: current RMS per joint.
-- ``twin``: a realistic twin (:func:`kinergy.simulate.realistic_truth`), one 60 s excitation log
+- ``twin``: a realistic twin (:func:`kinergy.twin.realistic_truth`), one 60 s excitation log
   (the one ``kinergy excite`` designs, then a random Fourier one for contrast), identified
   (sequential with ``friction="auto"``, then the electrics and standby from the logged voltages
   and supply): each drive parameter against the truth; the full method's base parameters
@@ -35,17 +35,17 @@ from kinergy.accounting.energy import energy
 from kinergy.drives.electrics import DQ_VOLTAGE_FACTOR, back_emf_constants, winding_resistances
 from kinergy.dynamics.regressor import base_parameters, inertial_parameters
 from kinergy.friction.registry import friction_torque
-from kinergy.identify.full import FullFit, identify_full
-from kinergy.identify.result import IdentificationResult, predict
+from kinergy.identification.full import FullFit, identify_full
+from kinergy.identification.result import IdentificationResult, predict
 from kinergy.io.rtde import read_log, write_log
 from kinergy.io.ur_calibration import read_ur_calibration
 from kinergy.logs.prepare import IdentData, prepare
 from kinergy.model.robot import Robot
 from kinergy.predict import drive_state
-from kinergy.simulate import TwinSettings, realistic_truth, simulate
 from kinergy.trajectory.fourier import fourier_motion
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import TwinSettings, realistic_truth, simulate
 from kinergy.workflows.calibration import import_calibration
 from kinergy.workflows.energy import energy_of_log
 from kinergy.workflows.excite import ExciteOptions, run_excite

@@ -20,12 +20,12 @@ from pathlib import Path
 import numpy as np
 
 import kinergy
-from kinergy.identify.full import identify_full
-from kinergy.identify.sequential import identify_sequential
+from kinergy.identification.full import identify_full
+from kinergy.identification.sequential import identify_sequential
 from kinergy.io.rtde import read_log, write_log
 from kinergy.logs.prepare import prepare
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_motion
+from kinergy.twin import TwinSettings, simulate
 
 
 def main() -> None:

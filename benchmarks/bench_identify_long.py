@@ -38,8 +38,8 @@ import numpy as np
 import kinergy
 from kinergy.io.rtde import write_log
 from kinergy.model import Payload
-from kinergy.simulate import simulate
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import simulate
 
 #: the payload of the payload case
 PAYLOAD = Payload(mass=2.0, com=[0.01, -0.02, 0.05])

@@ -112,7 +112,7 @@ def standstill_evidence(model: Path) -> dict:
     falls there, R^2 while it moves, and the ceiling set by the current's wander within each
     standstill around its own mean (no model predicting a steady current at rest can explain
     it); then what sets the level at rest (:func:`rest_level_evidence`)."""
-    from kinergy.identify.result import predict
+    from kinergy.identification.result import predict
     from kinergy.model import load_robot
 
     data = ur10e_logs([HELD_OUT])[0]
@@ -152,7 +152,7 @@ def rest_level_evidence(model: Path) -> dict:
     (``target_moment``) during the wrist-3 stops of ptp_10_points."""
     import dataclasses
 
-    from kinergy.identify.result import predict
+    from kinergy.identification.result import predict
     from kinergy.model import Friction, load_robot
 
     robot = load_robot(str(model))
@@ -257,7 +257,7 @@ def pair_difference(model: Path, loaded: Path) -> dict:
     from kinergy.drives.electrics import torque_constants
     from kinergy.drives.transmission import joint_torque
     from kinergy.dynamics.regressor import regressor
-    from kinergy.identify.payload import _com, block_std
+    from kinergy.identification.payload import _com, block_std
     from kinergy.linalg import scaled_lstsq
     from kinergy.model import load_robot
 

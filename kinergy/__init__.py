@@ -44,11 +44,12 @@ _API = {
     "EnergyReport": "kinergy.accounting.energy",
     "energy": "kinergy.api",
     "identify": "kinergy.api",
+    "optimize_program": "kinergy.api",
     "read_log": "kinergy.api",
     "simulate": "kinergy.api",
     "validate": "kinergy.api",
-    "IdentificationResult": "kinergy.identify.result",
-    "ValidationReport": "kinergy.identify.validation",
+    "IdentificationResult": "kinergy.identification.result",
+    "ValidationReport": "kinergy.identification.validation",
     "LogEnergy": "kinergy.workflows.energy",
     "Log": "kinergy.io.log",
     "KinergyError": "kinergy.errors",
@@ -86,6 +87,7 @@ __all__ = [
     "load_robot",
     "mass_matrix",
     "movej",
+    "optimize_program",
     "parameter_names",
     "read_log",
     "regressor",
@@ -97,7 +99,7 @@ __all__ = [
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from kinergy.accounting.energy import EnergyReport
-    from kinergy.api import energy, identify, read_log, simulate, validate
+    from kinergy.api import energy, identify, optimize_program, read_log, simulate, validate
     from kinergy.dynamics.kinematics import flange_pose, jacobian, link_poses
     from kinergy.dynamics.regressor import (
         BaseParameters,
@@ -108,8 +110,8 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     )
     from kinergy.dynamics.rnea import forward_dynamics, gravity_torque, mass_matrix, rnea
     from kinergy.errors import KinergyError
-    from kinergy.identify.result import IdentificationResult
-    from kinergy.identify.validation import ValidationReport
+    from kinergy.identification.result import IdentificationResult
+    from kinergy.identification.validation import ValidationReport
     from kinergy.io.log import Log
     from kinergy.model.library import library_names, load_robot
     from kinergy.model.robot import Payload, Robot

@@ -14,6 +14,8 @@ with its checks), ``notes`` and ``warnings``.
 ``energy(model, log_or_motion)``    ``kinergy energy``: :class:`LogEnergy` of a log or motion
                                     file, :class:`EnergyReport` of a :class:`Motion`
 ``simulate(robot, trajectory)``     ``kinergy simulate``: the twin's :class:`Log`
+``optimize_program(model, prog)``  ``kinergy optimize``: a URScript program's or a task's
+                                    energy-optimal version at the same cycle time
 =================================  ==========================================================
 """
 
@@ -26,9 +28,9 @@ from typing import Any
 from kinergy.accounting.energy import EnergyReport
 from kinergy.accounting.energy import energy as _energy_of_motion
 from kinergy.errors import KinergyError
-from kinergy.identify.options import IdentifyOptions, Method, Solver, Target
-from kinergy.identify.result import IdentificationResult
-from kinergy.identify.validation import ValidationReport
+from kinergy.identification.options import IdentifyOptions, Method, Solver, Target
+from kinergy.identification.result import IdentificationResult
+from kinergy.identification.validation import ValidationReport
 from kinergy.io.columns import parse_columns
 from kinergy.io.formats import read_log as _read_file
 from kinergy.io.log import Log
@@ -37,16 +39,19 @@ from kinergy.logs.checks import parse_accept
 from kinergy.logs.reading import CheckedLog, LogReading
 from kinergy.model.library import load_robot
 from kinergy.model.robot import Robot
-from kinergy.simulate import TwinSettings
-from kinergy.simulate import simulate as _simulate
+from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import TEST_TRAJECTORIES, paper_trajectory
+from kinergy.twin import TwinSettings
+from kinergy.twin import simulate as _simulate
 from kinergy.workflows.energy import LogEnergy, energy_of_log
 from kinergy.workflows.identify import identify_logs
+from kinergy.workflows.optimize import OptimizeRun, run_optimize
+from kinergy.workflows.optimize_program import ProgramRun, run_program_optimize
 from kinergy.workflows.twin import twin_truth
 from kinergy.workflows.validate import validate_logs
 
-__all__ = ["energy", "identify", "read_log", "simulate", "validate"]
+__all__ = ["energy", "identify", "optimize_program", "read_log", "simulate", "validate"]
 
 PathLike = str | os.PathLike[str]
 RobotLike = Robot | PathLike
@@ -222,3 +227,52 @@ def simulate(
         )
     name = trajectory if isinstance(trajectory, str) else "twin"
     return _simulate(twin_truth(r, mismatch, seed), motion, settings, name=name)
+
+
+def optimize_program(
+    model: RobotLike,
+    program: PathLike,
+    *,
+    configurations: str = "keep",
+    tool_symmetry: str = "none",
+    via: str = "keep",
+    blends: bool = True,
+    standby: float | None = None,
+    cycle_time: float | None = None,
+    v_max: float | None = None,
+    a_max: float | None = None,
+    urscript: PathLike | None = None,
+) -> ProgramRun | OptimizeRun:
+    """``kinergy optimize``: the same job with less energy from the supply, at the same cycle
+    time (``cycle_time``, s: another; None: the program's own).
+
+    ``program``: a URScript program (``*.script``: the levers ``configurations`` (``keep`` or
+    ``free``), ``tool_symmetry`` (``none``, ``z``, ``z2``, ``z4``), ``via`` (``keep`` or
+    ``free``), ``blends`` and the timing, judged by the supply energy with ``standby`` W; a
+    :class:`~kinergy.workflows.optimize_program.ProgramRun`), or a task file or built-in task
+    (``"test-a"``, ``"test-b"``: the timing only; an
+    :class:`~kinergy.workflows.optimize.OptimizeRun`). ``v_max`` (rad/s) and ``a_max``
+    (rad/s²) cap every joint (None: a program's own peaks; a task: the robot's limits).
+    ``urscript``: write the optimised program there.
+
+    Raises
+    ------
+    KinergyError
+        One line naming the option or the program's line at fault.
+    """
+    r = _robot(model)
+    if os.fspath(program).endswith(".script"):
+        options = ProgramOptions(
+            configurations=Configurations.parse(configurations),
+            tool_symmetry=ToolSymmetry.parse(tool_symmetry),
+            via=ViaPoints.parse(via),
+            blends=blends,
+            standby=standby,
+            cycle_time=cycle_time,
+            v_max=v_max,
+            a_max=a_max,
+        )
+        return run_program_optimize(r, program, urscript=urscript, options=options)
+    return run_optimize(
+        r, program, cycle_time=cycle_time, v_max=v_max, a_max=a_max, points=0, urscript=urscript
+    )

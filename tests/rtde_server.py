@@ -227,8 +227,8 @@ class RtdeServer:
 def twin_log() -> Log:
     """The UR5e twin running the UR5e doc's test A (13.5 s at 500 Hz), realistic noise."""
     import kinergy
-    from kinergy.simulate import TwinSettings, simulate
     from kinergy.trajectory.programs import paper_trajectory
+    from kinergy.twin import TwinSettings, simulate
 
     robot = kinergy.load_robot("ur5e")
     return simulate(robot, paper_trajectory(robot, "test-a"), TwinSettings(seed=3))

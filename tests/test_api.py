@@ -53,10 +53,8 @@ def _same(api: Any, cli: Any, where: str = "") -> None:
 
 @pytest.mark.skipif(not UR10E.exists(), reason="shared datasets not available")
 def test_identify_validate_energy_equal_the_commands(tmp_path, capsys) -> None:
-    from kinergy.api import identify
-
     robot = kinergy.load_robot("ur10e")
-    result = identify(FOURIER, robot, columns=SPEC, out=tmp_path / "api.toml")
+    result = kinergy.identify(FOURIER, robot, columns=SPEC, out=tmp_path / "api.toml")
     argv = ["identify", *map(str, FOURIER), "--robot", "ur10e", "--columns", SPEC]
     cli = _cli([*argv, "--out", str(tmp_path / "cli.toml"), "--json"], capsys)
     _same(_plain(result.to_dict()), cli)
@@ -79,12 +77,13 @@ def test_identify_validate_energy_equal_the_commands(tmp_path, capsys) -> None:
 
 
 def test_read_log_checks_with_a_robot_and_simulate_writes_the_twin() -> None:
-    from kinergy.api import simulate
+    import kinergy.identification.sequential  # a sub-package never shadows the function
 
-    log = simulate("ur5e", "test-b", mismatch="realistic", seed=2)
+    assert callable(kinergy.identify) and callable(kinergy.simulate)
+    log = kinergy.simulate("ur5e", "test-b", mismatch="realistic", seed=2)
     assert len(log) > 1000 and "actual_current" in log
     with pytest.raises(kinergy.KinergyError, match="trajectory must be"):
-        simulate("ur5e", "test-c")
+        kinergy.simulate("ur5e", "test-c")
     motion_energy = kinergy.energy(
         "ur5e", kinergy.movej([[0] * 6, [1, -1, 1, 0, 1, 0]], speed=1.0, acceleration=2.0, dt=0.002)
     )
@@ -99,3 +98,30 @@ def test_read_log_through_the_checks() -> None:
     with pytest.raises(kinergy.KinergyError, match="speeds check failed"):
         kinergy.read_log(HELD_OUT, columns=swapped, robot="ur10e")
     assert len(kinergy.read_log(HELD_OUT, columns=swapped)) == len(log)  # unchecked without a robot
+
+
+def test_optimize_program_equals_the_command(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``kinergy.optimize_program`` on a URScript program and on a task gives the command's JSON;
+    a lever's name is parsed (and a wrong one refused) as the flag is."""
+    small = Path(__file__).parent / "programs" / "small.script"
+    run = kinergy.optimize_program("ur5e", small, tool_symmetry="z", urscript=tmp_path / "a.script")
+    cli = _cli(
+        ["optimize", "ur5e", str(small), "--tool-symmetry", "z", "--json",
+         "--urscript", str(tmp_path / "c.script")],
+        capsys,
+    )  # fmt: skip
+    cli.pop("inputs")
+    api = _plain(run.to_dict())
+    api["written"], cli["written"] = [], []
+    _same(api, cli)
+    assert (tmp_path / "a.script").read_text() == (tmp_path / "c.script").read_text()
+    task = kinergy.optimize_program("ur5e", "test-a")
+    cli = _cli(["optimize", "ur5e", "test-a", "--pareto-points", "0", "--json"], capsys)
+    cli.pop("inputs")
+    api = _plain(task.to_dict())
+    api["solver"].pop("seconds"), cli["solver"].pop("seconds")  # wall time
+    _same(api, cli)
+    with pytest.raises(kinergy.KinergyError, match="tool symmetry: expected one of none, z"):
+        kinergy.optimize_program("ur5e", small, tool_symmetry="z3")

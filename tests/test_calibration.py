@@ -12,8 +12,8 @@ import pytest
 import kinergy
 from kinergy.cli import main
 from kinergy.errors import KinergyError
-from kinergy.identify.electrics import fit_electrics
-from kinergy.identify.friction_curve import choose_model, fit_curve, points_from
+from kinergy.identification.electrics import fit_electrics
+from kinergy.identification.friction_curve import choose_model, fit_curve, points_from
 from kinergy.io.ur_calibration import read_ur_calibration
 from kinergy.workflows.calibration import import_calibration
 

@@ -229,8 +229,8 @@ def test_a_payload_the_model_lacks_is_named_not_refused():
     """The twin of a UR5e carrying 3 kg: read for the bare ur5e, the log passes with a warning
     that names the payload the torques fit (within 10 %)."""
     from kinergy.model import Payload
-    from kinergy.simulate import TwinSettings, simulate
     from kinergy.trajectory.programs import paper_trajectory
+    from kinergy.twin import TwinSettings, simulate
 
     ur5e = load_robot("ur5e")
     loaded = ur5e.with_payload(Payload(mass=3.0, com=[0.0, 0.0, 0.08]))

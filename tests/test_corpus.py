@@ -25,8 +25,8 @@ from clicase import run_case
 
 from kinergy.io.rtde import write_log
 from kinergy.model import load_robot, robot_to_dict
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import TwinSettings, simulate
 
 
 @dataclass
@@ -332,6 +332,8 @@ def _task_cases() -> Iterator[Case]:
         "move-not-table": "move = [1, 2]\n",
         "deep": "x = " + "[" * 20_000 + "]" * 20_000 + "\n",
         "binary": bytes(range(256)) * 8,
+        "robot-another": 'robot = "ur10e"\n' + _MOVE + _MOVE2,
+        "robot-no-file": 'robot = "nowhere.toml"\n' + _MOVE + _MOVE2,
     }
     for label, text in tasks.items():
         yield Case(

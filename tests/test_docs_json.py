@@ -225,10 +225,10 @@ def _run(argv: list[str]) -> Any:
 
 def _monitor_run() -> Any:
     """``kinergy monitor --json`` against the RTDE test server serving a repeating program."""
-    from kinergy.simulate import TwinSettings, simulate
     from kinergy.trajectory.motion import Motion
     from kinergy.trajectory.movej import movej
     from kinergy.trajectory.programs import UR_HOME, pad_rest
+    from kinergy.twin import TwinSettings, simulate
 
     robot = load_robot("ur5e")
     step = np.array([[0.0] * 6, [0.8, 0.3, -0.5, 0.2, 0.6, 0.0], [-0.5, 0.2, 0.4, 0, 0, 1]])
@@ -293,7 +293,7 @@ def _nursing_result() -> Any:
     """The nursing method on the coupled twin: its Table 6 excitation and one friction run."""
     from kinergy.experiments.friction_runs import back_and_forth_motion
     from kinergy.experiments.nursing_excitation import table6_motion
-    from kinergy.simulate import TwinSettings
+    from kinergy.twin import TwinSettings
 
     arm = load_robot("nursing-arm")
     motion, _, _ = table6_motion(arm, periods=2, dt=0.004)

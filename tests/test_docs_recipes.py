@@ -46,14 +46,6 @@ def _json(argv: list[str]) -> dict:
 
 
 @pytest.mark.skipif(not UR10E.exists(), reason="shared datasets not available")
-@pytest.mark.xfail(
-    strict=True,
-    raises=TypeError,
-    reason="kinergy.identify is the sub-package kinergy.identify once kinergy.api is imported "
-    "(kinergy.read_log imports it): Python binds a sub-package to its parent's attribute, "
-    "shadowing the public function of the same name (kinergy.simulate likewise); remove this "
-    "mark when kinergy/__init__.py keeps the functions",
-)
 def test_the_python_recipe_runs_and_matches_the_commands(tmp_path: Path) -> None:
     (tmp_path / "dynamic_calibration").mkdir()
     (tmp_path / "dynamic_calibration" / "dataset_ur10e").symlink_to(UR10E)
@@ -65,8 +57,6 @@ def test_the_python_recipe_runs_and_matches_the_commands(tmp_path: Path) -> None
     run = subprocess.run(
         [sys.executable, "recipe.py"], cwd=tmp_path, env=env, capture_output=True, text=True
     )
-    if "TypeError: 'module' object is not callable" in run.stderr:
-        raise TypeError(run.stderr.strip().splitlines()[-1])
     assert run.returncode == 0, run.stderr
     printed = dict(line.split(": ", 1) for line in run.stdout.splitlines() if ": " in line)
     r2 = ast.literal_eval(printed["held-out current R^2"])

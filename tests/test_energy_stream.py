@@ -13,8 +13,8 @@ import kinergy
 from kinergy.accounting.energy import energy
 from kinergy.cli import main
 from kinergy.io.rtde import read_log, write_log
-from kinergy.simulate import simulate
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import simulate
 from kinergy.workflows.energy import energy_of_log
 from kinergy.workflows.logs import read_motion
 

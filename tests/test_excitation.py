@@ -38,14 +38,14 @@ from kinergy.experiments.excitation_design import (
 )
 from kinergy.experiments.excitation_limits import excitation_limits
 from kinergy.experiments.excitation_problem import ExcitationProblem, excitation_problem
-from kinergy.identify.full import identify_full
-from kinergy.identify.physical import parameter_scale
+from kinergy.identification.full import identify_full
+from kinergy.identification.physical import parameter_scale
 from kinergy.io.rtde import read_log
 from kinergy.io.urscript import servoj_program
 from kinergy.logs.prepare import prepare
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_series
 from kinergy.trajectory.motion import Motion
+from kinergy.twin import TwinSettings, simulate
 
 HOME = np.array([0.0, -np.pi / 2, 0.0, -np.pi / 2, 0.0, 0.0])
 

@@ -157,7 +157,7 @@ def test_a_filter_overshoot_at_a_stop_does_not_set_the_held_friction() -> None:
 
 
 def test_the_standstill_hold_does_not_cross_from_one_log_into_the_next() -> None:
-    from kinergy.identify.drive_steps import _columns, _Signals
+    from kinergy.identification.drive_steps import _columns, _Signals
 
     wm = np.concatenate([np.full(10, 5.0), np.zeros(10), np.zeros(10), np.full(10, 5.0)])
     z = np.zeros_like(wm)

@@ -23,8 +23,8 @@ from hypothesis import strategies as st
 
 from kinergy.io.rtde import write_log
 from kinergy.model import load_robot, robot_to_dict
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import TwinSettings, simulate
 
 FUZZ = settings(
     derandomize=True,

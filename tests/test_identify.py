@@ -14,16 +14,16 @@ import pytest
 import kinergy
 from kinergy.cli import main
 from kinergy.errors import KinergyError
-from kinergy.identify.options import Hold
-from kinergy.identify.payload import identify_payload
-from kinergy.identify.result import validation_metrics
-from kinergy.identify.sequential import identify_sequential
+from kinergy.identification.options import Hold
+from kinergy.identification.payload import identify_payload
+from kinergy.identification.result import validation_metrics
+from kinergy.identification.sequential import identify_sequential
 from kinergy.io.log import Log
 from kinergy.io.rtde import read_log
 from kinergy.logs.prepare import prepare
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_motion
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import TwinSettings, simulate
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared" / "datasets"
 UR10E = DATASETS / "ur10e-innopolis"
@@ -184,6 +184,25 @@ def test_cli_identify_bad_log_leaves_no_model(
     err = capsys.readouterr().err
     assert "bad.csv: line 3, column 2 (actual_q_0)" in err and err.count("\n") == 1
     assert not out.exists()
+
+
+def test_a_torque_log_is_sent_to_the_method_that_can_use_it(
+    ur5e: kinergy.Robot, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A log with measured joint torques but neither target_moment nor actual_current (the
+    Panda's): the default method says which method and target can use it, and that one does."""
+    log = _twin(ur5e, paper_trajectory(ur5e, "test-a"), TwinSettings.exact(), "a")
+    path = tmp_path / "torques.csv"
+    signals = {k: log[k] for k in ("actual_q", "actual_qd")}
+    kinergy.io.rtde.write_log(path, log.t, {**signals, "actual_joint_torque": log["target_moment"]})
+    args = ["identify", str(path), "--robot", "ur5e", "--accept", "robot"]
+    assert main([*args, "--out", str(tmp_path / "m.toml")]) == 1
+    err = [line for line in capsys.readouterr().err.splitlines() if "compiling" not in line]
+    assert len(err) == 1 and "use --method full --target torque" in err[0]
+    assert not (tmp_path / "m.toml").exists()
+    full = ["--method", "full", "--target", "torque", "--out", str(tmp_path / "f.toml")]
+    assert main([*args, *full]) == 0
+    assert (tmp_path / "f.toml").exists()
 
 
 # --- real robots ----------------------------------------------------------------------------------

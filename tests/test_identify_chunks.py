@@ -23,19 +23,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from kinergy.identify.chunks import History, LogChunks, WholeSegment
-from kinergy.identify.drive_steps import _Signals, signal_history
-from kinergy.identify.full import FullFit
-from kinergy.identify.options import IdentifyOptions, Method, Solver, Target
-from kinergy.identify.payload import identify_payload
-from kinergy.identify.result import IdentificationResult
-from kinergy.identify.sequential import identify_sequential
+from kinergy.identification.chunks import History, LogChunks, WholeSegment
+from kinergy.identification.drive_steps import _Signals, signal_history
+from kinergy.identification.full import FullFit
+from kinergy.identification.options import IdentifyOptions, Method, Solver, Target
+from kinergy.identification.payload import identify_payload
+from kinergy.identification.result import IdentificationResult
+from kinergy.identification.sequential import identify_sequential
 from kinergy.io.rtde import write_log
 from kinergy.logs.prepare import spill_log
 from kinergy.logs.reading import CheckedLog, LogReading
 from kinergy.model import Payload, Robot, load_robot
-from kinergy.simulate import TwinSettings, realistic_truth, simulate
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import TwinSettings, realistic_truth, simulate
 from kinergy.workflows.identify import identify_logs, identify_model, identify_payload_model
 from kinergy.workflows.logs import chunked_logs, prepared_logs
 
@@ -200,13 +200,13 @@ def test_the_payload_does_not_depend_on_the_chunks(tmp_path: Path, ur5e: Robot) 
 def test_friction_held_through_standstill_crosses_chunks(twin_log: Path, ur5e: Robot) -> None:
     """With the hold on, each chunk's columns and predictions recall the last moving sample
     of the chunks before it; the result equals the whole logs' (chunks of one log held whole)."""
-    from kinergy.identify.options import Hold
+    from kinergy.identification.options import Hold
 
     datas, _ = prepared_logs([twin_log], ur5e, LogReading())
     whole = identify_sequential(ur5e, datas, hold=Hold.FULL)
     assert all(j.drive.friction.params.get("holding") == 1.0 for j in whole.robot.joints)
-    from kinergy.identify.options import CurrentOptions
-    from kinergy.identify.sequential import sequential
+    from kinergy.identification.options import CurrentOptions
+    from kinergy.identification.sequential import sequential
     from kinergy.workflows.identify import measured_electrics
 
     logs = LogChunks([WholeSegment(d) for d in datas], rows=700, spool=True)

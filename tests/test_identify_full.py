@@ -18,22 +18,22 @@ import numpy as np
 import pytest
 
 import kinergy
-import kinergy.identify.writeback as writeback
-from kinergy.identify.full import identify_full
-from kinergy.identify.physical import (
+import kinergy.identification.writeback as writeback
+from kinergy.identification.full import identify_full
+from kinergy.identification.physical import (
     inertia_vector,
     link_consistency,
     parameter_scale,
     pseudo_inertia,
     standard_from_base,
 )
-from kinergy.identify.result import IdentificationResult, validation_metrics
+from kinergy.identification.result import IdentificationResult, validation_metrics
 from kinergy.io.log import Log
 from kinergy.logs.prepare import IdentData, lowpass, prepare
 from kinergy.model.robot import Friction, inertia_matrix
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_motion
 from kinergy.trajectory.motion import Motion
+from kinergy.twin import TwinSettings, simulate
 
 PANDA_GAZ = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "panda-gaz"
 

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 import kinergy
-from kinergy.identify.sequential import identify_sequential
+from kinergy.identification.sequential import identify_sequential
 from kinergy.io.rtde import write_log
 from kinergy.logs.reading import LogReading
 from kinergy.model import load_robot
-from kinergy.simulate import simulate
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import simulate
 from kinergy.workflows.logs import prepared_logs
 
 

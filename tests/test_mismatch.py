@@ -10,11 +10,11 @@ import pytest
 
 import kinergy
 from kinergy.cli import main
-from kinergy.identify.options import IdentifyOptions
+from kinergy.identification.options import IdentifyOptions
 from kinergy.io.rtde import read_log, write_log
 from kinergy.logs.prepare import prepare
-from kinergy.simulate import TwinSettings, realistic_truth, simulate
 from kinergy.trajectory.fourier import fourier_motion
+from kinergy.twin import TwinSettings, realistic_truth, simulate
 from kinergy.workflows.identify import identify_model
 
 

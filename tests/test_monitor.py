@@ -21,9 +21,9 @@ import pytest
 import kinergy
 from kinergy.cli.app import main
 from kinergy.live.monitor import MONITOR_FIELDS, CycleTracker
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import UR_HOME, pad_rest
+from kinergy.twin import TwinSettings, simulate
 
 sys.path.insert(0, str(Path(__file__).parent))
 from rtde_server import RtdeServer

@@ -30,18 +30,22 @@ from kinergy.experiments.friction_runs import back_and_forth_motion
 from kinergy.experiments.nursing_doc import BASE_FREQUENCY, DOC_EQ21
 from kinergy.experiments.nursing_excitation import table6_motion
 from kinergy.friction.makkar import makkar
-from kinergy.identify import nursing as nu
-from kinergy.identify.cycles import cycle_average, find_period
-from kinergy.identify.friction_points import constant_speed_runs, friction_points, odd_even_friction
-from kinergy.identify.makkar_fit import fit_makkar_lsq, fit_makkar_pso
-from kinergy.identify.pso import constriction, particle_swarm
-from kinergy.identify.ridge import ridge_minimal
+from kinergy.identification import nursing as nu
+from kinergy.identification.cycles import cycle_average, find_period
+from kinergy.identification.friction_points import (
+    constant_speed_runs,
+    friction_points,
+    odd_even_friction,
+)
+from kinergy.identification.makkar_fit import fit_makkar_lsq, fit_makkar_pso
+from kinergy.identification.pso import constriction, particle_swarm
+from kinergy.identification.ridge import ridge_minimal
 from kinergy.io.log import Log
 from kinergy.logs.prepare import prepare
 from kinergy.model import load_robot, save_robot
 from kinergy.model.robot import Limits
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.fourier import fourier_motion
+from kinergy.twin import TwinSettings, simulate
 
 #: the nursing arm's joint-side Makkar curve (its file's header): the mean of Table 4's two
 TWIN_GAMMA = np.array([30.137, 9.295, 5.895, 20.884, 12.998, 1.812])
@@ -387,8 +391,8 @@ def test_the_nursing_method_does_not_depend_on_the_chunks(arm) -> None:
     """Logs cut into chunks of 997 rows (filtered on windows, cycle-averaged by sums per phase)
     give the whole logs' identification: the averaged torques to round-off of the filter's
     window (its reach: 1e-25 of the impulse response), the ridge's base parameters with them."""
-    from kinergy.identify.chunks import LogChunks, WholeSegment
-    from kinergy.identify.options import NursingOptions
+    from kinergy.identification.chunks import LogChunks, WholeSegment
+    from kinergy.identification.options import NursingOptions
 
     run = back_and_forth_motion(arm, 1)
     motion, _, _ = table6_motion(arm, periods=3, dt=0.004)

@@ -374,6 +374,22 @@ def test_task_defaults_start_at_the_last_target_and_missing_speeds_are_nan(
     assert np.all(np.isnan(task.speeds)) and np.all(np.isnan(task.accels))
 
 
+def test_a_task_written_for_another_robot_is_refused(tmp_path: Path, ur5e: Robot) -> None:
+    """The task names the robot its poses were chosen for: another model is refused in one line
+    naming both; the same robot (or a file of it, relative to the task) is accepted."""
+    path = _write(tmp_path, TASK)
+    assert load_task(path, robot=ur5e).robot == "ur5e"
+    ur10e = kinergy.load_robot("ur10e")
+    with pytest.raises(KinergyError, match=r"task.toml: robot: the task was written for ur5e, "
+                       r"the model is ur10e; give a ur5e model"):  # fmt: skip
+        load_task(path, robot=ur10e)
+    kinergy.save_robot(ur5e, tmp_path / "arm.toml")
+    path = _write(tmp_path, TASK.replace('robot = "ur5e"', 'robot = "arm.toml"'), "t2.toml")
+    assert load_task(path, robot=ur5e).moves == 2
+    with pytest.raises(KinergyError, match="written for ur5e, the model is ur10e"):
+        load_task(path, robot=ur10e)
+
+
 def test_builtin_tasks_are_the_papers_test_programs(ur5e: Robot) -> None:
     task = load_task("test-a", robot=ur5e)
     assert task.waypoints == pytest.approx(paper_waypoints(ur5e, 1))

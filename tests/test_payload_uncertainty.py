@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from kinergy.identify.payload import _disagreement, block_std
+from kinergy.identification.payload import _disagreement, block_std
 from kinergy.linalg import scaled_lstsq
 
 

@@ -18,8 +18,8 @@ from kinergy.io.log import Log
 from kinergy.logs.prepare import IdentData, prepare_segment, spill_log
 from kinergy.logs.reading import CheckedLog, LogReading
 from kinergy.model import load_robot
-from kinergy.simulate import simulate
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import simulate
 
 UR10E = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "ur10e-innopolis"
 FIELDS = ("t", "q_cmd", "qd_cmd", "qdd_cmd", "q", "qd", "qdd", "current", "tau_ref")

@@ -24,9 +24,9 @@ from kinergy.logs.prepare import (
     running_range,
     uniform_grid,
 )
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import TwinSettings, simulate
 
 DT = 0.002  # the twin's (and a UR controller's) 500 Hz
 

@@ -14,10 +14,10 @@ import kinergy
 from kinergy.accounting.supply import measured_supply, supply_energy
 from kinergy.cli import main
 from kinergy.drives.bus import supply_power
-from kinergy.identify.electrics import fit_electrics
+from kinergy.identification.electrics import fit_electrics
 from kinergy.io.rtde import write_log
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import TwinSettings, simulate
 from kinergy.workflows.energy import energy_of_log
 
 

@@ -12,8 +12,8 @@ import kinergy
 from kinergy.drives.electrics import winding_resistances
 from kinergy.drives.thermal import joint_losses, joint_temperatures
 from kinergy.errors import KinergyError
-from kinergy.simulate import TwinSettings, realistic_truth, simulate
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import TwinSettings, realistic_truth, simulate
 
 
 def test_constant_losses_approach_the_steady_state_exponentially(ur5e: kinergy.Robot) -> None:

@@ -12,8 +12,8 @@ import pytest
 import kinergy
 from kinergy.cli import main
 from kinergy.io.rtde import read_log
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.programs import paper_trajectory, paper_waypoints
+from kinergy.twin import TwinSettings, simulate
 
 pin = pytest.importorskip("pinocchio")
 from kinergy.dynamics.pinocchio import to_pinocchio  # noqa: E402

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import kinergy
-from kinergy.identify.options import IdentifyOptions, Method
-from kinergy.identify.validation import (
+from kinergy.identification.options import IdentifyOptions, Method
+from kinergy.identification.validation import (
     HOLD_SECONDS,
     SignalMetrics,
     _signal_metrics,

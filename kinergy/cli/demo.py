@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from kinergy.cli.common import print_tables, progress, report_folder_option, writes
-from kinergy.simulate import MISMATCHES
+from kinergy.twin import MISMATCHES
 from kinergy.workflows.demo import run_demo
 
 __all__ = ["TABLES", "demo"]

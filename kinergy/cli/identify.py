@@ -21,10 +21,10 @@ from kinergy.cli.common import (
 )
 from kinergy.cli.validate import validation_text
 from kinergy.friction.registry import MODELS, parameter_units
-from kinergy.identify.full import FullFit
-from kinergy.identify.options import IdentifyOptions, Method, Solver, Target
-from kinergy.identify.payload import PayloadEstimate
-from kinergy.identify.result import FLAGS, IDENTIFIED, DriveEstimate, IdentificationResult
+from kinergy.identification.full import FullFit
+from kinergy.identification.options import IdentifyOptions, Method, Solver, Target
+from kinergy.identification.payload import PayloadEstimate
+from kinergy.identification.result import FLAGS, IDENTIFIED, DriveEstimate, IdentificationResult
 from kinergy.model import load_robot
 from kinergy.workflows.identify import METHODS, identify_logs, identify_payload_model
 

@@ -14,7 +14,7 @@ from kinergy.cli.common import (
     seed_option,
     writes,
 )
-from kinergy.simulate import MISMATCHES, TwinSettings
+from kinergy.twin import MISMATCHES, TwinSettings
 from kinergy.workflows.twin import simulate_to_file
 
 __all__ = ["simulate"]

@@ -23,9 +23,9 @@ from kinergy.cli.common import (
     topic_option,
     writes,
 )
-from kinergy.identify.metrics import JointMetrics
-from kinergy.identify.result import Validation
-from kinergy.identify.validation import (
+from kinergy.identification.metrics import JointMetrics
+from kinergy.identification.result import Validation
+from kinergy.identification.validation import (
     HOLD_SECONDS,
     HOLD_SPEED,
     SignalMetrics,

@@ -1,7 +1,7 @@
 """What an excitation is designed for: the regression matrix of the full identification and its
 conditioning criterion.
 
-The regression the full identification solves (:mod:`kinergy.identify.full`)::
+The regression the full identification solves (:mod:`kinergy.identification.full`)::
 
     tau = Y_b(q, qd, qdd) pi_b + N^T diag(J) N qdd + N^T F(wm) phi
 

@@ -4,7 +4,7 @@ One joint moves back and forth at constant speed, at a ladder of speeds, the oth
 pose where gravity on it does not change (its axis vertical). At constant speed the joint needs
 no inertial torque, so the torque from the motor currents (nursing eq 21) is friction plus what
 does not depend on the direction of motion; the odd part over the two directions is friction
-(eqs 19-20, :mod:`kinergy.identify.friction_points`). This module designs the runs:
+(eqs 19-20, :mod:`kinergy.identification.friction_points`). This module designs the runs:
 
 - :func:`vertical_axis_pose`: a pose in which the moving joint's axis is parallel to gravity;
 - :func:`default_speeds`: the speed ladder;
@@ -85,7 +85,7 @@ def vertical_axis_pose(
     of the vertical poses found, the one farthest from the joint limits. ``joint`` and the joints
     after it keep ``q``'s values. Some axes can never be vertical (the nursing arm's joint 2 is
     always horizontal): the tilt says so, and
-    :func:`kinergy.identify.friction_points.friction_points` still cancels gravity by pairing
+    :func:`kinergy.identification.friction_points.friction_points` still cancels gravity by pairing
     equal positions.
 
     Returns

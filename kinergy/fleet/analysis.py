@@ -3,7 +3,7 @@
 :func:`analyse_log` runs on a Dask worker and holds one log at a time; it returns small typed
 figures, never the log's arrays. For each segment of the log (:mod:`kinergy.io.segments`):
 
-1. the program's period from the commanded joint angles (:func:`kinergy.identify.cycles.find_period`);
+1. the program's period from the commanded joint angles (:func:`kinergy.identification.cycles.find_period`);
    a segment with no repeat is one row covering it;
 2. the model over the logged motion (:func:`kinergy.accounting.energy.energy`): the joints'
    electrical power (UR5e eq 23) split into inertial, gravity, friction and copper parts
@@ -40,7 +40,7 @@ from kinergy.drives.transmission import transmission_matrix
 from kinergy.dynamics.threads import kernel_threads
 from kinergy.errors import KinergyError
 from kinergy.fleet.manifest import FleetLog
-from kinergy.identify.cycles import find_period
+from kinergy.identification.cycles import find_period
 from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
 from kinergy.io.segments import split_segments

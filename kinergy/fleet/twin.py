@@ -1,6 +1,6 @@
 """A twin fleet: N robots x D days of controller logs, some robots wearing or changing payload.
 
-Every robot is the UR5e twin (:func:`kinergy.simulate.simulate`) repeating one program, logged
+Every robot is the UR5e twin (:func:`kinergy.twin.simulate`) repeating one program, logged
 at 500 Hz in record.py layout, one file per log named ``NAME_YYYY-MM-DD_HHMM.csv`` in a folder
 per robot, with a manifest ``fleet.toml`` beside them. From log to log the joints' friction
 varies by ``jitter`` (0.5 %, seeded: temperature, lubrication); a robot in ``wear`` has its
@@ -27,10 +27,10 @@ from kinergy.friction.registry import linear_values, with_linear_parameters
 from kinergy.io.rtde import write_log
 from kinergy.model.library import load_robot
 from kinergy.model.robot import Friction, Payload, Robot
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.motion import CONTROLLER_DT, Motion
 from kinergy.trajectory.movej import movej
 from kinergy.trajectory.programs import UR_HOME, pad_rest, paper_trajectory
+from kinergy.twin import TwinSettings, simulate
 
 __all__ = ["PROGRAMS", "TwinLog", "plan", "twin_fleet", "with_friction_scaled", "write_twin_log"]
 

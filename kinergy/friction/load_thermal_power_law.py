@@ -4,7 +4,7 @@ and a speed term that falls as the joint warms:
 |wm|^exponent) tanh(wm / smoothing)``.
 
 It joins ``power_law`` (concave in speed), ``load_coulomb`` (AURT) and ``thermal_viscous``
-(Raviola et al. 2021); the realistic twin's true joints have it (:mod:`kinergy.simulate`).
+(Raviola et al. 2021); the realistic twin's true joints have it (:mod:`kinergy.twin`).
 Linear in ``coulomb``, ``load``, ``viscous`` and ``viscous_temperature`` for a fixed exponent,
 which fits find by a 1-D search. Without a temperature it is evaluated at
 ``reference_temperature``.

@@ -1,6 +1,6 @@
 """The one log type: time stamps and named signals, whatever file or stream they came from.
 
-Readers (:mod:`kinergy.io.rtde`), the twin (:mod:`kinergy.simulate`) and the recorder all produce a
+Readers (:mod:`kinergy.io.rtde`), the twin (:mod:`kinergy.twin`) and the recorder all produce a
 :class:`Log`; preprocessing, identification and energy accounting take one.
 """
 

@@ -41,6 +41,7 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import read_toml
+from kinergy.model.library import library_names, load_robot
 from kinergy.model.robot import Robot
 from kinergy.trajectory.programs import paper_speed, paper_waypoints
 
@@ -246,6 +247,28 @@ def load_task(name_or_path: str | os.PathLike[str], *, robot: Robot | None = Non
         )
     data = read_toml(path, "task file")
     try:
-        return task_from_dict(data, name=path.stem, n_joints=None if robot is None else robot.n)
+        task = task_from_dict(data, name=path.stem, n_joints=None if robot is None else robot.n)
     except KinergyError as exc:
         raise exc.prefixed(str(path)) from None
+    if robot is not None and task.robot is not None:
+        _check_robot(path, task.robot, robot)
+    return task
+
+
+def _check_robot(path: Path, named: str, robot: Robot) -> None:
+    """Refuse a task file whose ``robot`` names another robot than the one it is run on: its
+    poses and speeds were chosen for that arm. A robot file it names is read (relative to the
+    task file) for its name; an identified model keeps its robot's name."""
+    if named in library_names():
+        want = named
+    else:
+        where = path.parent / named
+        try:
+            want = load_robot(where).name
+        except KinergyError as exc:
+            raise exc.prefixed(f"{path}: robot") from None
+    if want != robot.name:
+        raise KinergyError(
+            f"{path}: robot: the task was written for {want}, the model is {robot.name}; "
+            f"give a {want} model, or remove the task's robot line to run it on {robot.name}"
+        )

@@ -4,7 +4,7 @@ A robot in production repeats one program. :class:`CycleTracker` takes the strea
 as they come and
 
 1. finds the program's period from the commanded joint angles (``target_q``) by the
-   autocorrelation search of :func:`kinergy.identify.cycles.find_period`, once two periods
+   autocorrelation search of :func:`kinergy.identification.cycles.find_period`, once two periods
    have been seen;
 2. cuts the stream into cycles one period long, each boundary re-aligned to the pose at the
    first cycle's start (the best match of a short window of ``target_q`` within a tenth of a
@@ -29,7 +29,7 @@ from scipy.integrate import trapezoid
 
 from kinergy.accounting.energy import energy
 from kinergy.arrays import Array
-from kinergy.identify.cycles import find_period
+from kinergy.identification.cycles import find_period
 from kinergy.io.log import Log
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion

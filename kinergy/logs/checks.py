@@ -28,7 +28,7 @@ sample of rows.
   (a robot file whose masses are off, a controller logging a scaled signal).
 
 ``fit`` is not a check of the log: ``identify`` uses the name for a model its fit does not
-support (:mod:`kinergy.identify`).
+support (:mod:`kinergy.identification`).
 """
 
 from __future__ import annotations

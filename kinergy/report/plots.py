@@ -35,7 +35,7 @@ from scipy.integrate import cumulative_trapezoid
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
-from kinergy.identify.metrics import r_squared
+from kinergy.identification.metrics import r_squared
 
 __all__ = [
     "DPI",

@@ -17,8 +17,8 @@ import numpy as np
 
 from kinergy.accounting.energy import EnergyReport
 from kinergy.arrays import Array
-from kinergy.identify.metrics import JointMetrics
-from kinergy.identify.result import IdentificationResult
+from kinergy.identification.metrics import JointMetrics
+from kinergy.identification.result import IdentificationResult
 from kinergy.model.robot import Robot
 from kinergy.report import seed
 from kinergy.report.html import Figure, Section, Table

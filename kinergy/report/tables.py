@@ -14,7 +14,7 @@ import numpy as np
 
 from kinergy.accounting.energy import EnergyReport
 from kinergy.friction.registry import get_model, parameter_units
-from kinergy.identify.metrics import JointMetrics
+from kinergy.identification.metrics import JointMetrics
 from kinergy.model.robot import Robot
 from kinergy.report import seed
 from kinergy.report.html import Table

@@ -7,7 +7,7 @@ For every joint of the summary (:mod:`kinergy.io.ur_calibration`):
    robot's gear ratio: ``wm = gear_ratio * speed``; ``Tau`` is motor side already), by default
    the model that cross-validates best (leave one point out) among
    :data:`CALIBRATION_CANDIDATES`, every point weighted to the same relative accuracy
-   (:mod:`kinergy.identify.friction_curve`); Coulomb + viscous is fitted beside it, for contrast;
+   (:mod:`kinergy.identification.friction_curve`); Coulomb + viscous is fitted beside it, for contrast;
 3. the motor's winding resistance and back-EMF constant by least squares on UR5e eq 19 from its
    ``U``, ``I`` and motor speed, ``U`` read as the controller's dq voltage (the equivalent DC
    motor's voltage is ``1.5 U``, :mod:`kinergy.drives.electrics`).
@@ -26,8 +26,8 @@ import numpy as np
 
 from kinergy.drives.electrics import controller_voltage, equivalent_voltage
 from kinergy.errors import KinergyError
-from kinergy.identify.electrics import ElectricsFit, fit_electrics, with_electrics
-from kinergy.identify.friction_curve import (
+from kinergy.identification.electrics import ElectricsFit, fit_electrics, with_electrics
+from kinergy.identification.friction_curve import (
     CurveFit,
     FrictionPoints,
     choose_model,

@@ -2,7 +2,7 @@
 
 1. The twin runs the UR5e doc's test programs A and B and writes their RTDE logs. With
    ``mismatch="realistic"`` (the default) the twin's true robot differs from the UR5e model as a
-   real arm differs from its data sheet (:func:`kinergy.simulate.realistic_truth`: link and
+   real arm differs from its data sheet (:func:`kinergy.twin.realistic_truth`: link and
    rotor inertias, torque constants, electrics, a concave friction that grows with the load and
    falls as the joints warm) and its controller quantises currents, adds noise, lag and supply
    ripple; with ``"none"`` the twin is the UR5e doc's own model (Tables I-IV and VI) with a 4 ms
@@ -27,10 +27,10 @@ from pathlib import Path
 
 from kinergy.files import output_folder
 from kinergy.friction.model import SMOOTHING
-from kinergy.identify.metrics import fit_metrics
-from kinergy.identify.options import AUTO, IdentifyOptions
-from kinergy.identify.result import IdentificationResult, predict
-from kinergy.identify.sequential import identify_sequential
+from kinergy.identification.metrics import fit_metrics
+from kinergy.identification.options import AUTO, IdentifyOptions
+from kinergy.identification.result import IdentificationResult, predict
+from kinergy.identification.sequential import identify_sequential
 from kinergy.io.motion import motion_from_log
 from kinergy.io.rtde import read_log, write_log
 from kinergy.io.task import load_task
@@ -38,9 +38,9 @@ from kinergy.logs.prepare import IdentData, prepare
 from kinergy.model.library import load_robot
 from kinergy.model.robot import Friction, Robot
 from kinergy.report.html import Section, Table
-from kinergy.simulate import TwinSettings, realistic_truth, simulate
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.twin import TwinSettings, realistic_truth, simulate
 from kinergy.workflows.identify import identify_model
 from kinergy.workflows.study import run_study, write_study
 
@@ -210,7 +210,7 @@ def _demo(out: Path, say: Callable[[str], None], mismatch: str) -> dict[str, lis
         compared = truth_tables(truth, result.robot, datas["test B"])
         text = (
             "The twin's true robot differs from the UR5e model being identified (seeded, "
-            "kinergy.simulate.realistic_truth); here is how close identification on test A gets "
+            "kinergy.twin.realistic_truth); here is how close identification on test A gets "
             "to it, and how well the result predicts the unseen test B."
         )
         extra.append(Section(compared[0].caption, text, compared, []))

@@ -1,7 +1,7 @@
 """``kinergy identify``: a model (or a payload) from logs, written as a robot file.
 
 Every identification reads its logs in chunks (:func:`~kinergy.workflows.logs.chunked_logs`)
-and runs as folds over them (:class:`~kinergy.identify.chunks.LogChunks`), whatever the method;
+and runs as folds over them (:class:`~kinergy.identification.chunks.LogChunks`), whatever the method;
 logs already prepared in memory (:func:`identify_model`) are one chunk each of the same folds.
 """
 
@@ -18,15 +18,15 @@ from kinergy.drives.bus import supply_power
 from kinergy.drives.electrics import electrical_power, equivalent_voltage, torque_constants
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.errors import KinergyError
-from kinergy.identify.chunks import LogChunks, Summary, data_history
-from kinergy.identify.electrics import ElectricsFit, ElectricsSums, with_electrics
-from kinergy.identify.full import full
-from kinergy.identify.nursing import nursing
-from kinergy.identify.options import CurrentOptions, IdentifyOptions, Method
-from kinergy.identify.payload import PayloadEstimate, payload
-from kinergy.identify.result import IDENTIFIED, IdentificationResult, validation_metrics
-from kinergy.identify.sanity import check_motion
-from kinergy.identify.sequential import sequential
+from kinergy.identification.chunks import LogChunks, Summary, data_history
+from kinergy.identification.electrics import ElectricsFit, ElectricsSums, with_electrics
+from kinergy.identification.full import full
+from kinergy.identification.nursing import nursing
+from kinergy.identification.options import CurrentOptions, IdentifyOptions, Method
+from kinergy.identification.payload import PayloadEstimate, payload
+from kinergy.identification.result import IDENTIFIED, IdentificationResult, validation_metrics
+from kinergy.identification.sanity import check_motion
+from kinergy.identification.sequential import sequential
 from kinergy.io.columns import compact_columns
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
@@ -69,7 +69,7 @@ def _checks(summaries: list[Summary]) -> None:
     Raises
     ------
     KinergyError
-        Logs without motion (:func:`kinergy.identify.sanity.check_motion`) or too short.
+        Logs without motion (:func:`kinergy.identification.sanity.check_motion`) or too short.
     """
     check_motion(max(float(np.max(s.span)) for s in summaries))
     seconds = sum(s.seconds for s in summaries)
@@ -106,7 +106,7 @@ def identify_model(
     ------
     KinergyError
         Logs spanning less than :data:`MIN_SECONDS` together, with signals no robot logs or
-        without motion (:mod:`kinergy.identify.sanity`).
+        without motion (:mod:`kinergy.identification.sanity`).
     """
     return identify_chunks(robot, LogChunks.of(datas, check=_checks), options)
 
@@ -209,7 +209,7 @@ def identify_logs(
 
 def _predicted_currents(robot: Robot, logs: LogChunks) -> list[np.ndarray]:
     """The currents ``robot`` predicts on every chunk, as its validation kept them
-    (:attr:`~kinergy.identify.chunks.LogChunks.currents`; validated now when it did not)."""
+    (:attr:`~kinergy.identification.chunks.LogChunks.currents`; validated now when it did not)."""
     if logs.currents is None or logs.currents[0] is not robot:
         validation_metrics(robot, logs)
     assert logs.currents is not None
@@ -242,7 +242,7 @@ def _electrics_fits(
 def _standby(robot: Robot, logs: LogChunks, currents: list[np.ndarray] | None) -> float:
     """The mean of the supply power less the motors' draw (W; UR5e eq 23 on the ``currents``
     ``robot`` predicts, else on its :func:`~kinergy.predict.drive_state`;
-    :func:`~kinergy.identify.electrics.fit_standby`'s ``standby``)."""
+    :func:`~kinergy.identification.electrics.fit_standby`'s ``standby``)."""
     n_mat, kt = transmission_matrix(robot), torque_constants(robot)
     held = data_history(robot)
     total, count = 0.0, 0
@@ -263,7 +263,7 @@ def _standby(robot: Robot, logs: LogChunks, currents: list[np.ndarray] | None) -
 
 def measured_electrics(result: IdentificationResult, logs: LogChunks) -> IdentificationResult:
     """``result`` with the motor electrics fitted to the logs' joint voltages (UR5e eq 19,
-    :class:`kinergy.identify.electrics.ElectricsSums`) and the standby power to their supply
+    :class:`kinergy.identification.electrics.ElectricsSums`) and the standby power to their supply
     power, when every log has them, the currents its robot predicts (friction held per log) as
     the instrument and the motors' draw; the fit's notes say what was written into the model.
     Unchanged for logs without them."""

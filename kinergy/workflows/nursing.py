@@ -4,15 +4,15 @@
 
 1. for every joint, the constant-speed back-and-forth friction runs
    (:func:`kinergy.experiments.friction_runs.back_and_forth_motion`), simulated by the twin
-   (:func:`kinergy.simulate.simulate`) with its current noise (the twin's default
-   :class:`~kinergy.simulate.TwinSettings`) or without; currents to joint torques by eq 21 and
+   (:func:`kinergy.twin.simulate`) with its current noise (the twin's default
+   :class:`~kinergy.twin.TwinSettings`) or without; currents to joint torques by eq 21 and
    the robot's coupling; friction as the odd part (eq 20); Makkar's model (eq 13) fitted by
    particle swarm optimisation and by least squares, next to the twin's own curve (the robot
    file's motor-side Makkar converted to the joint side, ``gamma1, gamma4 * k n``, rates ``* n``,
    ``gamma6 * k n^2``; k = 2 motors of n = 3060 on the nursing arm) and the doc's Table 4 and
    R^2 (0.927 pitch, 0.931 rotation);
 2. the excitation of Table 6 (eq 22), ten 10 s periods on the twin, then the nursing method
-   (:func:`kinergy.identify.nursing.identify_nursing`): currents filtered at 15 Hz and averaged
+   (:func:`kinergy.identification.nursing.identify_nursing`): currents filtered at 15 Hz and averaged
    over the periods (eq 24), joint torques less the identified friction and drive inertia
    (eq 25), ridge regression of the minimal parameter set on a 70/30 split in time, and the
    per-joint RMSE on the 30 % (eq 26) next to the doc's Table 8.
@@ -32,14 +32,14 @@ from kinergy.experiments.friction_runs import back_and_forth_motion
 from kinergy.experiments.nursing_doc import DOC_FRICTION_R2, DOC_TABLE4, DOC_TABLE8
 from kinergy.experiments.nursing_excitation import table6_motion
 from kinergy.friction.makkar import makkar
-from kinergy.identify.friction_points import FrictionPoints, friction_points
-from kinergy.identify.makkar_fit import MakkarFit, fit_makkar_lsq, fit_makkar_pso
-from kinergy.identify.nursing import MotorFrictionFit, NursingFit, identify_nursing
-from kinergy.identify.options import MakkarMethod
+from kinergy.identification.friction_points import FrictionPoints, friction_points
+from kinergy.identification.makkar_fit import MakkarFit, fit_makkar_lsq, fit_makkar_pso
+from kinergy.identification.nursing import MotorFrictionFit, NursingFit, identify_nursing
+from kinergy.identification.options import MakkarMethod
 from kinergy.logs.prepare import IdentData, prepare
 from kinergy.model.robot import Robot
-from kinergy.simulate import TwinSettings, simulate
 from kinergy.trajectory.motion import Motion
+from kinergy.twin import TwinSettings, simulate
 
 __all__ = [
     "DocFriction",

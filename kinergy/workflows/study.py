@@ -10,9 +10,9 @@ from pathlib import Path
 
 from kinergy.accounting.energy import energy
 from kinergy.files import output_folder
-from kinergy.identify.metrics import fit_metrics
-from kinergy.identify.result import IdentificationResult, predict
-from kinergy.identify.sequential import identify_sequential
+from kinergy.identification.metrics import fit_metrics
+from kinergy.identification.result import IdentificationResult, predict
+from kinergy.identification.sequential import identify_sequential
 from kinergy.io.task import Task
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import LogReading

@@ -10,9 +10,9 @@ from kinergy.io.rtde import write_log
 from kinergy.logs.reading import LogReading
 from kinergy.model.robot import Robot
 from kinergy.model.toml import save_robot
-from kinergy.simulate import TwinSettings, realistic_truth, simulate
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import TEST_TRAJECTORIES, paper_trajectory
+from kinergy.twin import TwinSettings, realistic_truth, simulate
 from kinergy.workflows.logs import read_motion
 
 __all__ = ["builtin_log", "is_builtin", "simulate_to_file", "twin_truth"]
@@ -20,7 +20,7 @@ __all__ = ["builtin_log", "is_builtin", "simulate_to_file", "twin_truth"]
 
 def twin_truth(robot: Robot, mismatch: str, seed: int) -> Robot:
     """The twin's true robot for ``--mismatch``: the model itself (``none``) or
-    :func:`kinergy.simulate.realistic_truth` of it, seeded (``realistic``)."""
+    :func:`kinergy.twin.realistic_truth` of it, seeded (``realistic``)."""
     return realistic_truth(robot, seed) if mismatch == "realistic" else robot
 
 

@@ -8,9 +8,9 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from kinergy.identify.result import predict
-from kinergy.identify.sanity import check_signals
-from kinergy.identify.validation import ValidationReport, validation_report
+from kinergy.identification.result import predict
+from kinergy.identification.sanity import check_signals
+from kinergy.identification.validation import ValidationReport, validation_report
 from kinergy.io.log import Log
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs, LogReading
@@ -44,7 +44,7 @@ def validate_logs(
     plots: str | os.PathLike[str] | None = None,
 ) -> ValidationReport:
     """UR5e Tables V and VII for ``logs`` (read through the checks), pooled and per log, moving
-    and holding apart (:func:`~kinergy.identify.validation.validation_report`); with ``plots``,
+    and holding apart (:func:`~kinergy.identification.validation.validation_report`); with ``plots``,
     also write the measured-against-predicted figures to that folder. A log the model was
     identified from is named in a warning."""
     sources = [builtin_log(robot, str(log)) if is_builtin(log) else log for log in logs]

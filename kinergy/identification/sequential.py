@@ -17,8 +17,8 @@ and its current keeps part of the friction of the direction it stopped in. With
 ``Hold.SEARCH`` each joint's fit is made holding 0, 25, 50, 75 and 100 % of its friction through
 standstill (the ``standstill`` and ``holding`` friction parameters) and keeps the best.
 
-Every step is a fold over the logs' prepared chunks (:mod:`kinergy.identify.chunks`): step 2's
-triangle in one pass, step 3's trials in one pass per batch (:mod:`kinergy.identify.drive_steps`),
+Every step is a fold over the logs' prepared chunks (:mod:`kinergy.identification.chunks`): step 2's
+triangle in one pass, step 3's trials in one pass per batch (:mod:`kinergy.identification.drive_steps`),
 the fit statistics in one more; logs held in memory are one chunk each.
 """
 
@@ -33,8 +33,8 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import get_model
-from kinergy.identify.chunks import STILL_SPEED, LogChunks, Summary, one_blas_thread
-from kinergy.identify.drive_steps import (
+from kinergy.identification.chunks import STILL_SPEED, LogChunks, Summary, one_blas_thread
+from kinergy.identification.drive_steps import (
     AUTO_CANDIDATES,
     CurrentStats,
     FrictionChoice,
@@ -43,8 +43,8 @@ from kinergy.identify.drive_steps import (
     rotor_step,
     with_rotor_inertias,
 )
-from kinergy.identify.options import CurrentOptions, Hold
-from kinergy.identify.result import (
+from kinergy.identification.options import CurrentOptions, Hold
+from kinergy.identification.result import (
     AT_BOUND,
     IDENTIFIED,
     KEPT,
@@ -241,9 +241,15 @@ def sequential(
     said = Messages([f"{text}; kept the model's values" for text in problems.values()])
     has_ref, has_current = logs.any("tau_ref"), logs.any("current")
     if not (has_ref or has_current):
+        torques = logs.any("torque")
         raise KinergyError(
-            "identification needs target_moment (rotor inertia) or actual_current (torque "
+            "the sequential method needs target_moment (rotor inertia) or actual_current (torque "
             "constant and friction); the logs have neither"
+            + (
+                ", but they have measured joint torques: use --method full --target torque"
+                if torques
+                else ""
+            )
         )
     active = [j for j in range(robot.n) if j not in problems]
     rotor, rotor_std, cond = rotor_step(robot, rotor_triangle, active, said)
@@ -272,7 +278,7 @@ def sequential(
 class DrivesFromCurrents:
     """Step 3 on its own (:func:`drives_from_currents`): the robot with the torque constants and
     friction the currents give, per joint the flags and standard errors of those parameters
-    (:class:`~kinergy.identify.result.DriveEstimate`), the friction fraction held through
+    (:class:`~kinergy.identification.result.DriveEstimate`), the friction fraction held through
     standstill (None where not fitted) and what the fit said (:class:`~kinergy.messages.Messages`)."""
 
     robot: Robot

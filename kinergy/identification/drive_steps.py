@@ -9,12 +9,12 @@
   friction a stopped joint holds: a *trial*) is a triangle per block of samples, folded in one
   pass over the chunks with currents together with every other trial asked for at the same
   time: the holds of every joint in one pass; a shape search (``power_law``'s exponent,
-  :func:`~kinergy.identify.friction_curve.shape_search`) a pass per step of all joints' searches;
+  :func:`~kinergy.identification.friction_curve.shape_search`) a pass per step of all joints' searches;
   ``friction="auto"`` scores each model by cross-validation over :data:`FOLDS` blocks from
   those per-block triangles (no pass of its own). When more than one pass may be needed, the
   motor signals of eq 18 (load torque, speed, acceleration, current) are kept from the first.
 
-:mod:`kinergy.identify.sequential` runs them in order and assembles the typed result.
+:mod:`kinergy.identification.sequential` runs them in order and assembles the typed result.
 
 One difference from a cross-validation that refits on the rows left: each block's rows carry the
 friction their whole log held through standstill into them, also when the block before them is
@@ -43,7 +43,7 @@ from kinergy.friction.registry import (
     start_parameters,
     with_linear_parameters,
 )
-from kinergy.identify.chunks import (
+from kinergy.identification.chunks import (
     STILL_SPEED,
     Asks,
     History,
@@ -53,9 +53,9 @@ from kinergy.identify.chunks import (
     together,
     translated,
 )
-from kinergy.identify.friction_curve import shape_search
-from kinergy.identify.options import CurrentOptions, Hold
-from kinergy.identify.result import IDENTIFIED, KEPT
+from kinergy.identification.friction_curve import shape_search
+from kinergy.identification.options import CurrentOptions, Hold
+from kinergy.identification.result import IDENTIFIED, KEPT
 from kinergy.jsonable import OPTIONAL
 from kinergy.linalg import Reduced, scaled_solution
 from kinergy.logs.prepare import IdentData
@@ -251,7 +251,7 @@ def _columns(model: str, params: dict[str, float], signals: _Signals) -> Array:
 
 
 def signal_history(still: float) -> History[_Signals]:
-    """A :class:`~kinergy.identify.chunks.History` of one motor's eq 18 signals."""
+    """A :class:`~kinergy.identification.chunks.History` of one motor's eq 18 signals."""
 
     def take(x: _Signals, index: NDArray[np.int64]) -> _Signals:
         t = None if x.temperature is None else x.temperature[index]
@@ -384,7 +384,7 @@ class _Blocks:
 
 
 class _Passes:
-    """Answers the trials of eq 18 asked for (:data:`~kinergy.identify.chunks.Asks`): each new
+    """Answers the trials of eq 18 asked for (:data:`~kinergy.identification.chunks.Asks`): each new
     batch is one pass over the logs with currents, the motor signals of ``staged`` with rotor
     inertias ``rotor`` computed on the first and, when ``keep``, kept for the others; every
     trial's triangles are cached. ``edges`` cut the samples (of those logs, stacked) into the
@@ -453,7 +453,7 @@ def _fit_hold(
     m: int, joint: Joint, model: str, params: dict[str, float]
 ) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, _Blocks]]:
     """Eq 18 for motor ``m`` from ``params``, their shape searched first where the model does
-    (:func:`~kinergy.identify.friction_curve.shape_search`, on the squared current error)."""
+    (:func:`~kinergy.identification.friction_curve.shape_search`, on the squared current error)."""
     kt = joint.drive.torque_constant
     if get_model(model).search:
         params = yield from translated(

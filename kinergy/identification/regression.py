@@ -1,7 +1,7 @@
-"""The full method's least squares (:mod:`kinergy.identify.full`, its eq (1)), from its triangles.
+"""The full method's least squares (:mod:`kinergy.identification.full`, its eq (1)), from its triangles.
 
 Eq (1)'s rows are folded chunk by chunk into one QR triangle per joint
-(:meth:`kinergy.identify.columns.Regression.rows`, :meth:`kinergy.linalg.Reduced.stack`);
+(:meth:`kinergy.identification.columns.Regression.rows`, :meth:`kinergy.linalg.Reduced.stack`);
 everything here works on those small triangles, whatever the number of samples:
 
 - column dependence (Gautier's numerical rank by pivoted QR, :func:`kinergy.linalg.pivoted_rank`):
@@ -26,10 +26,10 @@ from numpy.typing import NDArray
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.identify.chunks import LogChunks, Store
-from kinergy.identify.columns import Columns, Regression
-from kinergy.identify.drive_steps import joined
-from kinergy.identify.options import Solver
+from kinergy.identification.chunks import LogChunks, Store
+from kinergy.identification.columns import Columns, Regression
+from kinergy.identification.drive_steps import joined
+from kinergy.identification.options import Solver
 from kinergy.linalg import Reduced, ReducedSolution, pivoted_rank, solve_reduced
 from kinergy.messages import Messages
 

@@ -2,7 +2,7 @@
 
 Results are frozen dataclasses, written as JSON by :mod:`kinergy.jsonable`:
 
-- :class:`Validation`: per-joint :class:`~kinergy.identify.metrics.JointMetrics` of the reference
+- :class:`Validation`: per-joint :class:`~kinergy.identification.metrics.JointMetrics` of the reference
   torque, the current and the measured joint torque (``validate --json``);
 - :class:`Fit`: a validation on the identification logs plus what every method reports (samples,
   logs, lag, warnings); each method extends it with its own diagnostics;
@@ -20,8 +20,8 @@ from typing import Any, TypedDict
 
 from kinergy.arrays import Array
 from kinergy.drives.transmission import joint_torque
-from kinergy.identify.chunks import LogChunks, data_history
-from kinergy.identify.metrics import JointMetrics, MetricSums
+from kinergy.identification.chunks import LogChunks, data_history
+from kinergy.identification.metrics import JointMetrics, MetricSums
 from kinergy.jsonable import to_jsonable
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs

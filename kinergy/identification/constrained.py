@@ -1,6 +1,6 @@
 """The full method's physically consistent fit: least squares constrained to real bodies and drives.
 
-When the unconstrained least squares of :mod:`kinergy.identify.regression` has no physical
+When the unconstrained least squares of :mod:`kinergy.identification.regression` has no physical
 realisation (a link whose standard parameters closest to the model's are not a real body, a
 negative rotor inertia, friction outside its model's bounds), the
 robot is written from the least-squares fit constrained to physical values instead: a convex
@@ -35,15 +35,15 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.dynamics.regressor import BaseParameters
 from kinergy.friction.registry import get_model
-from kinergy.identify.columns import Columns
-from kinergy.identify.physical import (
+from kinergy.identification.columns import Columns
+from kinergy.identification.physical import (
     LENGTH_SCALE,
     PSEUDO_BASIS,
     base_projection,
     link_consistency,
     pseudo_inertia,
 )
-from kinergy.identify.regression import Solved
+from kinergy.identification.regression import Solved
 
 __all__ = ["MARGIN", "ConstrainedFit", "bounds", "physical_fit"]
 
@@ -271,14 +271,14 @@ def physical_fit(
     pi0 : ndarray, shape (10 n,)
         The model's standard parameters (payload included).
     scale : ndarray, shape (10 n,)
-        Typical size of each standard parameter (:func:`~kinergy.identify.physical.parameter_scale`).
+        Typical size of each standard parameter (:func:`~kinergy.identification.physical.parameter_scale`).
     payload : ndarray, shape (10 n,)
         The payload's share of ``pi0`` (the last link's), which the links' consistency excludes.
     names : sequence of str
         Joint names, for the active-constraint phrases.
     merged_rotor : dict
         Rotor inertias merged into link columns: motor -> its column in link base columns (b,)
-        (:class:`~kinergy.identify.regression.Merging`).
+        (:class:`~kinergy.identification.regression.Merging`).
 
     Returns
     -------

@@ -62,8 +62,8 @@ class Solver(enum.StrEnum):
 
 class Hold(enum.Enum):
     """How much of its friction a stopped joint holds through standstill, as the current fit
-    tries it (:mod:`kinergy.identify.sequential`): each fraction of
-    :data:`~kinergy.identify.drive_steps.HOLDINGS`, keeping whichever explains the currents best
+    tries it (:mod:`kinergy.identification.sequential`): each fraction of
+    :data:`~kinergy.identification.drive_steps.HOLDINGS`, keeping whichever explains the currents best
     (``SEARCH``), none (the UR5e doc's model) or all of it."""
 
     SEARCH = "search"
@@ -152,7 +152,7 @@ class MakkarMethod(enum.StrEnum):
 
 @dataclass(frozen=True)
 class NursingOptions:
-    """The options of the nursing method (:func:`kinergy.identify.nursing.nursing`).
+    """The options of the nursing method (:func:`kinergy.identification.nursing.nursing`).
 
     Attributes
     ----------

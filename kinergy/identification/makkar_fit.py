@@ -2,11 +2,11 @@
 
 ``f(v) = gamma1 (tanh(gamma2 v) - tanh(gamma3 v)) + gamma4 tanh(gamma5 v) + gamma6 v``
 (:func:`kinergy.friction.makkar.makkar`) is fitted to the joint-side friction of constant-speed
-runs (:mod:`kinergy.identify.friction_points`), with R^2 as the doc reports it (0.931 rotation,
+runs (:mod:`kinergy.identification.friction_points`), with R^2 as the doc reports it (0.931 rotation,
 0.927 pitch):
 
 - :func:`fit_makkar_pso`: particle swarm optimisation with a constriction factor (the doc's
-  method; :mod:`kinergy.identify.pso`), by default searching only the three rates and solving the
+  method; :mod:`kinergy.identification.pso`), by default searching only the three rates and solving the
   three gains by linear least squares (variable projection);
 - :func:`fit_makkar_lsq`: deterministic least squares from a grid of the rates.
 
@@ -27,8 +27,8 @@ from kinergy.errors import KinergyError
 from kinergy.friction.makkar import PARAMETERS as _MAKKAR
 from kinergy.friction.makkar import makkar, makkar_columns
 from kinergy.friction.registry import get_model
-from kinergy.identify.metrics import r_squared, rmse
-from kinergy.identify.pso import SwarmResult, particle_swarm
+from kinergy.identification.metrics import r_squared, rmse
+from kinergy.identification.pso import SwarmResult, particle_swarm
 
 __all__ = ["MakkarFit", "fit_makkar_lsq", "fit_makkar_pso"]
 

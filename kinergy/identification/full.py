@@ -1,6 +1,6 @@
 """The full method: one base-parameter regression of the links, the rotor inertias and friction.
 
-Where the sequential method (:mod:`kinergy.identify.sequential`) keeps the model's link data and
+Where the sequential method (:mod:`kinergy.identification.sequential`) keeps the model's link data and
 identifies the drives step by step, the full method identifies everything the joint torques are
 linear in at once (Gautier's base-parameter identification; nursing eqs 15-16 and the nursing
 paper's ridge regression)::
@@ -27,11 +27,11 @@ paper's ridge regression)::
     ``tau = N^T (k_t * I)`` (UR5e eq 17), with friction. A common scale of every parameter and of
     ``1/k_t`` cannot be told apart, so the torque constants stay the model's.
 
-The pipeline: the stacked columns of (1) (:mod:`kinergy.identify.columns`); their linear
+The pipeline: the stacked columns of (1) (:mod:`kinergy.identification.columns`); their linear
 dependence by column-scaled QR with column pivoting (Gautier's numerical rank), the link base
-columns first, and the solver (:mod:`kinergy.identify.regression`); the robot written back
-(:mod:`kinergy.identify.writeback`, with the physically consistent refit of
-:mod:`kinergy.identify.constrained`).
+columns first, and the solver (:mod:`kinergy.identification.regression`); the robot written back
+(:mod:`kinergy.identification.writeback`, with the physically consistent refit of
+:mod:`kinergy.identification.constrained`).
 
 A rotor inertia can multiply the very signal a link base parameter does (on a UR arm ``J_1`` and
 the ``Iyy1`` group both multiply only ``qdd1`` on joint 1), and a friction term can go unexcited.
@@ -61,7 +61,7 @@ the model's data, and the returned robot then differs from the identified base p
 Limitations: only the friction models' linear parameters are fitted, and the torque constants
 never. With ``power_flow`` friction the direction of power flow is decided from the measurement
 where the load is within its noise of zero: a small bias
-(:func:`kinergy.identify.columns.power_flow_load`).
+(:func:`kinergy.identification.columns.power_flow_load`).
 """
 
 from __future__ import annotations
@@ -75,17 +75,17 @@ import numpy as np
 from kinergy.dynamics.regressor import BaseParameters, base_parameters, inertial_parameters
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import MODELS, get_model, linear_values, with_linear_parameters
-from kinergy.identify.chunks import LogChunks, Summary, one_blas_thread
-from kinergy.identify.columns import (
+from kinergy.identification.chunks import LogChunks, Summary, one_blas_thread
+from kinergy.identification.columns import (
     LOAD_DEPENDENT,
     Regression,
     columns,
     joint_frictions,
     scale_row,
 )
-from kinergy.identify.metrics import JointMetrics, MetricSums
-from kinergy.identify.options import CurrentOptions, IdentifyOptions, Method, Solver, Target
-from kinergy.identify.regression import (
+from kinergy.identification.metrics import JointMetrics, MetricSums
+from kinergy.identification.options import CurrentOptions, IdentifyOptions, Method, Solver, Target
+from kinergy.identification.regression import (
     MAX_CONDITION,
     FlowFit,
     MergedColumn,
@@ -95,7 +95,7 @@ from kinergy.identify.regression import (
     merged_columns,
     solve,
 )
-from kinergy.identify.result import (
+from kinergy.identification.result import (
     KEPT,
     DriveEstimate,
     Fit,
@@ -103,8 +103,8 @@ from kinergy.identify.result import (
     drive_fields,
     fit_fields,
 )
-from kinergy.identify.sequential import DrivesFromCurrents, drives_from_currents
-from kinergy.identify.writeback import WriteBack, write_back
+from kinergy.identification.sequential import DrivesFromCurrents, drives_from_currents
+from kinergy.identification.writeback import WriteBack, write_back
 from kinergy.jsonable import OPTIONAL
 from kinergy.logs.prepare import IdentData
 from kinergy.messages import Messages
@@ -149,7 +149,7 @@ _SIGNAL = {
 class Parameter:
     """One unknown of the regression: its value, standard error and relative standard error
     (None where not estimable) and, for the stacked unknowns, its group (``link``, ``rotor``,
-    ``friction``, ``torque_constant``) and flag (:data:`~kinergy.identify.result.FLAGS`, as
+    ``friction``, ``torque_constant``) and flag (:data:`~kinergy.identification.result.FLAGS`, as
     written to the returned robot)."""
 
     name: str
@@ -176,7 +176,7 @@ class FullJoint(DriveEstimate):
 
 @dataclass(frozen=True)
 class PhysicalFit:
-    """The fit constrained to physical values (:mod:`kinergy.identify.constrained`): its chi^2
+    """The fit constrained to physical values (:mod:`kinergy.identification.constrained`): its chi^2
     increase over the unconstrained fit, the constraints it sits on, the solver, its base
     parameters (b,), rotor inertias (n, kg m^2, motor side) and per-joint metrics of its
     prediction of the target (N m, joint side; ``FullFit.regression`` is the unconstrained
@@ -221,7 +221,7 @@ class FullFit(Fit):
         solution) or ``"physically consistent least squares"``.
     drives : str
         Where the torque constants and friction come from: ``"currents"`` (UR5e eqs 17-18 on the
-        identified links, :func:`~kinergy.identify.sequential.drives_from_currents`),
+        identified links, :func:`~kinergy.identification.sequential.drives_from_currents`),
         ``"regression"`` (unknowns of the regression) or ``"model"``.
     scale : str or None
         Against currents alone: where the common scale comes from.
@@ -337,7 +337,7 @@ def _diagnose(robot: Robot, summary: Summary, commanded: bool, n_params: int) ->
 def _regression(
     robot: Robot, base: BaseParameters, logs: LogChunks, target: Target, friction: str | None
 ) -> Regression:
-    """Eq (1) over ``logs`` (:class:`kinergy.identify.columns.Regression`), after checking the
+    """Eq (1) over ``logs`` (:class:`kinergy.identification.columns.Regression`), after checking the
     logs can identify its columns (:func:`_diagnose`)."""
     commanded = target == Target.MOMENT
     frictions = joint_frictions(robot, friction, commanded)
@@ -573,7 +573,7 @@ def identify_full(
     parameters (nursing eqs 15-16), ``J = J_m + J_r`` the rotor inertias (motor side, kg m^2;
     UR5e eq 2) and ``phi`` the friction models' linear parameters (motor side), then writes
     physically consistent standard link parameters back into the model
-    (:mod:`kinergy.identify.writeback`, :mod:`kinergy.identify.constrained`). Against
+    (:mod:`kinergy.identification.writeback`, :mod:`kinergy.identification.constrained`). Against
     ``target_moment`` or measured torques, logged currents then give the torque constants and
     friction (UR5e eqs 17-18); against currents alone they are unknowns of the regression.
 
@@ -611,7 +611,7 @@ def identify_full(
     IdentificationResult
         ``method = "full"``, ``joints`` of :class:`FullJoint`, ``fit`` a :class:`FullFit`
         (``torque``/``current``/``joint_torque`` are the returned robot's
-        :func:`~kinergy.identify.result.validation_metrics` on the same logs).
+        :func:`~kinergy.identification.result.validation_metrics` on the same logs).
 
     Raises
     ------

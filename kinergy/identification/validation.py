@@ -20,8 +20,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.arrays import Array
-from kinergy.identify.metrics import JointMetrics, fit_metrics
-from kinergy.identify.result import Validation, predict
+from kinergy.identification.metrics import JointMetrics, fit_metrics
+from kinergy.identification.result import Validation, predict
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs
 from kinergy.model.robot import Robot

@@ -40,11 +40,11 @@ from kinergy.drives.electrics import torque_constants
 from kinergy.drives.transmission import joint_torque
 from kinergy.dynamics.regressor import regressor
 from kinergy.errors import KinergyError
-from kinergy.identify.chunks import LogChunks, data_history, one_blas_thread
-from kinergy.identify.columns import ROWS
-from kinergy.identify.drive_steps import joined
-from kinergy.identify.options import Target
-from kinergy.identify.physical import inertia_vector, link_from_standard
+from kinergy.identification.chunks import LogChunks, data_history, one_blas_thread
+from kinergy.identification.columns import ROWS
+from kinergy.identification.drive_steps import joined
+from kinergy.identification.options import Target
+from kinergy.identification.physical import inertia_vector, link_from_standard
 from kinergy.linalg import Reduced, scaled_solution
 from kinergy.logs.prepare import IdentData
 from kinergy.model.robot import Payload, Robot

@@ -3,7 +3,7 @@
 No method holds its logs whole. :class:`LogChunks` gives it the prepared samples of every log
 (segment) in chunks, in time order, and each step folds the chunks it needs into a small
 accumulator and drops them: a QR triangle (:meth:`kinergy.linalg.Reduced.stack`, numerically as
-good as one factorisation of all rows), running sums (:class:`~kinergy.identify.metrics.MetricSums`),
+good as one factorisation of all rows), running sums (:class:`~kinergy.identification.metrics.MetricSums`),
 per-block or per-log accumulators, and the state friction held through standstill carries from
 one chunk into the next (:class:`History`). A step that needs several passes (a fixed point, a
 shape search, a weighted refit) makes them: the first pass keeps the prepared chunks
@@ -13,10 +13,10 @@ keeps what it derives per chunk in a store of its own when reading it back costs
 computing it again.
 
 A log held in memory is one chunk (:class:`WholeSegment`, :meth:`LogChunks.of`): the in-memory
-entry points (:func:`~kinergy.identify.sequential.identify_sequential`,
-:func:`~kinergy.identify.full.identify_full`, ...) run the very same folds.
+entry points (:func:`~kinergy.identification.sequential.identify_sequential`,
+:func:`~kinergy.identification.full.identify_full`, ...) run the very same folds.
 
-The first pass checks every chunk's signals (:func:`~kinergy.identify.sanity.check_signals`) and
+The first pass checks every chunk's signals (:func:`~kinergy.identification.sanity.check_signals`) and
 summarises each segment (:class:`Summary`: samples, time span, the joints' position ranges and
 speeds), then runs the ``check`` it was given on the summaries, before the pass ends: a check's
 error reaches the user before anything computed from the chunks.
@@ -48,7 +48,7 @@ from kinergy.arrays import Array
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.errors import KinergyError
 from kinergy.friction.standstill import MIN_RUN, sustained
-from kinergy.identify.sanity import check_signals
+from kinergy.identification.sanity import check_signals
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.logs.prepare import SAMPLE_FIELDS, IdentData
 from kinergy.model.robot import Robot
@@ -288,7 +288,7 @@ class LogChunks:
         self._summaries: list[Summary] | None = None
         self.stores: list[Store] = []  # what steps derived, closed with the chunks
         #: the currents a robot predicts on every chunk, kept by its validation for the fit of
-        #: its electrics (:func:`kinergy.identify.result.validation_metrics`)
+        #: its electrics (:func:`kinergy.identification.result.validation_metrics`)
         self.currents: tuple[Robot, Store] | None = None
 
     @classmethod

@@ -7,28 +7,28 @@ steps:
    at constant speed (:mod:`kinergy.experiments.friction_runs` designs them) give, per run, the
    joint torques from the currents (eq 21 and the coupling,
    :func:`kinergy.drives.coupled.joint_torques_from_current`) and their odd part over the two
-   directions, the friction (eqs 19-20, :mod:`kinergy.identify.friction_points`); per joint a
+   directions, the friction (eqs 19-20, :mod:`kinergy.identification.friction_points`); per joint a
    Makkar curve (eq 13, joint side) is fitted by particle swarm optimisation or least squares
-   (:mod:`kinergy.identify.makkar_fit`).
+   (:mod:`kinergy.identification.makkar_fit`).
 2. **Per-motor pooling.** Per group of coupled motors one curve, fitted to all its joints'
    points, split onto the motors (:func:`kinergy.drives.coupled.makkar_motor_side`).
 3. **Excitation regression** (section 4.2, eqs 22-26). A periodic Fourier excitation (eq 22; the
    doc's Table 6) runs for several periods; the currents are low-pass filtered (Butterworth,
    15 Hz; the doc's "4 dB ripple" cannot apply to a Butterworth filter, which has none) and every
-   signal is averaged over the periods (eq 24, :mod:`kinergy.identify.cycles`); the joint torques
+   signal is averaged over the periods (eq 24, :mod:`kinergy.identification.cycles`); the joint torques
    from the currents, less friction and the coupled joints' internal inertia (eq 25), are
    regressed on the minimal (base) parameter set (eq 16) by ridge regression
-   (:mod:`kinergy.identify.ridge`), trained on the first 70 % and tested on the last 30 %
+   (:mod:`kinergy.identification.ridge`), trained on the first 70 % and tested on the last 30 %
    (per-joint RMSE, eq 26, Table 8).
 4. **Write-back.** The links with the identified base parameters
-   (:func:`kinergy.identify.physical.standard_from_base`); a link that is not physical keeps the
+   (:func:`kinergy.identification.physical.standard_from_base`); a link that is not physical keeps the
    model's data.
 
-Passes over the logs' chunks (:class:`~kinergy.identify.chunks.LogChunks`): the first finds each
+Passes over the logs' chunks (:class:`~kinergy.identification.chunks.LogChunks`): the first finds each
 log's moving joints; the filtered, cycle-averaged signals of the excitation logs are folded
 chunk by chunk (the zero-phase filter on windows reaching :data:`~kinergy.logs.prepare.FILTER_REACH`
-periods of its cutoff into the neighbouring chunks, :func:`~kinergy.identify.chunks.windowed`;
-eq 24 as sums per sample of the period, :class:`~kinergy.identify.cycles.CycleAverage`: the same
+periods of its cutoff into the neighbouring chunks, :func:`~kinergy.identification.chunks.windowed`;
+eq 24 as sums per sample of the period, :class:`~kinergy.identification.cycles.CycleAverage`: the same
 bits as whole). Three things take a log's samples of a few signals instead, because their maths
 needs them all at once: a friction run's odd part pairs each forward sample with the backward
 run's torque at the same position (the moving joint's position, torque, commanded speed and
@@ -59,25 +59,29 @@ from kinergy.drives.transmission import reflected_inertia, transmission_matrix
 from kinergy.dynamics.regressor import inertial_parameters
 from kinergy.errors import KinergyError
 from kinergy.friction.makkar import PARAMETERS as MAKKAR_PARAMETERS
-from kinergy.identify.chunks import LogChunks, one_blas_thread, windowed
-from kinergy.identify.cycles import CycleAverage, find_period
-from kinergy.identify.friction_points import FrictionPoints, constant_speed_runs, friction_points
-from kinergy.identify.makkar_fit import MakkarFit, fit_makkar_lsq, fit_makkar_pso
-from kinergy.identify.options import FILTER_CUTOFF, MakkarMethod, NursingOptions
-from kinergy.identify.physical import (
+from kinergy.identification.chunks import LogChunks, one_blas_thread, windowed
+from kinergy.identification.cycles import CycleAverage, find_period
+from kinergy.identification.friction_points import (
+    FrictionPoints,
+    constant_speed_runs,
+    friction_points,
+)
+from kinergy.identification.makkar_fit import MakkarFit, fit_makkar_lsq, fit_makkar_pso
+from kinergy.identification.options import FILTER_CUTOFF, MakkarMethod, NursingOptions
+from kinergy.identification.physical import (
     link_consistency,
     link_from_standard,
     parameter_scale,
     standard_from_base,
 )
-from kinergy.identify.result import (
+from kinergy.identification.result import (
     DriveEstimate,
     Fit,
     IdentificationResult,
     drive_fields,
     fit_fields,
 )
-from kinergy.identify.ridge import RidgeFit, ridge_minimal
+from kinergy.identification.ridge import RidgeFit, ridge_minimal
 from kinergy.jsonable import OPTIONAL
 from kinergy.logs.prepare import FILTER_REACH, IdentData, lowpass
 from kinergy.messages import Messages
@@ -146,7 +150,7 @@ class ExcitationLog:
 
 @dataclass(frozen=True)
 class RidgeSummary:
-    """The ridge regression of the links (:class:`kinergy.identify.ridge.RidgeFit`) as reported:
+    """The ridge regression of the links (:class:`kinergy.identification.ridge.RidgeFit`) as reported:
     ``alpha``, ``intercept`` (N m), ``condition``, the training share ``split`` and its rows;
     per joint ``rmse_test``, ``rmse_train`` (N m, eq 26), ``r2_test`` and ``torque_std_test``
     (the spread of the regressed torques on the test part, N m, to read the RMSE against); the
@@ -459,7 +463,7 @@ def _identified_link(j: int, joint: Joint, standard: Array, said: Messages) -> J
 
 def _write_links(robot: Robot, rf: RidgeFit, said: Messages) -> tuple[Robot, tuple[int, ...]]:
     """Links with the identified base parameters: the standard parameters closest to the model's
-    (:func:`kinergy.identify.physical.standard_from_base`); a link that is not physical keeps the
+    (:func:`kinergy.identification.physical.standard_from_base`); a link that is not physical keeps the
     model's data, with a warning. Returns the robot and the kept links (1-based)."""
     pi0 = inertial_parameters(robot)
     payload = pi0 - inertial_parameters(robot, include_payload=False)
@@ -533,7 +537,7 @@ def identify_nursing(
     seed: int = 0,
 ) -> IdentificationResult:
     """:func:`nursing` on prepared logs held in memory (each one chunk), its options
-    (:class:`~kinergy.identify.options.NursingOptions`) as keywords."""
+    (:class:`~kinergy.identification.options.NursingOptions`) as keywords."""
     try:
         method = MakkarMethod(fit)
     except ValueError:
@@ -555,7 +559,7 @@ def nursing(
     (``options.cutoff`` Hz; None: not filtered), each averaged over its periods
     (``options.period`` s, else :func:`find_period`) and joined in order; the first
     ``options.split`` in time trains the ridge regression on the weights ``options.alphas``
-    (:func:`~kinergy.identify.ridge.ridge_minimal`); Makkar's curves are fitted as
+    (:func:`~kinergy.identification.ridge.ridge_minimal`); Makkar's curves are fitted as
     ``options.fit`` says (:func:`fit_makkar_lsq`, or :func:`fit_makkar_pso` seeded by
     ``options.seed``) to runs trimmed by ``options.trim`` samples, the currents converted with
     eq 21's efficiency ``options.eta``.
@@ -564,7 +568,7 @@ def nursing(
     -------
     IdentificationResult
         ``method = "nursing"``, with a :class:`NursingFit`: ``torque`` and ``current`` are the
-        returned robot's :func:`kinergy.identify.result.validation_metrics` on all logs.
+        returned robot's :func:`kinergy.identification.result.validation_metrics` on all logs.
 
     Raises
     ------

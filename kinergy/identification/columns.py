@@ -1,4 +1,4 @@
-"""The regression columns of the full method (:mod:`kinergy.identify.full`, its eq (1)).
+"""The regression columns of the full method (:mod:`kinergy.identification.full`, its eq (1)).
 
 Rows are the (sample, joint) pairs of every log, made chunk by chunk (:class:`Regression`);
 columns, in this order:
@@ -35,9 +35,9 @@ from kinergy.friction.registry import (
     linear_values,
     start_parameters,
 )
-from kinergy.identify.chunks import History, LogChunks
-from kinergy.identify.drive_steps import _Signals, rotor_columns, signal_history
-from kinergy.identify.options import Target
+from kinergy.identification.chunks import History, LogChunks
+from kinergy.identification.drive_steps import _Signals, rotor_columns, signal_history
+from kinergy.identification.options import Target
 from kinergy.logs.prepare import IdentData
 from kinergy.model.robot import Robot
 from kinergy.predict import drive_state
@@ -173,7 +173,7 @@ def power_flow_load(
     model's own load torque instead does not (near a load zero crossing the friction jumps by
     ``coulomb_direct - coulomb_reverse``, and small parameter errors flip samples that pull the
     fit further). Deciding by the measurement ties the regressor to the measurement's noise where
-    the load is within the noise of zero: a small bias (:mod:`kinergy.identify.full`).
+    the load is within the noise of zero: a small bias (:mod:`kinergy.identification.full`).
 
     Parameters
     ----------
@@ -182,7 +182,7 @@ def power_flow_load(
     signals : _Signals
         Motor speeds, accelerations and the measured motor torque (``current``, N m) of the
         samples, the first ``skip`` of them those a friction held through standstill recalls
-        (:class:`~kinergy.identify.chunks.History`).
+        (:class:`~kinergy.identification.chunks.History`).
     previous : ndarray, shape (N - skip,)
         The loads of the previous pass, N m, motor side.
     """
@@ -213,7 +213,7 @@ class Rows:
 
 @dataclass(frozen=True, eq=False)
 class Regression:
-    """The full method's regression, eq (1) of :mod:`kinergy.identify.full`, over the logs'
+    """The full method's regression, eq (1) of :mod:`kinergy.identification.full`, over the logs'
     chunks: what its columns are and how a chunk's rows are made.
 
     Attributes

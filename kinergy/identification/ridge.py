@@ -19,7 +19,7 @@ from kinergy.arrays import Array
 from kinergy.dynamics.regressor import BaseParameters, base_parameters
 from kinergy.dynamics.regressor import regressor as full_regressor
 from kinergy.errors import KinergyError
-from kinergy.identify.metrics import r_squared, rmse
+from kinergy.identification.metrics import r_squared, rmse
 from kinergy.linalg import Reduced, reduce, solve_reduced
 from kinergy.model.robot import Robot
 

@@ -29,7 +29,7 @@ from kinergy.friction.registry import (
     start_parameters,
     with_linear_parameters,
 )
-from kinergy.identify.chunks import Asks, answer, translated
+from kinergy.identification.chunks import Asks, answer, translated
 from kinergy.linalg import scaled_lstsq
 
 __all__ = [

@@ -1,14 +1,14 @@
-"""From the full method's regression unknowns back to a Robot (:mod:`kinergy.identify.full`).
+"""From the full method's regression unknowns back to a Robot (:mod:`kinergy.identification.full`).
 
 A robot file stores masses, centres of mass and inertias, not base parameters. The links are
 written, in this order of preference:
 
 1. the standard parameters closest to the model's that reproduce the identified base parameters
-   exactly (:func:`~kinergy.identify.physical.standard_from_base`);
-2. when one of those links is not physical (:func:`~kinergy.identify.physical.link_consistency`)
+   exactly (:func:`~kinergy.identification.physical.standard_from_base`);
+2. when one of those links is not physical (:func:`~kinergy.identification.physical.link_consistency`)
    or a rotor inertia, friction level or torque constant is outside its bounds, the
    least-squares fit constrained to physical values
-   (:func:`~kinergy.identify.constrained.physical_fit`, a convex problem); when the
+   (:func:`~kinergy.identification.constrained.physical_fit`, a convex problem); when the
    unconstrained fit is physical it is that problem's solution already;
 3. the model's data for a link still not physical.
 
@@ -26,17 +26,17 @@ from kinergy.arrays import Array
 from kinergy.dynamics.regressor import BaseParameters, inertial_parameters, parameter_names
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import get_model, with_linear_parameters
-from kinergy.identify.columns import Columns, Regression
-from kinergy.identify.constrained import ConstrainedFit, bounds, physical_fit
-from kinergy.identify.physical import (
+from kinergy.identification.columns import Columns, Regression
+from kinergy.identification.constrained import ConstrainedFit, bounds, physical_fit
+from kinergy.identification.physical import (
     inertia_vector,
     link_consistency,
     link_from_standard,
     parameter_scale,
     standard_from_base,
 )
-from kinergy.identify.regression import Solved
-from kinergy.identify.result import AT_BOUND, IDENTIFIED, KEPT
+from kinergy.identification.regression import Solved
+from kinergy.identification.result import AT_BOUND, IDENTIFIED, KEPT
 from kinergy.messages import Messages
 from kinergy.model.robot import Drive, Friction, Joint, Link, Robot, Source
 
