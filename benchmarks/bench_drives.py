@@ -52,8 +52,6 @@ from kinergy.workflows.excite import ExciteOptions, run_excite
 from kinergy.workflows.identify import identify_model
 
 DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "datasets"
-if not DATA.exists():
-    DATA = Path("/work/shared/datasets")
 UR10E = DATA / "ur10e-innopolis"
 UR10E_COLUMNS = "timestamp,actual_q:6,actual_qd:6,actual_current:6,target_current:6,target_moment:6"
 SEED = 1
