@@ -2,7 +2,7 @@
 
 Given the twin's true robot and a commanded (target) motion, the twin produces, at the rate the
 motion is sampled (the controller's 500 Hz), the RTDE signals the UR5e doc works from (section
-2.2) and the ones issue 13 adds:
+2.2) and the drive-side ones a real controller also logs:
 
 - ``target_q``, ``target_qd``, ``target_qdd``: the commanded motion;
 - ``target_moment``: the controller's feed-forward torque, UR5e eq 7 on the *target* motion
