@@ -124,6 +124,27 @@ def test_place_reports_every_candidate_and_the_best(placed: tuple[Path, dict]) -
     assert "set_standard_digital_out(0, True)" in text and "# down" in text
 
 
+def test_the_text_report_keeps_every_reason_within_the_width(tmp_path: Path) -> None:
+    """The printed report: no line over the tables' 120 characters, and the reason a placement is
+    out of reach printed whole (wrapped, not cut), naming the placement."""
+    import clicase
+
+    from kinergy.cli.common import TABLE_WIDTH
+
+    (tmp_path / "small.script").write_text(SMALL)
+    args = ["place", "ur5e", "small.script", "--x", "0:0", "--y", "0:0.9", "--step", "0.9"]
+    limit = clicase.LIMIT
+    clicase.LIMIT = 120.0
+    try:
+        out = run_case(args, tmp_path, refuse=False).out
+    finally:
+        clicase.LIMIT = limit
+    assert max(len(line) for line in out.splitlines()) <= TABLE_WIDTH
+    assert "out of reach: small.script:" in out
+    words = " ".join(out.split())
+    assert "best placement: x=+0.000 m, y=+0.000 m" in words
+
+
 @pytest.mark.parametrize(
     ("label", "extra", "match"),
     [
