@@ -61,6 +61,21 @@ F = TypeVar("F", bound=Callable[..., Any])
 TABLE_WIDTH = 120
 
 
+def prose(text: str, width: int = TABLE_WIDTH) -> str:
+    """Each line of ``text`` wrapped to ``width`` characters, its continuation lines indented
+    two more than its own (the tables' width, so a report reads in one column)."""
+    out = []
+    for line in text.split("\n"):
+        if len(line) <= width:
+            out.append(line)
+            continue
+        lead = " " * (len(line) - len(line.lstrip(" ")))
+        out.append(
+            textwrap.fill(line.strip(), width, initial_indent=lead, subsequent_indent=lead + "  ")
+        )
+    return "\n".join(out)
+
+
 def table(headers: Sequence[str], rows: Sequence[Sequence[Any]], width: int = TABLE_WIDTH) -> str:
     """Left-aligned text columns, two spaces apart (the one table printer of the CLI), no line
     longer than ``width`` characters.

@@ -16,6 +16,7 @@ from kinergy.cli.common import (
     load,
     log_reading,
     payload_option,
+    prose,
     table,
     tell,
     topic_option,
@@ -79,8 +80,8 @@ def energy_text(report: dict[str, Any]) -> str:
     if "segments" in report:
         head += f"\n{report['segments']} segments; gaps of {report['gaps']:.3f} s not integrated."
     lines = [
-        head,
-        *_supply_lines(report),
+        prose(head),
+        *(prose(line) for line in _supply_lines(report)),
         "",
         table(headers, rows),
         "",

@@ -19,6 +19,7 @@ from kinergy.cli.common import (
     output_file_option,
     payload_option,
     progress,
+    prose,
     table,
     writes,
 )
@@ -216,7 +217,7 @@ def program_text(run: ProgramRun) -> str:
             f"{', '.join(left)} now take the joints of the target before them"
         )
     lines += [f"note: {n}" for n in run.notes]
-    return "\n".join(lines)
+    return "\n".join(line if "\n" in line else prose(line) for line in lines)
 
 
 def lever_options(prefix: str = "") -> Callable[[F], F]:

@@ -10,17 +10,16 @@ result as text or JSON.
 from __future__ import annotations
 
 import math
-import textwrap
 
 import click
 
 from kinergy.cli.common import (
-    TABLE_WIDTH,
     json_result,
     load,
     output_file_option,
     payload_option,
     progress,
+    prose,
     table,
     writes,
 )
@@ -74,11 +73,7 @@ def place_text(run: PlaceRun) -> str:
     ]
     headers = ["x [m]", "y [m]", "z [m]", "yaw [deg]", "reachable", "E supply [J]"]
     why = [
-        textwrap.fill(
-            f"{c.placement.label()}: {c.reason.value}: {c.why}",
-            TABLE_WIDTH,
-            subsequent_indent="    ",
-        )
+        prose(f"{c.placement.label()}: {c.reason.value}: {c.why}")
         for c in search.candidates
         if not c.reachable
     ]
@@ -86,26 +81,23 @@ def place_text(run: PlaceRun) -> str:
     cycle = best.result.settings.cycle_time
     reachable = sum(c.reachable for c in search.candidates)
     lines = [
-        textwrap.fill(
+        prose(
             f"{run.robot.name}, program {run.program.name}: {len(search.candidates)} candidate "
             f"placements, {reachable} reachable; each optimised at today's cycle time of "
             f"{cycle:.3f} s within today's caps (supply energy per cycle, model-predicted)",
-            TABLE_WIDTH,
         ),
         table(headers, rows),
         *(["", "not reachable:", *why] if why else []),
         "",
-        textwrap.fill(
+        prose(
             f"today's placement: {today.result.program.result.score:.1f} J as written, "
             f"{_energy(today)} J optimised ({100 * today.result.saving:.1f} % by the levers); "
             f"its optimised program read back: {run.today_readback:.1f} J",
-            TABLE_WIDTH,
         ),
-        textwrap.fill(
+        prose(
             f"best placement: {best.placement.label()}: {_energy(best)} J optimised; its "
             f"written program read back and simulated again: {run.readback:.1f} J, "
             f"{100 * run.saving:.1f} % less than today's placement beyond the program levers",
-            TABLE_WIDTH,
         ),
     ]
     return "\n".join(lines)

@@ -11,6 +11,7 @@ from kinergy.cli.common import (
     log_reading,
     output_file_option,
     payload_option,
+    prose,
     seed_option,
     writes,
 )
@@ -121,8 +122,10 @@ def simulate(
         r, trajectory, out, settings, reading=reading, mismatch=mismatch, truth_out=truth_out
     ).t
     click.echo(
-        f"wrote {out}: {len(t)} samples, {t[-1] - t[0]:.3f} s, {r.name}, trajectory {trajectory}, "
-        f"mismatch {mismatch}, lag {settings.lag * 1e3:g} ms, speed noise "
-        f"{settings.speed_noise:g} rad/s, current noise {settings.current_noise:g} A"
-        + (f"; true robot: {truth_out}" if truth_out else "")
+        prose(
+            f"wrote {out}: {len(t)} samples, {t[-1] - t[0]:.3f} s, {r.name}, trajectory "
+            f"{trajectory}, mismatch {mismatch}, lag {settings.lag * 1e3:g} ms, speed noise "
+            f"{settings.speed_noise:g} rad/s, current noise {settings.current_noise:g} A"
+            + (f"; true robot: {truth_out}" if truth_out else "")
+        )
     )
