@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import enum
 import math
+import re
 from dataclasses import dataclass
+from typing import Self
 
 import numpy as np
 
@@ -82,15 +84,12 @@ class ToolSymmetry(enum.Enum):
         return 2.0 * np.pi * np.arange(self.turns) / self.turns
 
 
-class Configurations(enum.Enum):
-    """Whether a movej's pose target keeps the program's inverse-kinematics branch (``KEEP``: a
-    new branch can collide with the cell) or may take any of the eight (``FREE``)."""
-
-    KEEP = "keep"
-    FREE = "free"
+class _KeepOrFree(enum.Enum):
+    """An option that is ``keep`` or ``free``, named in its messages after its class
+    (``ViaPoints``: "via points")."""
 
     @classmethod
-    def parse(cls, text: str) -> Configurations:
+    def parse(cls, text: str) -> Self:
         """``keep`` or ``free``.
 
         Raises
@@ -101,10 +100,19 @@ class Configurations(enum.Enum):
         try:
             return cls(text)
         except ValueError:
-            raise KinergyError(f"configurations: expected keep or free, got {text!r}") from None
+            name = re.sub(r"(?<!^)(?=[A-Z])", " ", cls.__name__).lower()
+            raise KinergyError(f"{name}: expected keep or free, got {text!r}") from None
 
 
-class ViaPoints(enum.Enum):
+class Configurations(_KeepOrFree):
+    """Whether a movej's pose target keeps the program's inverse-kinematics branch (``KEEP``: a
+    new branch can collide with the cell) or may take any of the eight (``FREE``)."""
+
+    KEEP = "keep"
+    FREE = "free"
+
+
+class ViaPoints(_KeepOrFree):
     """Whether the program's joint-space via points stay where the programmer put them.
 
     A joint-space via point is the target of a ``movej`` that is followed by another ``movej``
@@ -117,20 +125,6 @@ class ViaPoints(enum.Enum):
 
     KEEP = "keep"
     FREE = "free"
-
-    @classmethod
-    def parse(cls, text: str) -> ViaPoints:
-        """``keep`` or ``free``.
-
-        Raises
-        ------
-        KinergyError
-            Any other name, in one line.
-        """
-        try:
-            return cls(text)
-        except ValueError:
-            raise KinergyError(f"via points: expected keep or free, got {text!r}") from None
 
 
 def _positive(name: str, value: float | None) -> float | None:
