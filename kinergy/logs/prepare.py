@@ -345,24 +345,6 @@ JOINT_SIGNALS = (
 )
 
 
-#: the log signal of measured joint torques, N m (RTDE-style name, ``actual_joint_torque_k``)
-MEASURED_TORQUE = "actual_joint_torque"
-
-#: (N, n) signals whose joint count must match the robot's
-JOINT_SIGNALS = (
-    "target_q",
-    "target_qd",
-    "target_qdd",
-    "actual_q",
-    "actual_qd",
-    "target_moment",
-    "actual_current",
-    MEASURED_TORQUE,
-    "joint_temperatures",
-    "actual_joint_voltage",
-)
-
-
 def check_joints(log: Log, n_joints: int) -> None:
     """Raise when a joint signal of ``log`` does not have ``n_joints`` columns."""
     for name in JOINT_SIGNALS:
