@@ -37,8 +37,9 @@ What reaches across chunk edges, and the pad that makes each chunk equal the who
   the far end: the whole segment's spline to round-off), plus the lag in samples; at the
   segment's ends the window ends with the segment, as the whole-segment spline does;
 - the lag itself (:func:`estimate_lag`) compares the spline of the commanded speed with the
-  measured speed at a few thousand samples (:func:`lag_samples`): one spline through the samples
-  within ``HALO`` of each of them gives the same lag;
+  measured speed at a few thousand samples (:func:`lag_samples`): splines through the samples
+  within ``HALO`` of each of them, in batches of about :data:`LAG_BATCH_ROWS` (a batch's ends
+  lie in the gaps between windows), give the same lag;
 - the filtered measured speed (a log without the commanded motion) is a zero-phase Butterworth
   filter run forward and back (:func:`lowpass`). Its impulse response decays as
   ``exp(-zeta 2 pi f_c t)`` with ``zeta = sin(pi/8)`` for the 4th order, so a chunk filtered
@@ -53,7 +54,7 @@ import itertools
 import math
 import os
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, fields
 from typing import BinaryIO
 
@@ -298,10 +299,16 @@ def estimate_lag(t: Array, commanded: Array, measured: Array, *, max_lag: float 
 
 
 def lag_search(
-    spline: CubicSpline, t: Array, measured: Array, dt: float, *, max_lag: float = MAX_LAG
+    spline: Callable[[Array], Array],
+    t: Array,
+    measured: Array,
+    dt: float,
+    *,
+    max_lag: float = MAX_LAG,
 ) -> float:
-    """The shift (s) of the commanded speeds ``spline`` that best matches ``measured`` (k, n) at
-    the times ``t`` (k,): a grid of whole periods ``dt`` then a golden-section refinement."""
+    """The shift (s) of the commanded speeds ``spline`` (times (k,) -> speeds (k, n)) that best
+    matches ``measured`` (k, n) at the times ``t`` (k,): a grid of whole periods ``dt`` then a
+    golden-section refinement."""
 
     def cost(lag: float) -> float:
         return float(np.sum((spline(t - lag) - measured) ** 2))
@@ -652,11 +659,42 @@ def _lag(segment: PreparedSegment) -> float:
     covered = np.cumsum(near[:-1]) > 0
     edges = np.flatnonzero(np.diff(np.concatenate([[0], covered.astype(int), [0]])))
     speeds = ("target_qd", "actual_qd")
-    parts = [segment.uniform(a, b, speeds) for a, b in zip(edges[::2], edges[1::2], strict=True)]
-    window = Log.concatenate(parts)
-    spline = CubicSpline(window.t, window["target_qd"], axis=0)
-    measured = np.vstack([p["actual_qd"] for p in parts])[np.searchsorted(window.t, t[inner])]
-    return lag_search(spline, t[inner], measured, float(t[1] - t[0]), max_lag=MAX_LAG)
+    times = t[inner]
+    splines: list[tuple[CubicSpline, int, int]] = []
+    measured: list[Array] = []
+    done = 0
+    for batch in _batches(list(zip(edges[::2], edges[1::2], strict=True)), LAG_BATCH_ROWS):
+        window = Log.concatenate([segment.uniform(a, b, speeds) for a, b in batch])
+        stop = int(np.searchsorted(inner, batch[-1][1]))
+        splines.append((CubicSpline(window.t, window["target_qd"], axis=0), done, stop))
+        measured.append(window["actual_qd"][np.searchsorted(window.t, times[done:stop])])
+        done = stop
+
+    def commanded(x: Array) -> Array:
+        """The commanded speeds at ``x`` (the compared samples' times, shifted), each sample
+        from the spline of its own batch of windows."""
+        return np.concatenate([spline(x[a:b]) for spline, a, b in splines])
+
+    return lag_search(commanded, times, np.concatenate(measured), float(t[1] - t[0]))
+
+
+#: samples splined at once by the lag estimate (the windows around the compared samples, in
+#: batches: the spline of a batch's windows needs a few times its samples while it is built)
+LAG_BATCH_ROWS = 50_000
+
+
+def _batches(windows: list[tuple[int, int]], rows: int) -> Iterator[list[tuple[int, int]]]:
+    """Consecutive ``windows`` (start, stop) grouped into batches of about ``rows`` samples."""
+    batch: list[tuple[int, int]] = []
+    size = 0
+    for a, b in windows:
+        batch.append((a, b))
+        size += b - a
+        if size >= rows:
+            yield batch
+            batch, size = [], 0
+    if batch:
+        yield batch
 
 
 def prepare_segment(
