@@ -115,7 +115,7 @@ def _file_hash(path: Path, out: list[str], stop: threading.Event) -> None:
             if path.is_dir():
                 digest.update(part.relative_to(path).as_posix().encode() + b"\0")
             with part.open("rb") as fh:
-                while block := fh.read(1 << 23):
+                while block := fh.read(1 << 20):
                     if stop.is_set():
                         return
                     digest.update(block)
@@ -242,6 +242,16 @@ class CheckedLog:
         have = self.names()
         return [s for s in dict.fromkeys([*self.select, *CHECKED_SIGNALS]) if s in have]
 
+    def _selected(self, chunk: Log) -> Log:
+        """``chunk`` with only the selected signals: those only the checks read are not
+        carried on (a consumer joining chunks would copy them for nothing)."""
+        if self.select is None:
+            return chunk
+        keep = {k: v for k, v in chunk.signals.items() if k in self.select}
+        if len(keep) == len(chunk.signals):
+            return chunk
+        return Log(chunk.path, chunk.t, keep, chunk.notes)
+
     def chunks(self) -> Iterator[Log]:
         """The log's chunks in order, each folded into the checks first; after the last one,
         the checks' verdict (:attr:`checks`, :attr:`provenance`).
@@ -268,7 +278,7 @@ class CheckedLog:
                 self.notes.extend(chunk.notes)
                 check.add(chunk)
                 rows += len(chunk)
-                yield chunk
+                yield self._selected(chunk)
         except BaseException:
             stop.set()
             raise
