@@ -99,3 +99,28 @@ def test_a_gap_is_never_integrated_across(
     assert "2 segments; gaps of 3600.000 s not integrated." in text
     assert main(["energy", "ur5e", str(parts["a"])]) == 0
     assert "segments" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("dropped", "note"),
+    [
+        (
+            ("target_qd", "target_qdd"),
+            "target_qd not in the log: speeds and accelerations from a spline of target_q",
+        ),
+        (("target_qdd",), "target_qdd not in the log: accelerations from a spline of target_qd"),
+    ],
+)
+def test_a_motion_derived_from_positions_is_said_and_close(
+    ur5e: kinergy.Robot, long_log: Path, tmp_path: Path, dropped: tuple[str, ...], note: str
+) -> None:
+    log = read_log(long_log)
+    path = tmp_path / "fewer.csv"
+    write_log(path, log.t, {k: v for k, v in log.signals.items() if k not in dropped})
+    full = energy_of_log(ur5e, long_log, source="target")
+    fewer = energy_of_log(ur5e, path, source="target")
+    assert f"{path}: {note}" in fewer.notes
+    assert not any("spline" in n for n in full.notes)
+    # the spline of the commanded positions gives the commanded motion's energy closely
+    assert fewer.supply.drawn == pytest.approx(full.supply.drawn, rel=1e-3)
+    np.testing.assert_allclose(fewer.e_elec, full.e_elec, rtol=2e-3)

@@ -90,6 +90,21 @@ def _signals_used(log: CheckedLog, source: str) -> list[str] | None:
     return [name for name in wanted if name in names]
 
 
+def _derived(signals: list[str] | None) -> str | None:
+    """What the motion of a log read for ``signals`` (:func:`_signals_used`) takes from a
+    spline rather than from the log, when that is not routine (a measured motion's accelerations
+    always are: RTDE logs no ``actual_qdd``); None when nothing is."""
+    if not signals:
+        return None
+    q = signals[0]
+    source = q.removesuffix("_q")
+    if f"{source}_qd" not in signals:
+        return f"{source}_qd not in the log: speeds and accelerations from a spline of {q}"
+    if source == "target" and "target_qdd" not in signals:
+        return "target_qdd not in the log: accelerations from a spline of target_qd"
+    return None
+
+
 def energy_of_log(
     robot: Robot,
     path: str | os.PathLike[str],
@@ -129,4 +144,6 @@ def energy_of_log(
         measured = power is not None
         acc.add(m.t, state, starts=part.starts, measured_power=power)
     inputs.add(log)
+    if derived := _derived(log.select):
+        inputs.notes.append(f"{log.path}: {derived}")
     return _with(acc.figures(measured=measured), inputs)
