@@ -8,9 +8,10 @@ from typing import Any
 
 import numpy as np
 import pytest
+from scipy.integrate import trapezoid
 
 import kinergy
-from kinergy.accounting.energy import energy
+from kinergy.accounting.energy import energy, trapezoid_weights
 from kinergy.cli import main
 from kinergy.io.rtde import read_log, write_log
 from kinergy.trajectory.programs import paper_trajectory
@@ -124,3 +125,11 @@ def test_a_motion_derived_from_positions_is_said_and_close(
     # the spline of the commanded positions gives the commanded motion's energy closely
     assert fewer.supply.drawn == pytest.approx(full.supply.drawn, rel=1e-3)
     np.testing.assert_allclose(fewer.e_elec, full.e_elec, rtol=2e-3)
+
+
+def test_the_trapezoid_weights_are_scipys_trapezoid_rule() -> None:
+    rng = np.random.default_rng(7)
+    t = np.cumsum(rng.uniform(0.001, 0.003, 1000))
+    y = rng.standard_normal((1000, 5))
+    np.testing.assert_allclose(trapezoid_weights(t) @ y, trapezoid(y, t, axis=0), rtol=1e-12)
+    assert trapezoid_weights(t[:1]) @ y[:1] == pytest.approx(np.zeros(5))

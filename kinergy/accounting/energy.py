@@ -39,7 +39,6 @@ import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import trapezoid
 
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy
@@ -101,6 +100,18 @@ def part_powers(robot: Robot, state: DriveState) -> dict[str, Array]:
         "friction": state.wm * state.tau_friction / kt_over_kb,
         "copper": state.power - state.wm * state.tau_m / kt_over_kb,
     }
+
+
+def trapezoid_weights(t: Array) -> Array:
+    """The trapezoid rule as weights, (N,): ``w @ y`` is the integral of samples ``y`` (N, ...)
+    at times ``t`` (s, (N,)) over ``[t[0], t[-1]]``: ``w_i = (t[i+1] - t[i-1]) / 2``, half a
+    step at either end; zero for a single sample."""
+    w = np.zeros(t.size)
+    if t.size > 1:
+        dt = 0.5 * np.diff(t)
+        w[:-1] += dt
+        w[1:] += dt
+    return w
 
 
 class EnergyAccumulator:
@@ -181,15 +192,14 @@ class EnergyAccumulator:
         elif y.shape[1] != self.sums.size:
             raise KinergyError("measured supply columns in some chunks of a log only")
         cuts = sorted(starts)
-        tt, yy = t, y
         if self.last is not None and (not cuts or cuts[0] != 0):
-            tt = np.concatenate([[self.last[0]], t])  # continue the previous chunk's segment
-            yy = np.vstack([self.last[1], y])
-            cuts = [c + 1 for c in cuts]
-        edges = [0, *(c for c in cuts if c > 0), tt.size]
+            t0, y0 = self.last  # the previous chunk's segment goes on: the step between them
+            self.sums += 0.5 * (t[0] - t0) * (y0 + y[0])
+            self.duration += float(t[0] - t0)
+        edges = [0, *(c for c in cuts if c > 0), t.size]
         for a, b in itertools.pairwise(edges):
-            self.sums += trapezoid(yy[a:b], tt[a:b], axis=0)
-            self.duration += float(tt[b - 1] - tt[a])
+            self.sums += trapezoid_weights(t[a:b]) @ y[a:b]
+            self.duration += float(t[b - 1] - t[a])
         self.segments += len(starts)
         self.samples += t.size
         self.last = (float(t[-1]), y[-1].copy())
