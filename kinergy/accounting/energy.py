@@ -105,7 +105,9 @@ def part_powers(robot: Robot, state: DriveState) -> dict[str, Array]:
 def trapezoid_weights(t: Array) -> Array:
     """The trapezoid rule as weights, (N,): ``w @ y`` is the integral of samples ``y`` (N, ...)
     at times ``t`` (s, (N,)) over ``[t[0], t[-1]]``: ``w_i = (t[i+1] - t[i-1]) / 2``, half a
-    step at either end; zero for a single sample."""
+    step at either end; zero for a single sample. (The accumulator sums ``w[:, None] * y``
+    rather than calling BLAS: a threaded BLAS's workers spin after each call, taking the cores
+    the log's reader needs.)"""
     w = np.zeros(t.size)
     if t.size > 1:
         dt = 0.5 * np.diff(t)
@@ -198,7 +200,7 @@ class EnergyAccumulator:
             self.duration += float(t[0] - t0)
         edges = [0, *(c for c in cuts if c > 0), t.size]
         for a, b in itertools.pairwise(edges):
-            self.sums += trapezoid_weights(t[a:b]) @ y[a:b]
+            self.sums += np.sum(trapezoid_weights(t[a:b])[:, None] * y[a:b], axis=0)
             self.duration += float(t[b - 1] - t[a])
         self.segments += len(starts)
         self.samples += t.size
