@@ -9,7 +9,7 @@ per joint with the four-way breakdown. Warm-up first (numba kernels), then min a
     python benchmarks/bench_energy.py [--repeats 15]
 
 ``--long``: the energy of a long UR log (issue 16 bar: a 60-minute 500 Hz log under 10 s and
-under 500 MB), ``energy_of_log`` in chunks of ``ENERGY_ROWS`` (15,000) rows (``one-pass``) against the same with
+under 500 MB), ``energy_of_log`` in chunks of ``ENERGY_ROWS`` (10,000) rows (``one-pass``) against the same with
 the whole log as one chunk (``in-memory``), each in a fresh process
 (so its peak resident memory is its own), on the log of ``benchmarks/bench_read.py`` (actual_q
 and actual_qd: accelerations from a spline of the speed). Prints the seconds of the call (after a
