@@ -3,6 +3,8 @@ every kind of malformed input."""
 
 from __future__ import annotations
 
+import threading
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -179,3 +181,45 @@ def test_reads_the_headerless_ur10e_logs() -> None:
         columns=spec,
     )
     assert log["target_moment"].shape == (len(log), 6)
+
+
+def test_reading_ahead_keeps_the_order_and_raises_where_the_reader_failed() -> None:
+    from kinergy.logs.reading import _read_ahead
+
+    def chunks() -> Iterator[int]:
+        yield from range(5)
+        raise KinergyError("log.csv: line 7: not a number")
+
+    got: list[int] = []
+    with pytest.raises(KinergyError, match="line 7"):
+        for x in _read_ahead(chunks()):
+            got.append(x)
+    assert got == [0, 1, 2, 3, 4]
+    assert list(_read_ahead(iter(range(1000)))) == list(range(1000))
+
+
+def test_reading_ahead_stops_the_reader_and_closes_its_files_when_the_caller_stops() -> None:
+    from kinergy.logs.reading import _read_ahead
+
+    read: list[int] = []
+    closed = threading.Event()
+
+    def chunks() -> Iterator[int]:
+        try:
+            for i in range(10_000):
+                read.append(i)
+                yield i
+        finally:
+            closed.set()
+
+    def readers() -> set[threading.Thread]:
+        return {t for t in threading.enumerate() if t.name == "kinergy-log-reader"}
+
+    before = readers()
+    ahead = _read_ahead(chunks())
+    assert [next(ahead) for _ in range(3)] == [0, 1, 2]
+    assert len(readers() - before) == 1
+    ahead.close()  # the caller stops early (as on an error)
+    assert closed.is_set()  # closed before close() returned: the reader thread has ended
+    assert len(read) <= 5  # it read at most one chunk ahead of the caller (and one in hand)
+    assert not readers() - before

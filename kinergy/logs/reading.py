@@ -12,8 +12,10 @@ from __future__ import annotations
 
 import hashlib
 import os
+import queue
 import threading
 from collections.abc import Iterator, Sequence
+from typing import TypeVar
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -124,6 +126,59 @@ def _file_hash(path: Path, out: list[str], stop: threading.Event) -> None:
     out.append(digest.hexdigest())
 
 
+T = TypeVar("T")
+
+#: what the reader thread puts last: the end of its chunks
+_END = object()
+
+
+def _read_ahead(chunks: Iterator[T]) -> Iterator[T]:
+    """``chunks`` in order, each read in a thread while the caller works on the one before:
+    parsing (pyarrow) and the caller's numerical work (numpy, numba) release the interpreter
+    lock, so the two overlap on two cores; one chunk waits at most, so memory grows by one chunk.
+
+    An exception the reader raises is raised here after the chunks before it, as without the
+    thread. When the caller stops early (an error, or it closes this generator), the reader
+    stops after the chunk it is reading and its files are closed in its own thread.
+    """
+    ready: queue.Queue[object] = queue.Queue(maxsize=1)
+    stop = threading.Event()
+
+    def put(item: object) -> bool:
+        while not stop.is_set():
+            try:
+                ready.put(item, timeout=0.05)
+                return True
+            except queue.Full:
+                continue
+        return False
+
+    def read() -> None:
+        try:
+            for chunk in chunks:
+                if not put(chunk):
+                    break
+            else:
+                put(_END)
+        except BaseException as exc:  # handed to the caller, raised there
+            put(exc)
+        finally:
+            close = getattr(chunks, "close", None)
+            if close is not None:
+                close()
+
+    reader = threading.Thread(target=read, name="kinergy-log-reader", daemon=True)
+    reader.start()
+    try:
+        while (item := ready.get()) is not _END:
+            if isinstance(item, BaseException):
+                raise item
+            yield item  # type: ignore[misc]
+    finally:
+        stop.set()
+        reader.join()
+
+
 def _log_hash(log: Log) -> tuple[str, int]:
     """SHA-256 and size of a log's samples: its time stamps and signals, by name."""
     digest = hashlib.sha256()
@@ -190,7 +245,7 @@ class CheckedLog:
                     list(log.notes) if start == 0 else [],
                 )
             return
-        yield from iter_log(
+        chunks = iter_log(
             self.source,
             columns=self.reading.columns,
             repair=self.reading.repair,
@@ -199,6 +254,7 @@ class CheckedLog:
             joints=self.robot.joint_names,
             bag=self.reading.bag,
         )
+        yield from _read_ahead(chunks)
 
     def names(self) -> set[str]:
         """The signals the log has (its first rows read to tell)."""
