@@ -15,9 +15,9 @@ import os
 import queue
 import threading
 from collections.abc import Iterator, Sequence
-from typing import TypeVar
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -207,6 +207,11 @@ class CheckedLog:
         are read too.
     rows : int
         The most samples per chunk.
+    ahead : bool
+        Read a file one chunk ahead in a thread (:func:`_read_ahead`): for a consumer whose work
+        per chunk is heavy and whose chunks are small (energy: the 60-minute log 9.7-10.4 s ->
+        7.6 s, the same peak). Off by default: identification's peak rose by up to 65 MiB with
+        it (the reader thread's allocations stay in a malloc arena of their own).
 
     Attributes
     ----------
@@ -224,6 +229,7 @@ class CheckedLog:
     reading: LogReading = field(default_factory=LogReading)
     select: Sequence[str] | None = None
     rows: int = CHUNK_ROWS
+    ahead: bool = False
     checks: LogChecks | None = None
     provenance: Provenance | None = None
     notes: list[str] = field(default_factory=list)
@@ -254,7 +260,7 @@ class CheckedLog:
             joints=self.robot.joint_names,
             bag=self.reading.bag,
         )
-        yield from _read_ahead(chunks)
+        yield from _read_ahead(chunks) if self.ahead else chunks
 
     def names(self) -> set[str]:
         """The signals the log has (its first rows read to tell)."""

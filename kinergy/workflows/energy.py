@@ -135,7 +135,7 @@ def energy_of_log(
         return _with(energy(robot, motion, recovery=recovery).figures(), inputs)
     acc = EnergyAccumulator(robot, recovery=recovery)
     measured = False
-    log = CheckedLog(path, robot, reading or LogReading(), rows=rows)
+    log = CheckedLog(path, robot, reading or LogReading(), rows=rows, ahead=True)
     log.select = _signals_used(log, source)
     for part in iter_motion(log.chunks(), n_joints=robot.n, source=source):
         m = part.motion
