@@ -387,3 +387,28 @@ def test_a_bag_folder_is_known_by_the_content_of_its_files(tmp_path: Path) -> No
         assert checked.provenance.size > 0
         digests.append(checked.provenance.sha256)
     assert digests[0] != digests[1] and digests[0] == digests[2]
+
+
+@pytest.mark.skipif(not PTP.exists(), reason="shared datasets not available")
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_the_energy_of_a_bag_read_ahead_in_a_thread_is_the_csv_logs(
+    tmp_path: Path, storage: str
+) -> None:
+    """Energy reads a log one chunk ahead in a thread: a bag's storage (an SQLite connection is
+    bound to the thread that opened it) is opened and read there, with the CSV log's result."""
+    from kinergy.io.columns import parse_columns
+    from kinergy.logs.reading import LogReading
+    from kinergy.workflows.energy import energy_of_log
+
+    csv = read_log(PTP, columns=COLUMNS)
+    bag = write_bag(
+        tmp_path / "ptp", csv.t, csv["actual_q"], csv["actual_qd"], csv["actual_current"],
+        storage=storage,
+    )  # fmt: skip
+    robot = load_robot("ur10e")
+    reading = LogReading(columns=tuple(parse_columns(COLUMNS)))
+    from_csv = energy_of_log(robot, PTP, reading, rows=500)
+    from_bag = energy_of_log(robot, bag, rows=500)
+    assert from_bag.samples == from_csv.samples > 5 * 500
+    np.testing.assert_array_equal(from_bag.e_elec, from_csv.e_elec)
+    assert from_bag.supply.drawn == from_csv.supply.drawn
