@@ -9,19 +9,25 @@ point-to-point programs are mostly static holds, where the current is the holdin
 wandering standstill friction no motion model predicts; so every figure is given again for the
 ``moving`` and the ``holding`` samples apart (holding: every joint slower than
 :data:`HOLD_SPEED` for at least :data:`HOLD_SECONDS`), and for each log on its own.
+
+Every figure is accumulated over each log's chunks in one pass (:func:`validation_report`), so a
+log of any length is validated in bounded memory.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.arrays import Array
-from kinergy.identification.metrics import JointMetrics, fit_metrics
-from kinergy.identification.result import Validation, predict
+from kinergy.identification.chunks import Segment, WholeSegment, data_history
+from kinergy.identification.metrics import JointMetrics, MetricSums
+from kinergy.identification.result import Prediction, Validation, predict
+from kinergy.identification.sanity import check_signals
+from kinergy.io.formats import CHUNK_ROWS
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs
 from kinergy.model.robot import Robot
@@ -30,8 +36,10 @@ __all__ = [
     "EXCITED_RANGE",
     "HOLD_SECONDS",
     "HOLD_SPEED",
+    "PLOT_SAMPLES",
     "LogValidation",
     "SegmentedValidation",
+    "Series",
     "SignalMetrics",
     "ValidationReport",
     "holding_mask",
@@ -45,9 +53,11 @@ HOLD_SPEED = 0.02
 HOLD_SECONDS = 0.5
 #: rad: a joint whose position spans less than this over the samples is not excited
 EXCITED_RANGE = 0.02
+#: most samples of one log kept for plots (:attr:`LogValidation.series`); a longer log's plots
+#: show every k-th sample
+PLOT_SAMPLES = 200_000
 #: the signals compared, as (name, measured attribute of IdentData)
 SIGNALS = (("torque", "tau_ref"), ("current", "current"), ("joint_torque", "torque"))
-_FIELDS = ("measured", "predicted", "q", "holding")
 
 
 @dataclass(frozen=True)
@@ -72,11 +82,24 @@ class SegmentedValidation(Validation):
     holding: Validation | None = None
 
 
+@dataclass(frozen=True, eq=False)
+class Series:
+    """One signal of one log for plots: time from the log's start (N,) s, the measured and the
+    predicted values (N, n), every ``step``-th sample of the log."""
+
+    t: Array
+    measured: Array
+    predicted: Array
+    step: int = 1
+
+
 @dataclass(frozen=True)
 class LogValidation(SegmentedValidation):
-    """One log's :class:`SegmentedValidation`."""
+    """One log's :class:`SegmentedValidation`, and its signals for plots (:class:`Series`, by
+    signal name; not in JSON)."""
 
     log: str = ""
+    series: Mapping[str, Series] = field(default_factory=dict, metadata={"json": False})
 
 
 @dataclass(frozen=True)
@@ -94,95 +117,238 @@ class ValidationReport(SegmentedValidation):
 def holding_mask(t: Array, qd: Array) -> NDArray[np.bool_]:
     """Samples of static holds: every joint slower than :data:`HOLD_SPEED` for at least
     :data:`HOLD_SECONDS`; ``t`` (N,) in s, ``qd`` (N, n) in rad/s -> (N,) bool."""
-    still = np.all(np.abs(qd) < HOLD_SPEED, axis=1)
-    mask = np.zeros_like(still)
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], still.astype(np.int8), [0]])))
-    for start, stop in zip(edges[::2], edges[1::2], strict=True):
-        if t[stop - 1] - t[start] >= HOLD_SECONDS:
-            mask[start:stop] = True
-    return mask
+    return _Holds().mask(t, qd, closed=True)[0]
 
 
 def _signal_metrics(measured: Array, predicted: Array, q: Array) -> tuple[SignalMetrics, ...]:
     """Per joint metrics of (N, n) signals, with the joint positions ``q`` (N, n) deciding which
     joints were excited."""
-    out = []
-    for j, m in enumerate(fit_metrics(measured, predicted)):
-        spread = float(np.ptp(q[:, j])) if len(q) else 0.0
-        level = float(np.sqrt(np.mean(measured[:, j] ** 2))) if len(q) else 0.0
-        note = None
-        if spread < EXCITED_RANGE:
-            note = "not excited"
-        elif not np.isfinite(m.r2):
-            note = "signal constant"
-        r2 = m.r2 if note is None else float("nan")
-        nrms = m.rms / level if level > 0 else float("nan")
-        out.append(SignalMetrics(m.mean, m.max, m.rms, r2, nrms, note))
-    return tuple(out)
+    part = _Part(q.shape[1])
+    part.add(measured, predicted, q)
+    metrics = part.metrics()
+    assert metrics is not None, "no samples"
+    return metrics
+
+
+class _Part:
+    """One signal's figures over some samples, accumulated block by block: the error
+    statistics (:class:`~kinergy.identification.metrics.MetricSums`) and each joint's position
+    range (which joints were excited)."""
+
+    def __init__(self, n: int):
+        self.sums = MetricSums(n)
+        self.low = np.full(n, np.inf)
+        self.high = np.full(n, -np.inf)
+
+    def add(self, measured: Array, predicted: Array, q: Array) -> None:
+        """Fold in a block of (N, n) signals and joint positions."""
+        if len(q):
+            self.sums.add(measured, predicted)
+            self.low = np.minimum(self.low, q.min(axis=0))
+            self.high = np.maximum(self.high, q.max(axis=0))
+
+    def metrics(self) -> tuple[SignalMetrics, ...] | None:
+        """Per joint :class:`SignalMetrics`; None without samples."""
+        if self.sums.count == 0:
+            return None
+        level = np.sqrt(self.sums.sq / self.sums.count)
+        out = []
+        for j, m in enumerate(self.sums.metrics()):
+            note = None
+            if self.high[j] - self.low[j] < EXCITED_RANGE:
+                note = "not excited"
+            elif not np.isfinite(m.r2):
+                note = "signal constant"
+            r2 = m.r2 if note is None else float("nan")
+            nrms = m.rms / level[j] if level[j] > 0 else float("nan")
+            out.append(SignalMetrics(m.mean, m.max, m.rms, r2, nrms, note))
+        return tuple(out)
 
 
 @dataclass(frozen=True, eq=False)
-class _Signal:
-    """One signal over some samples: measured and predicted (N, n), the joint positions (N, n)
-    and which samples are static holds (N,)."""
+class _Rows:
+    """Consecutive samples of one log: time (N,) s, the real joint positions and speeds (N, n)
+    and, per signal name, the measured and predicted values (N, n)."""
 
-    measured: Array
-    predicted: Array
+    t: Array
     q: Array
-    holding: NDArray[np.bool_]
+    qd: Array
+    signals: dict[str, tuple[Array, Array]]
 
-    def metrics(self, rows: NDArray[np.bool_]) -> tuple[SignalMetrics, ...] | None:
-        if not rows.any():
-            return None
-        return _signal_metrics(self.measured[rows], self.predicted[rows], self.q[rows])
+    def take(self, rows: slice) -> _Rows:
+        return _Rows(
+            self.t[rows],
+            self.q[rows],
+            self.qd[rows],
+            {k: (m[rows], p[rows]) for k, (m, p) in self.signals.items()},
+        )
+
+    def then(self, later: _Rows) -> _Rows:
+        """These samples, then ``later``'s."""
+
+        def cat(a: Array, b: Array) -> Array:
+            return np.concatenate([a, b])
+
+        return _Rows(
+            cat(self.t, later.t),
+            cat(self.q, later.q),
+            cat(self.qd, later.qd),
+            {
+                k: (cat(m, later.signals[k][0]), cat(p, later.signals[k][1]))
+                for k, (m, p) in self.signals.items()
+            },
+        )
 
 
-def _signals(robot: Robot, data: IdentData) -> dict[str, _Signal]:
-    """The signals ``data`` logged, with ``robot``'s predictions."""
-    pred = predict(robot, data)
-    holding = holding_mask(data.t, data.qd)
-    out = {}
+class _Holds:
+    """:func:`holding_mask` of one log over its chunks, in time order (the same mask as of the
+    whole log). A sample is decided once the still run it belongs to has lasted
+    :data:`HOLD_SECONDS` (a hold, whatever follows) or has ended; the samples of a still run
+    still shorter than that at the end of a chunk wait for the next (at most
+    :data:`HOLD_SECONDS` of samples)."""
+
+    def __init__(self) -> None:
+        self.waiting: _Rows | None = None
+        self.in_hold = False  # the decided samples end in a hold that may go on
+
+    def mask(self, t: Array, qd: Array, closed: bool) -> tuple[NDArray[np.bool_], int]:
+        """The holding mask of samples ``t`` (N,), ``qd`` (N, n) following the decided ones,
+        and how many of them are decided (all when the log ends with them, ``closed``)."""
+        still = np.all(np.abs(qd) < HOLD_SPEED, axis=1)
+        mask = np.zeros_like(still)
+        decided = len(still)
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], still.astype(np.int8), [0]])))
+        for start, stop in zip(edges[::2], edges[1::2], strict=True):
+            if t[stop - 1] - t[start] >= HOLD_SECONDS or (start == 0 and self.in_hold):
+                mask[start:stop] = True
+            elif stop == len(still) and not closed:
+                decided = int(start)
+        self.in_hold = bool(decided == len(still) and len(still) and mask[-1])
+        return mask[:decided], decided
+
+    def feed(self, rows: _Rows, closed: bool = False) -> tuple[_Rows, NDArray[np.bool_]]:
+        """The samples now decided (those waiting, then ``rows``'s) and their holding mask."""
+        if self.waiting is not None:
+            rows = self.waiting.then(rows)
+        mask, decided = self.mask(rows.t, rows.qd, closed)
+        self.waiting = rows.take(slice(decided, None)) if decided < len(rows.t) else None
+        return rows.take(slice(0, decided)), mask
+
+
+_PARTS = ("whole", "moving", "holding")
+
+
+class _Tally:
+    """The figures of one log (or of all): per signal over all, the moving and the holding
+    samples (:class:`_Part`), and how many samples and holding samples there were."""
+
+    def __init__(self, n: int):
+        self.n = n
+        self.parts: dict[str, dict[str, _Part]] = {}
+        self.samples = 0
+        self.held = 0
+
+    def add(self, rows: _Rows, holding: NDArray[np.bool_]) -> None:
+        self.samples += len(holding)
+        self.held += int(holding.sum())
+        for name, (measured, predicted) in rows.signals.items():
+            parts = self.parts.setdefault(name, {key: _Part(self.n) for key in _PARTS})
+            parts["whole"].add(measured, predicted, rows.q)
+            for key, sel in (("moving", ~holding), ("holding", holding)):
+                parts[key].add(measured[sel], predicted[sel], rows.q[sel])
+
+    def fields(self) -> dict[str, object]:
+        """The fields of a :class:`SegmentedValidation`."""
+        found = {}
+        for key in _PARTS:
+            metrics = {name: parts[key].metrics() for name, parts in self.parts.items()}
+            found[key] = None if all(m is None for m in metrics.values()) else metrics
+        return {
+            **(found["whole"] or {}),
+            "samples": self.samples,
+            "holding_fraction": self.held / self.samples if self.samples else 0.0,
+            "moving": None if found["moving"] is None else Validation(**found["moving"]),
+            "holding": None if found["holding"] is None else Validation(**found["holding"]),
+        }
+
+
+class _Sampled:
+    """Every ``step``-th sample of a log's signals, chunk by chunk (:class:`Series`)."""
+
+    def __init__(self, step: int):
+        self.step, self.seen, self.t0 = step, 0, 0.0
+        self.parts: dict[str, list[tuple[Array, Array, Array]]] = {}
+
+    def add(self, rows: _Rows) -> None:
+        if self.seen == 0 and len(rows.t):
+            self.t0 = float(rows.t[0])
+        at = slice((-self.seen) % self.step, None, self.step)
+        self.seen += len(rows.t)
+        for name, (measured, predicted) in rows.signals.items():
+            self.parts.setdefault(name, []).append((rows.t[at], measured[at], predicted[at]))
+
+    def series(self) -> dict[str, Series]:
+        out = {}
+        for name, parts in self.parts.items():
+            t, measured, predicted = (np.concatenate(x) for x in zip(*parts, strict=True))
+            out[name] = Series(t - self.t0, measured, predicted, self.step)
+        return out
+
+
+def _rows(robot: Robot, data: IdentData, pred: Prediction) -> _Rows:
+    """``data``'s samples with the signals it logged and ``robot`` predicts."""
+    signals = {}
     for name, attr in SIGNALS:
         measured, predicted = getattr(data, attr), getattr(pred, name)
         if measured is not None and predicted is not None:
-            out[name] = _Signal(np.asarray(measured), np.asarray(predicted), data.q, holding)
-    return out
+            signals[name] = (np.asarray(measured), np.asarray(predicted))
+    return _Rows(data.t, data.q, data.qd, signals)
 
 
-def _segmented(signals: dict[str, _Signal], t_holding: NDArray[np.bool_]) -> dict[str, object]:
-    """The fields of a :class:`SegmentedValidation` of ``signals``; ``t_holding`` (N,) marks the
-    static holds among all the samples."""
-    parts = {}
-    for key, select in (("whole", None), ("moving", False), ("holding", True)):
-        metrics = {
-            k: s.metrics(np.ones(len(s.q), bool) if select is None else s.holding == select)
-            for k, s in signals.items()
-        }
-        parts[key] = None if all(m is None for m in metrics.values()) else metrics
-    return {
-        **(parts["whole"] or {}),
-        "samples": len(t_holding),
-        "holding_fraction": float(np.mean(t_holding)) if len(t_holding) else 0.0,
-        "moving": None if parts["moving"] is None else Validation(**parts["moving"]),
-        "holding": None if parts["holding"] is None else Validation(**parts["holding"]),
-    }
+def validation_report(
+    robot: Robot,
+    logs: Sequence[Segment | IdentData],
+    *,
+    rows: int = CHUNK_ROWS,
+    plot_samples: int = 0,
+) -> ValidationReport:
+    """How well ``robot`` predicts ``logs`` (prepared segments, or prepared logs in memory):
+    pooled and per log, moving and holding apart (module docstring), in one pass over each
+    log's chunks of ``rows`` samples (the same figures to round-off, whatever the chunks).
 
+    Friction held through standstill is predicted as in the whole log
+    (:func:`~kinergy.identification.chunks.data_history`). With ``plot_samples`` > 0, each
+    log's :attr:`LogValidation.series` keeps its signals for plots: every sample of a log up to
+    that many samples, every ``k``-th of a longer one (the figures use every sample).
 
-def validation_report(robot: Robot, datas: Sequence[IdentData]) -> ValidationReport:
-    """How well ``robot`` predicts ``datas``: pooled and per log, moving and holding apart
-    (module docstring)."""
-    per_log = [_signals(robot, d) for d in datas]
-    holds = [holding_mask(d.t, d.qd) for d in datas]
-    logs = tuple(
-        LogValidation(**_segmented(sig, hold), log=str(d.path))  # type: ignore[arg-type]
-        for sig, hold, d in zip(per_log, holds, datas, strict=True)
-    )
-    pooled = {}
-    for name, _ in SIGNALS:
-        found = [sig[name] for sig in per_log if name in sig]
-        if found:
-            pooled[name] = _Signal(
-                *(np.concatenate([getattr(f, a) for f in found]) for a in _FIELDS)
-            )
-    every = np.concatenate(holds) if holds else np.zeros(0, dtype=bool)
-    return ValidationReport(**_segmented(pooled, every), logs=logs)  # type: ignore[arg-type]
+    Raises
+    ------
+    KinergyError
+        A chunk's signal not finite or beyond what a robot logs
+        (:func:`~kinergy.identification.sanity.check_signals`).
+    """
+    segments = [WholeSegment(x) if isinstance(x, IdentData) else x for x in logs]
+    pooled = _Tally(robot.n)
+    held = data_history(robot)
+    out = []
+    for k, segment in enumerate(segments):
+        tally, holds = _Tally(robot.n), _Holds()
+        sampled = _Sampled(-(-len(segment) // plot_samples)) if plot_samples > 0 else None
+        for chunk in segment.chunks(rows):
+            check_signals([chunk])
+            data, skip = held.ahead(k, chunk)
+            pred = predict(robot, data).after(skip)
+            held.update(data, skip)
+            found = _rows(robot, chunk, pred)
+            if sampled is not None:
+                sampled.add(found)
+            decided, holding = holds.feed(found)
+            tally.add(decided, holding)
+            pooled.add(decided, holding)
+        if holds.waiting is not None:  # a still run shorter than a hold ends the log
+            last = holds.waiting
+            tally.add(last, np.zeros(len(last.t), dtype=bool))
+            pooled.add(last, np.zeros(len(last.t), dtype=bool))
+        series = {} if sampled is None else sampled.series()
+        out.append(LogValidation(**tally.fields(), log=str(segment.path), series=series))  # type: ignore[arg-type]
+    return ValidationReport(**pooled.fields(), logs=tuple(out))  # type: ignore[arg-type]

@@ -10,9 +10,9 @@ from pathlib import Path
 
 from kinergy.accounting.energy import energy
 from kinergy.files import output_folder
-from kinergy.identification.metrics import fit_metrics
-from kinergy.identification.result import IdentificationResult, predict
-from kinergy.identification.sequential import identify_sequential
+from kinergy.identification.chunks import Segment
+from kinergy.identification.result import IdentificationResult
+from kinergy.identification.validation import PLOT_SAMPLES, validation_report
 from kinergy.io.task import Task
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import LogReading
@@ -21,7 +21,8 @@ from kinergy.model.robot import Robot
 from kinergy.report.html import Section, Table, write_report
 from kinergy.report.study import Comparison, Study, Timing, study_sections
 from kinergy.trajectory.motion import Motion
-from kinergy.workflows.logs import prepared_logs, read_motion
+from kinergy.workflows.identify import identify_logs as identified
+from kinergy.workflows.logs import chunked_logs, read_motion
 from kinergy.workflows.optimize import optimize_task
 
 __all__ = ["optimal_timing", "run_study", "study_report", "write_study"]
@@ -30,20 +31,20 @@ Progress = Callable[[str], None]
 
 
 def _comparisons(
-    model: Robot, validation: Mapping[str, IdentData], say: Progress
+    model: Robot, validation: Mapping[str, Segment | IdentData], say: Progress
 ) -> tuple[dict[str, Comparison], dict[str, Comparison]]:
-    """Per log: the model's reference torque and current against the logged ones."""
-    torque, current = {}, {}
-    for name, data in validation.items():
+    """Per log: the model's reference torque and current against the logged ones (a log's
+    figures over every sample, its plots over at most
+    :data:`~kinergy.identification.validation.PLOT_SAMPLES`)."""
+    torque: dict[str, Comparison] = {}
+    current: dict[str, Comparison] = {}
+    for name, log in validation.items():
         say(f"validating on {name}")
-        pred = predict(model, data)
-        t = data.t - data.t[0]
-        if data.tau_ref is not None and pred.torque is not None:
-            metrics = fit_metrics(data.tau_ref, pred.torque)
-            torque[name] = Comparison(t, data.tau_ref, pred.torque, metrics)
-        if data.current is not None and pred.current is not None:
-            metrics = fit_metrics(data.current, pred.current)
-            current[name] = Comparison(t, data.current, pred.current, metrics)
+        found = validation_report(model, [log], plot_samples=PLOT_SAMPLES).logs[0]
+        for key, out in (("torque", torque), ("current", current)):
+            series, metrics = found.series.get(key), getattr(found, key)
+            if series is not None and metrics is not None:
+                out[name] = Comparison(series.t, series.measured, series.predicted, metrics)
     return torque, current
 
 
@@ -56,7 +57,7 @@ def optimal_timing(model: Robot, task: Task, *, points: int = 6) -> Timing:
 def run_study(
     model: Robot,
     *,
-    validation: Mapping[str, IdentData] | None = None,
+    validation: Mapping[str, Segment | IdentData] | None = None,
     motions: Mapping[str, Motion] | None = None,
     result: IdentificationResult | None = None,
     truth: Robot | None = None,
@@ -69,8 +70,9 @@ def run_study(
     Parameters
     ----------
     model : Robot
-    validation : mapping of str to IdentData
-        Logs to compare the model with, by name (``"test A"``).
+    validation : mapping of str to Segment or IdentData
+        Logs to compare the model with, by name (``"test A"``): prepared segments
+        (:func:`~kinergy.workflows.logs.chunked_logs`, folded in chunks) or logs in memory.
     motions : mapping of str to Motion
         Motions to account the energy of, by name.
     result, truth, paper
@@ -140,24 +142,23 @@ def study_report(
     result = None
     if identify_logs:
         say("identifying")
-        datas, inputs = prepared_logs(identify_logs, robot, reading)
-        result = identify_sequential(robot, datas)
-        said.notes += [*inputs.notes, *result.notes]
-        said.warnings += [*inputs.warnings, *result.warnings]
+        result = identified(robot, identify_logs, None, reading=reading)
+        said.notes += result.notes
+        said.warnings += result.warnings
         robot = result.robot
-    datas, inputs = prepared_logs(validate_logs, robot, reading)
-    said.notes += inputs.notes
-    said.warnings += inputs.warnings
-    validation = {Path(d.path).name: d for d in datas}
     motions = {}
     for p in energy_logs:
         motion, inputs = read_motion(p, robot, reading)
         said.notes += inputs.notes
         said.warnings += inputs.warnings
         motions[Path(p).name] = motion
-    study = run_study(
-        robot, validation=validation, motions=motions, result=result, progress=progress
-    )
+    with chunked_logs(validate_logs, robot, reading) as (segments, inputs):
+        said.notes += inputs.notes
+        said.warnings += inputs.warnings
+        validation = {Path(s.path).name: s for s in segments}
+        study = run_study(
+            robot, validation=validation, motions=motions, result=result, progress=progress
+        )
     with output_folder(out, prefix="kinergy-report") as (folder, target):
         _, tables = write_study(
             study,

@@ -8,15 +8,17 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from kinergy.identification.result import predict
-from kinergy.identification.sanity import check_signals
-from kinergy.identification.validation import ValidationReport, validation_report
+from kinergy.identification.validation import (
+    PLOT_SAMPLES,
+    LogValidation,
+    ValidationReport,
+    validation_report,
+)
 from kinergy.io.log import Log
-from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.report.plots import error_boxplot, save, time_series
-from kinergy.workflows.logs import prepared_logs
+from kinergy.workflows.logs import chunked_logs
 from kinergy.workflows.twin import builtin_log, is_builtin
 
 __all__ = ["identified_from", "validate_logs", "write_validation_plots"]
@@ -43,49 +45,72 @@ def validate_logs(
     *,
     plots: str | os.PathLike[str] | None = None,
 ) -> ValidationReport:
-    """UR5e Tables V and VII for ``logs`` (read through the checks), pooled and per log, moving
-    and holding apart (:func:`~kinergy.identification.validation.validation_report`); with ``plots``,
-    also write the measured-against-predicted figures to that folder. A log the model was
-    identified from is named in a warning."""
+    """UR5e Tables V and VII for ``logs`` (read through the checks, in chunks), pooled and per
+    log, moving and holding apart (:func:`~kinergy.identification.validation.validation_report`);
+    with ``plots``, also write the measured-against-predicted figures to that folder. A log the
+    model was identified from is named in a warning."""
     sources = [builtin_log(robot, str(log)) if is_builtin(log) else log for log in logs]
-    datas, inputs = prepared_logs(sources, robot, reading or LogReading())
+    with chunked_logs(sources, robot, reading or LogReading()) as (segments, inputs):
+        report = validation_report(
+            robot, segments, plot_samples=PLOT_SAMPLES if plots is not None else 0
+        )
     inputs.notes += [
         f"{log}: the realistic twin of {robot.name} (seed 0) running the built-in motion {log}: "
         "a simulated log, not a real robot's"
         for log in logs
         if is_builtin(log)
     ]
-    check_signals(datas)
-    report = validation_report(robot, list(datas))
     if plots is not None:
-        write_validation_plots(robot, datas, plots)
+        write_validation_plots(robot, report.logs, plots)
+        inputs.notes += [
+            f"{log.log}: its plots show one sample in {s.step} of {log.samples:,} "
+            "(the figures use every sample)"
+            for log in report.logs
+            for s in list(log.series.values())[:1]
+            if s.step > 1
+        ]
     warnings = [*inputs.warnings, *identified_from(robot, inputs)]
     return dataclasses.replace(
         report, inputs=inputs, notes=tuple(inputs.notes), warnings=tuple(warnings)
     )
 
 
+def _stems(names: Sequence[str]) -> list[str]:
+    """A distinct file stem for each log or segment (``run.csv#1`` -> ``run#1``; a stem seen
+    before gets ``-2``, ``-3``, ...)."""
+    out: list[str] = []
+    for k, name in enumerate(names):
+        path, _, segment = name.partition("#")
+        stem = (Path(path).stem or f"log{k}") + (f"#{segment}" if segment else "")
+        base, n = stem, 1
+        while stem in out:
+            n += 1
+            stem = f"{base}-{n}"
+        out.append(stem)
+    return out
+
+
 def write_validation_plots(
-    robot: Robot, datas: Sequence[IdentData], folder: str | os.PathLike[str]
+    robot: Robot, logs: Sequence[LogValidation], folder: str | os.PathLike[str]
 ) -> None:
-    """Per log, measured against predicted torque and current (``STEM_torque.png``,
-    ``STEM_current.png``); over all logs, the error box plots (``torque_errors.png``, ...)."""
+    """Per log (or segment), measured against predicted torque and current (``STEM_torque.png``,
+    ``STEM_current.png``, :func:`_stems`) from its :attr:`~kinergy.identification.validation.LogValidation.series`;
+    over all logs, the error box plots (``torque_errors.png``, ...)."""
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
     errors: dict[str, dict[str, Any]] = {"torque": {}, "current": {}}
-    for k, data in enumerate(datas):
-        pred = predict(robot, data)
-        stem = Path(data.path).stem or f"log{k}"
-        for key, measured, predicted, unit, label in (
-            ("torque", data.tau_ref, pred.torque, "N m", "target_moment"),
-            ("current", data.current, pred.current, "A", "actual_current"),
+    for log, stem in zip(logs, _stems([log.log for log in logs]), strict=True):
+        for key, unit, label in (
+            ("torque", "N m", "target_moment"),
+            ("current", "A", "actual_current"),
         ):
-            if measured is None or predicted is None:
+            series = log.series.get(key)
+            if series is None:
                 continue
             fig = time_series(
-                data.t - data.t[0],
-                measured,
-                predicted,
+                series.t,
+                series.measured,
+                series.predicted,
                 joint_names=robot.joint_names,
                 quantity=key,
                 unit=unit,
@@ -93,7 +118,7 @@ def write_validation_plots(
                 predicted_label="model",
             )
             save(fig, out / f"{stem}_{key}.png")
-            errors[key][stem] = measured - predicted
+            errors[key][stem] = series.measured - series.predicted
     for key, unit in (("torque", "N m"), ("current", "A")):
         if errors[key]:
             fig = error_boxplot(errors[key], joint_names=robot.joint_names, quantity=key, unit=unit)
