@@ -127,3 +127,26 @@ def test_energy_floor_is_below_the_friction_of_the_program() -> None:
     for key, part in floor.parts.items():  # the same parts as the re-simulation's breakdown
         assert part.sum() == pytest.approx(run.result.breakdown[key], rel=1e-3, abs=1e-3)
     assert 0.0 < floor.untouched < run.result.e_elec
+
+
+def test_the_energy_of_a_program_carries_the_load_it_sets(tmp_path: Path) -> None:
+    """``kinergy energy`` of a URScript program runs it with its ``set_payload`` (as
+    ``optimize`` accounts it): the same as the program without it on the robot carrying that
+    load, and more than on the bare robot."""
+    from kinergy.io.urscript_reader import read_program
+    from kinergy.workflows.energy import energy_of_log
+
+    robot = load_robot("ur5e")
+    program = Path(__file__).parent / "programs" / "small.script"
+    (load,) = [
+        s.payload for s in read_program(program).steps if getattr(s, "kind", "") == "payload"
+    ]
+    bare = tmp_path / "bare.script"
+    bare.write_text(program.read_text().replace("  set_payload(0.5)\n", ""))
+    got = energy_of_log(robot, program)
+    loaded = energy_of_log(robot.with_payload(load), bare)
+    unloaded = energy_of_log(robot, bare)
+    assert load is not None and load.mass == 0.5
+    np.testing.assert_allclose(got.e_elec, loaded.e_elec, rtol=1e-12)
+    np.testing.assert_allclose(got.breakdown["copper"], loaded.breakdown["copper"], rtol=1e-12)
+    assert got.total_e_elec > unloaded.total_e_elec * 1.01

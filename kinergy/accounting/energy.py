@@ -258,6 +258,7 @@ def energy(
     *,
     recovery: bool = True,
     temperature: Array | None = None,
+    state: DriveState | None = None,
 ) -> EnergyReport:
     """Per-joint and total mechanical and electrical energy of ``motion`` (UR5e eqs 23-26): the
     accumulation of :class:`EnergyAccumulator` over the motion as one chunk, with the time series.
@@ -275,12 +276,16 @@ def energy(
     temperature : ndarray, shape (N, n), optional
         Joint temperatures over the motion, deg C (a log's ``joint_temperatures``), for
         temperature-dependent friction.
+    state : DriveState, optional
+        The drives along ``motion`` when computed otherwise (say, each sample with the load a
+        program's ``set_payload`` gives it); default :func:`kinergy.predict.drive_state`.
 
     Returns
     -------
     EnergyReport
     """
-    state = drive_state(robot, motion.q, motion.qd, motion.qdd, temperature=temperature)
+    if state is None:
+        state = drive_state(robot, motion.q, motion.qd, motion.qdd, temperature=temperature)
     acc = EnergyAccumulator(robot, recovery=recovery)
     acc.add(motion.t, state, starts=[a for a, _ in segment_bounds(motion.t)])
     figures = acc.figures()

@@ -13,6 +13,7 @@ from kinergy.cli.common import (
     payload_option,
     prose,
     seed_option,
+    tell,
     writes,
 )
 from kinergy.twin import MISMATCHES, TwinSettings
@@ -27,7 +28,9 @@ __all__ = ["simulate"]
     "--trajectory",
     required=True,
     metavar="test-a|test-b|FILE",
-    help="The UR5e doc's test programs, or a motion file (record.py layout with target_q).",
+    help="The UR5e doc's test programs, a motion file (record.py layout with target_q) or a "
+    "URScript program (*.script, run as the controller runs it; its set_payload is not "
+    "simulated: --payload).",
 )
 @output_file_option("--out", "Log to write.", required=True)
 @click.option(
@@ -118,9 +121,11 @@ def simulate(
         ambient=ambient,
         initial_temperature=initial_temperature,
     )
-    t = simulate_to_file(
+    twin, said = simulate_to_file(
         r, trajectory, out, settings, reading=reading, mismatch=mismatch, truth_out=truth_out
-    ).t
+    )
+    tell(said.notes, said.warnings)
+    t = twin.t
     click.echo(
         prose(
             f"wrote {out}: {len(t)} samples, {t[-1] - t[0]:.3f} s, {r.name}, trajectory "

@@ -8,20 +8,23 @@ from typing import Any
 
 import numpy as np
 
-from kinergy.accounting.energy import EnergyAccumulator, energy
+from kinergy.accounting.energy import EnergyAccumulator, EnergyReport, energy
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.arrays import Array
 from kinergy.io.log import Log
 from kinergy.io.motion import iter_motion
+from kinergy.io.urscript_reader import read_program
 from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
+from kinergy.optimize.program_samples import drive_by_payload
 from kinergy.predict import drive_state
 from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.program_motion import payload_index, program_motion
+from kinergy.trajectory.program_path import program_path
 from kinergy.trajectory.programs import paper_trajectory
-from kinergy.workflows.logs import read_motion
 from kinergy.workflows.twin import is_builtin
 
-__all__ = ["ENERGY_ROWS", "LogEnergy", "energy_of_log"]
+__all__ = ["ENERGY_ROWS", "LogEnergy", "energy_of_log", "program_energy"]
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -105,6 +108,20 @@ def _derived(signals: list[str] | None) -> str | None:
     return None
 
 
+def program_energy(
+    robot: Robot, path: str | os.PathLike[str], *, recovery: bool = True
+) -> EnergyReport:
+    """The energy of a URScript program run once as the controller runs it (500 Hz, from where
+    it ends; :func:`kinergy.trajectory.program_motion.program_motion`), each sample with the load
+    the program's ``set_payload`` gives it from there on (the robot's own before the first), as
+    ``kinergy optimize`` accounts the program as written."""
+    program = program_path(robot, read_program(path))
+    motion, sched = program_motion(robot, program)
+    load = payload_index(program, sched, motion.t)[0]
+    state = drive_by_payload(robot, program.payloads, load, motion.q, motion.qd, motion.qdd)
+    return energy(robot, motion, recovery=recovery, state=state)
+
+
 def energy_of_log(
     robot: Robot,
     path: str | os.PathLike[str],
@@ -123,16 +140,15 @@ def energy_of_log(
     (:class:`kinergy.accounting.energy.EnergyAccumulator`, with the supply energy the log
     measured, ``actual_robot_voltage`` x ``actual_robot_current``, beside the predicted one);
     memory bounded by the chunk. Segments (a time gap or a ``segment`` change) are never
-    integrated across. A URScript program (``*.script``) is run as the controller would
-    (:func:`kinergy.workflows.logs.read_motion`)."""
+    integrated across. A URScript program (``*.script``) is run as the controller would, with
+    the loads it sets (:func:`program_energy`)."""
     inputs = InputLogs()
     if is_builtin(path):  # test-a, test-b: the motion as planned for the robot
         motion = paper_trajectory(robot, os.fspath(path))
         inputs.notes.append(f"{path}: the built-in motion {path} planned for {robot.name}")
         return _with(energy(robot, motion, recovery=recovery).figures(), inputs)
     if os.fspath(path).endswith(".script"):
-        motion, _ = read_motion(path, robot)
-        return _with(energy(robot, motion, recovery=recovery).figures(), inputs)
+        return _with(program_energy(robot, path, recovery=recovery).figures(), inputs)
     acc = EnergyAccumulator(robot, recovery=recovery)
     measured = False
     log = CheckedLog(path, robot, reading or LogReading(), rows=rows, ahead=True)

@@ -8,7 +8,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-from kinergy.accounting.energy import energy
+from kinergy.accounting.energy import EnergyReport, energy
 from kinergy.files import output_folder
 from kinergy.identification.chunks import Segment
 from kinergy.identification.result import IdentificationResult
@@ -21,6 +21,7 @@ from kinergy.model.robot import Robot
 from kinergy.report.html import Section, Table, write_report
 from kinergy.report.study import Comparison, Study, Timing, study_sections
 from kinergy.trajectory.motion import Motion
+from kinergy.workflows.energy import program_energy
 from kinergy.workflows.identify import identify_logs as identified
 from kinergy.workflows.logs import chunked_logs, read_motion
 from kinergy.workflows.optimize import optimize_task
@@ -58,7 +59,7 @@ def run_study(
     model: Robot,
     *,
     validation: Mapping[str, Segment | IdentData] | None = None,
-    motions: Mapping[str, Motion] | None = None,
+    motions: Mapping[str, Motion | EnergyReport] | None = None,
     result: IdentificationResult | None = None,
     truth: Robot | None = None,
     paper: bool = False,
@@ -73,8 +74,9 @@ def run_study(
     validation : mapping of str to Segment or IdentData
         Logs to compare the model with, by name (``"test A"``): prepared segments
         (:func:`~kinergy.workflows.logs.chunked_logs`, folded in chunks) or logs in memory.
-    motions : mapping of str to Motion
-        Motions to account the energy of, by name.
+    motions : mapping of str to Motion or EnergyReport
+        Motions to account the energy of, by name (or their energy, accounted otherwise: a
+        program run with the loads it sets, :func:`~kinergy.workflows.energy.program_energy`).
     result, truth, paper
         See :class:`~kinergy.report.study.Study`.
     task : Task, optional
@@ -85,7 +87,7 @@ def run_study(
     reports = {}
     for name, motion in (motions or {}).items():
         say(f"energy of {name}")
-        reports[name] = energy(model, motion)
+        reports[name] = motion if isinstance(motion, EnergyReport) else energy(model, motion)
     timing = None
     if task is not None:
         say(f"optimising the timing of {task.name}")
@@ -146,8 +148,11 @@ def study_report(
         said.notes += result.notes
         said.warnings += result.warnings
         robot = result.robot
-    motions = {}
+    motions: dict[str, Motion | EnergyReport] = {}
     for p in energy_logs:
+        if p.endswith(".script"):  # run with the loads it sets
+            motions[Path(p).name] = program_energy(robot, p)
+            continue
         motion, inputs = read_motion(p, robot, reading)
         said.notes += inputs.notes
         said.warnings += inputs.warnings

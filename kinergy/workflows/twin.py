@@ -7,7 +7,9 @@ from typing import TypeGuard
 
 from kinergy.io.log import Log
 from kinergy.io.rtde import write_log
+from kinergy.io.urscript_reader import read_program
 from kinergy.logs.reading import LogReading
+from kinergy.messages import Messages
 from kinergy.model.robot import Robot
 from kinergy.model.toml import save_robot
 from kinergy.trajectory.motion import Motion
@@ -37,11 +39,25 @@ def builtin_log(robot: Robot, name: str, seed: int = 0) -> Log:
     return simulate(truth, motion, TwinSettings.realistic(seed), name=name)
 
 
-def _target(robot: Robot, trajectory: str, reading: LogReading) -> Motion:
+def _target(robot: Robot, trajectory: str, reading: LogReading) -> tuple[Motion, Messages]:
+    """The target motion of ``trajectory`` and what reading it said: the notes and warnings of
+    a log's checks, and a warning for each load a URScript program sets (the twin carries the
+    robot's own payload throughout)."""
+    said = Messages()
     if trajectory in TEST_TRAJECTORIES:
-        return paper_trajectory(robot, trajectory)
-    motion, _ = read_motion(trajectory, robot, reading, source="target")
-    return motion
+        return paper_trajectory(robot, trajectory), said
+    motion, inputs = read_motion(trajectory, robot, reading, source="target")
+    said.notes += inputs.notes
+    said.warnings += inputs.warnings
+    if trajectory.endswith(".script"):
+        said.warnings += [
+            f"{trajectory}:{step.line}: {step.text.strip()} is not simulated: the twin carries "
+            f"{robot.name}'s own payload throughout (--payload sets it; kinergy energy and "
+            "optimize run the program with the loads it sets)"
+            for step in read_program(trajectory).steps
+            if getattr(step, "kind", "") == "payload"
+        ]
+    return motion, said
 
 
 def simulate_to_file(
@@ -53,18 +69,19 @@ def simulate_to_file(
     reading: LogReading | None = None,
     mismatch: str = "none",
     truth_out: str | os.PathLike[str] | None = None,
-) -> Log:
+) -> tuple[Log, Messages]:
     """Simulate ``trajectory`` (``test-a``, ``test-b`` or a motion file's target motion) on the
     twin of ``robot`` and write the log to ``out`` (record.py layout, atomically).
 
     ``mismatch``: ``none`` runs the model itself, ``realistic`` a true robot that differs from
     it (:func:`twin_truth`, seeded with ``settings.seed``), whose robot file goes to
-    ``truth_out`` when given. The program is planned on the model, as a user would.
+    ``truth_out`` when given. The program is planned on the model, as a user would. Returns the
+    log and what reading ``trajectory`` said (its checks' notes and warnings).
     """
     truth = twin_truth(robot, mismatch, settings.seed)
-    motion = _target(robot, trajectory, reading or LogReading())
+    motion, said = _target(robot, trajectory, reading or LogReading())
     twin = simulate(truth, motion, settings, name=os.fspath(out))
     write_log(out, twin.t, twin.signals)
     if truth_out is not None:
         save_robot(truth, truth_out, header=truth.description)
-    return twin
+    return twin, said
