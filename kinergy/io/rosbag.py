@@ -5,7 +5,10 @@ A bag is a rosbag2 folder (``metadata.yaml`` beside its ``.mcap`` or ``.db3`` fi
 reads MCAP and SQLite3 storage without a ROS install. From the ``JointState`` messages on
 ``/joint_states`` (another topic by :class:`BagOptions`):
 
-- each message's ``header.stamp`` is the time stamp (s), strictly increasing;
+- each message's ``header.stamp`` is the time stamp, strictly increasing, in s from the first
+  message's (taken in integer nanoseconds: stamps since 1970, as drivers write them, would lose
+  a quarter of a microsecond as seconds in a float, and the results would then depend on the
+  clock's origin);
 - its joints are matched to the robot's by name, in any order and per message: a robot joint
   ``elbow`` is the bag's ``elbow`` or ``elbow_joint`` (UR's driver names ``shoulder_pan_joint``
   ... ``wrist_3_joint``; a robot file that says ``elbow_joint`` matches ``elbow`` too), with one
@@ -40,6 +43,7 @@ The bag is read message by message into chunks of ``rows`` samples: memory does 
 
 from __future__ import annotations
 
+import datetime
 import enum
 import functools
 from collections.abc import Iterator, Sequence
@@ -359,9 +363,17 @@ class _Chunks:
         self.values = {name: np.empty((rows, n)) for name in signals}
         self.count = 0
         self.notes: list[str] = []
+        self.origin: int | None = None  # the first sample's stamp, ns: time 0
 
     def add(self, ns: int, arrays: dict[str, Array]) -> Log | None:
         """Add one sample; the chunk when it is full."""
+        if self.origin is None:
+            self.origin = ns
+            when = datetime.datetime.fromtimestamp(ns // 1_000_000_000, datetime.UTC)
+            self.notes.append(
+                f"{self.path}: time 0 s is the first message's header stamp ({ns} ns, "
+                f"{when:%Y-%m-%d %H:%M:%S} UTC)"
+            )
         k = self.count
         self.ns[k] = ns
         for name, buffer in self.values.items():
@@ -380,7 +392,8 @@ class _Chunks:
             at = np.searchsorted(self.modes[0], ns, side="right") - 1
             signals["robot_mode"] = self.modes[1][np.maximum(at, 0)]
         notes, self.notes = self.notes, []
-        return Log(str(self.path), ns / 1e9, signals, notes)
+        assert self.origin is not None
+        return Log(str(self.path), (ns - self.origin) / 1e9, signals, notes)
 
 
 def _bag_chunks(
