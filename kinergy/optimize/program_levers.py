@@ -339,9 +339,10 @@ def path_levers(
 
 
 def via_blends(robot: Robot, path: ProgramPath) -> list[Move]:
-    """The program's moves with a blend radius at every via point that has none: a move followed
-    by a move with no event between gets 40 % of the shorter tool distance of the two, at most
-    10 cm."""
+    """The program's moves with a blend radius at every joint-space via point that has none: a
+    movej followed by a movej with no event between gets 40 % of the shorter tool distance of the
+    two, at most 10 cm. A move into or out of a movel or movep is never blended: the straight
+    line (an approach, a retreat) stays whole."""
     program = path.program
     steps, index = program.steps, program.move_index
     tips = np.array([tcp_pose(robot, path.q_end[k], path.tcp[k])[:3, 3] for k in range(path.moves)])
@@ -350,7 +351,8 @@ def via_blends(robot: Robot, path: ProgramPath) -> list[Move]:
     out = []
     for k, move in enumerate(program.moves):
         i = index[k]
-        via = k + 1 < path.moves and isinstance(steps[i + 1], Move) and move.r == 0.0
+        after = steps[i + 1] if k + 1 < path.moves else None
+        via = isinstance(after, Move) and move.kind == after.kind == "movej" and move.r == 0.0
         if via:
             r = min(_BLEND_MAX, _BLEND_SHARE * min(reach[k], reach[k + 1]))
             move = move.replaced(r=round(float(r), 4))
