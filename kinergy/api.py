@@ -21,9 +21,10 @@ with its checks), ``notes`` and ``warnings``.
 
 from __future__ import annotations
 
+import enum
 import os
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, TypeVar
 
 from kinergy.accounting.energy import EnergyReport
 from kinergy.accounting.energy import energy as _energy_of_motion
@@ -59,6 +60,18 @@ RobotLike = Robot | PathLike
 
 def _robot(robot: RobotLike) -> Robot:
     return robot if isinstance(robot, Robot) else load_robot(robot)
+
+
+E = TypeVar("E", bound=enum.Enum)
+
+
+def _choice(kind: type[E], value: str, name: str) -> E:
+    """``value`` as the ``kind`` option ``name`` takes, or one line naming the values it takes."""
+    try:
+        return kind(value)
+    except ValueError:
+        known = ", ".join(str(k.value) for k in kind)
+        raise KinergyError(f"{name}={value!r}: not one of {known}") from None
 
 
 def _reading(
@@ -141,10 +154,10 @@ def identify(
     """
     r = _robot(robot)
     options = IdentifyOptions(
-        method=Method(method),
+        method=_choice(Method, method, "method"),
         friction=friction,
-        target=Target(target),
-        solver=Solver(solver),
+        target=_choice(Target, target, "target"),
+        solver=_choice(Solver, solver, "solver"),
         ridge=ridge,
     )
     reading = _reading(r, columns, repair, cutoff, accept, topic, effort)
@@ -177,6 +190,7 @@ def energy(
     log_or_motion: PathLike | Motion,
     *,
     columns: str | Sequence[str] | None = None,
+    repair: bool = False,
     accept: str | Sequence[str] = (),
     source: str = "auto",
     recovery: bool = True,
@@ -195,7 +209,7 @@ def energy(
     r = _robot(model)
     if isinstance(log_or_motion, Motion):
         return _energy_of_motion(r, log_or_motion, recovery=recovery, temperature=temperature)
-    reading = _reading(r, columns, False, None, accept, topic, effort)
+    reading = _reading(r, columns, repair, None, accept, topic, effort)
     return energy_of_log(r, log_or_motion, reading, source=source, recovery=recovery)
 
 
@@ -273,6 +287,19 @@ def optimize_program(
             a_max=a_max,
         )
         return run_program_optimize(r, program, urscript=urscript, options=options)
+    levers = {
+        "configurations": configurations != "keep",
+        "tool_symmetry": tool_symmetry != "none",
+        "via": via != "keep",
+        "blends": not blends,
+        "standby": standby is not None,
+    }
+    for name, given in levers.items():
+        if given:
+            raise KinergyError(
+                f"{name}: only for a URScript program (*.script); {program} is a task, whose "
+                "timing alone is optimised"
+            )
     return run_optimize(
         r, program, cycle_time=cycle_time, v_max=v_max, a_max=a_max, points=0, urscript=urscript
     )

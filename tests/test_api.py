@@ -125,3 +125,45 @@ def test_optimize_program_equals_the_command(
     _same(api, cli)
     with pytest.raises(kinergy.KinergyError, match="tool symmetry: expected one of none, z"):
         kinergy.optimize_program("ur5e", small, tool_symmetry="z3")
+
+
+def test_a_wrong_option_is_one_kinergy_error_naming_it() -> None:
+    with pytest.raises(kinergy.KinergyError, match=r"method='payload': not one of sequential"):
+        kinergy.identify(["x.csv"], "ur5e", method="payload")
+    with pytest.raises(kinergy.KinergyError, match=r"target='voltage': not one of"):
+        kinergy.identify(["x.csv"], "ur5e", method="full", target="voltage")
+    with pytest.raises(kinergy.KinergyError, match=r"via: only for a URScript program"):
+        kinergy.optimize_program("ur5e", "test-a", via="free")
+
+
+def test_an_option_the_kind_of_task_does_not_take_is_refused(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``optimize`` of a task takes no lever of a URScript program, and of a program no Pareto
+    front: given, it is refused in one line naming the flag (it was left unused)."""
+    small = str(Path(__file__).parent / "programs" / "small.script")
+    for argv, flag in (
+        (["optimize", "ur5e", "test-a", "--via", "free"], "--via"),
+        (["optimize", "ur5e", "test-a", "--tool-symmetry", "z"], "--tool-symmetry"),
+        (["optimize", "ur5e", small, "--pareto-points", "3"], "--pareto-points"),
+    ):
+        assert main(argv) == 1
+        err = capsys.readouterr().err
+        assert err.startswith(f"kinergy: error: {flag}: only for a") and err.count("\n") == 1
+
+
+def test_energy_repairs_a_log_cut_short_when_asked(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The hint of a log cut short names --repair; energy takes it (command and API)."""
+    log = tmp_path / "a.csv"
+    assert main(["simulate", "ur5e", "--trajectory", "test-a", "--out", str(log)]) == 0
+    text = log.read_text()
+    log.write_text(text[: text.rindex("\n", 0, len(text) - 1) + 20])  # the last line cut short
+    capsys.readouterr()
+    assert main(["energy", "ur5e", str(log)]) == 1
+    assert "--repair" in capsys.readouterr().err
+    assert main(["energy", "ur5e", str(log), "--repair", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    api = kinergy.energy("ur5e", log, repair=True)
+    assert out["samples"] == api.samples == text.count("\n") - 2

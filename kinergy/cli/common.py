@@ -34,6 +34,7 @@ __all__ = [
     "columns_option",
     "cutoff_option",
     "effort_option",
+    "flag_of",
     "fmt",
     "fmt_vector",
     "json_result",
@@ -244,7 +245,7 @@ seed_option = click.option(
 )
 
 
-def _flag(command: click.Command, name: str) -> str:
+def flag_of(command: click.Command, name: str) -> str:
     """The flag (``--out``) or metavar (``LOG...``) of the parameter called ``name``."""
     for param in command.params:
         if param.name == name:
@@ -283,7 +284,7 @@ def writes(
         def checked(**kwargs: Any) -> Any:
             cmd = click.get_current_context().command
             outputs = [
-                (_flag(cmd, name), path)
+                (flag_of(cmd, name), path)
                 for name in (*files, *folders, *into)
                 for path in _given(kwargs[name])
             ]
@@ -297,7 +298,7 @@ def writes(
                     try:
                         check(path)
                     except KinergyError as exc:
-                        raise exc.prefixed(_flag(cmd, name)) from None
+                        raise exc.prefixed(flag_of(cmd, name)) from None
             sources = [p for name in inputs for p in _given(kwargs[name]) if Path(p).is_file()]
             check_outputs(outputs, sources)
             return command(**kwargs)

@@ -17,6 +17,7 @@ from kinergy.cli.common import (
     log_reading,
     payload_option,
     prose,
+    repair_option,
     table,
     tell,
     topic_option,
@@ -95,6 +96,7 @@ def energy_text(report: dict[str, Any]) -> str:
 @click.argument("model", metavar="MODEL")
 @click.argument("motion_path", metavar="LOG_OR_MOTION", type=click.Path())
 @columns_option
+@repair_option
 @accept_option
 @topic_option
 @effort_option
@@ -115,6 +117,7 @@ def energy(
     model: str,
     motion_path: str,
     columns: str | None,
+    repair: bool,
     as_json: bool,
     no_recovery: bool,
     source: str,
@@ -131,7 +134,9 @@ def energy(
     test-b: the UR5e doc's tests A and B planned for MODEL).
     """
     r = load(model, payload)
-    reading = log_reading(r, columns=columns, accept=accept, topic=topic, effort=effort)
+    reading = log_reading(
+        r, columns=columns, repair=repair, accept=accept, topic=topic, effort=effort
+    )
     result = energy_of_log(r, motion_path, reading, source=source, recovery=not no_recovery)
     tell(result.notes, result.warnings)
     report = result.to_dict()

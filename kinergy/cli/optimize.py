@@ -14,6 +14,7 @@ from typing import Any, TypeVar
 import click
 
 from kinergy.cli.common import (
+    flag_of,
     json_result,
     load,
     output_file_option,
@@ -271,6 +272,30 @@ def lever_options(prefix: str = "") -> Callable[[F], F]:
     return decorate
 
 
+#: the options only a URScript program takes, and those only a task takes (the Pareto front)
+PROGRAM_ONLY = ("configurations", "tool_symmetry", "via", "no_blends", "standby", "motions")
+TASK_ONLY = ("points", "fixed_shares", "plot")
+
+
+def _for_its_kind(task: str) -> None:
+    """Refuse, in one line, an option given on the command line that the kind of TASK does not
+    take (it would be left unused)."""
+    ctx = click.get_current_context()
+    script = task.endswith(".script")
+    for name in TASK_ONLY if script else PROGRAM_ONLY:
+        if ctx.get_parameter_source(name) is click.core.ParameterSource.COMMANDLINE:
+            flag = flag_of(ctx.command, name)
+            if script:
+                raise KinergyError(
+                    f"{flag}: only for a task (the Pareto front of its timing); {task} is a "
+                    "URScript program"
+                )
+            raise KinergyError(
+                f"{flag}: only for a URScript program (*.script); {task} is a task, whose "
+                "timing alone is optimised"
+            )
+
+
 def program_options(
     *,
     configurations: str,
@@ -311,7 +336,9 @@ def program_options(
 )
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @output_file_option(
-    "--urscript", "Write the optimised program as URScript (movej per move) to this file."
+    "--urscript",
+    "Write the optimised program as URScript to this file (a URScript program: as written, "
+    "your names and comments kept; a task: movej per move).",
 )
 @output_file_option(
     "--plot", "Write the Pareto plot (energy against cycle time) to this PNG.", metavar="FILE.png"
@@ -381,6 +408,7 @@ def optimize(
     budget = _cycle_time(cycle_time)
     _cap("--v-max", v_max)
     _cap("--a-max", a_max)
+    _for_its_kind(task_name)
     if task_name.endswith(".script"):
         options = program_options(
             configurations=configurations,
