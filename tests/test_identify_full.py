@@ -556,3 +556,26 @@ def test_panda_predicts_held_out_measured_torques() -> None:
     # link-side torque sensors see no rotor inertia: the fit finds it about zero
     assert all(j.rotor_inertia * 100**2 < 0.05 for j in result.joints)
     assert all(result.fit.links_physical)
+
+
+def test_what_the_logs_do_not_determine_is_a_warning() -> None:
+    """Base parameters whose standard error exceeds their value (above round-off) and drive
+    parameters held at a bound are warnings; a parameter zero to round-off is not counted."""
+    from kinergy.identification.full import Parameter, _undetermined
+
+    base = [
+        Parameter("m1", 2.0, 0.1, 0.05),
+        Parameter("mx4", 1e-12, 6e-12, 6.0),  # zero to round-off: determined
+        Parameter("Iyz7", -1e-4, 6e-4, 6.0),
+        Parameter("mx5", 5e-5, 4e-4, 8.0),
+    ]
+    drives = [
+        Parameter("rotor inertia of joint 1 (j1)", 0.0, 1e-5, None, "rotor", "at bound"),
+        Parameter("rotor inertia of joint 3 (j3)", 0.0, 1e-5, None, "rotor", "at bound"),
+        Parameter("viscous of joint 2 (j2)", 0.1, 0.01, 0.1, "friction", "identified"),
+    ]
+    loose, held = _undetermined(base, [*base, *drives])
+    assert loose.startswith("2 of 4 base parameters have a standard error larger than their")
+    assert "(largest: mx5, 8 times)" in loose
+    assert "rotor inertia of joint(s) 1, 3;" in held and "viscous" not in held
+    assert _undetermined(base[:2], base[:2]) == []

@@ -96,6 +96,7 @@ from kinergy.identification.regression import (
     solve,
 )
 from kinergy.identification.result import (
+    AT_BOUND,
     KEPT,
     DriveEstimate,
     Fit,
@@ -394,6 +395,41 @@ def _optional(value: float) -> float | None:
     return None if np.isnan(value) else float(value)
 
 
+#: a base parameter whose standard error is below this share of the largest base parameter is
+#: determined to round-off (a parameter that is zero, such as a product of inertia on an axis,
+#: has a relative standard error of any size there)
+ROUND_OFF = 1e-6
+
+
+def _undetermined(base: Sequence[Parameter], parameters: Sequence[Parameter]) -> list[str]:
+    """Warnings for what the logs do not determine: base parameters whose standard error exceeds
+    their value (and :data:`ROUND_OFF`), and drive parameters held at a physical bound (the
+    unconstrained fit put them outside it: what is written is the bound, not an estimate)."""
+    out = []
+    floor = ROUND_OFF * max((abs(p.value) for p in base), default=0.0)
+    loose = [p for p in base if p.rel_std is not None and p.rel_std > 1.0 and (p.std or 0) > floor]
+    if loose:
+        worst = max(loose, key=lambda p: p.rel_std or 0.0)
+        out.append(
+            f"{len(loose)} of {len(base)} base parameters have a standard error larger than "
+            f"their value (largest: {worst.name}, {worst.rel_std:.3g} times): the logs do not "
+            "determine them; the model predicts motions like the logs', its link parameters "
+            "are not measurements (fit.base_parameters[].rel_std)"
+        )
+    held: dict[str, list[str]] = {}
+    for p in parameters[len(base) :]:
+        if p.flag == AT_BOUND:
+            what, _, joint = p.name.partition(" of joint ")
+            held.setdefault(what, []).append(joint.split(" ")[0] if joint else p.name)
+    if held:
+        listed = "; ".join(f"{what} of joint(s) {', '.join(js)}" for what, js in held.items())
+        out.append(
+            f"held at a physical bound (the data put them outside it): {listed}; what is written "
+            "for them is the bound, not an estimate"
+        )
+    return out
+
+
 def _parameters(
     x: np.ndarray,
     std: np.ndarray,
@@ -504,6 +540,9 @@ def _fit(logs: LogChunks, steps: _Steps, *, solver: Solver, ridge: float) -> Ful
     weighted = solved.weights is not None
     b = cols.n_link
     regression = steps.evaluation.regression
+    parameters = _parameters(solved.x, solved.std, cols.names, cols.group, written.flags)
+    base = _parameters(solved.x, solved.std, reg.base.expressions(), [None] * b, written.flags[:b])
+    said.warnings += _undetermined(base, parameters)
     return FullFit(
         **vars(fit_fields(steps.robot, logs, said)),
         target=target.value,
@@ -517,10 +556,8 @@ def _fit(logs: LogChunks, steps: _Steps, *, solver: Solver, ridge: float) -> Ful
         residual_std=tuple(m.rms for m in regression),
         regression=regression,
         merged=steps.merging.columns,
-        parameters=_parameters(solved.x, solved.std, cols.names, cols.group, written.flags),
-        base_parameters=_parameters(
-            solved.x, solved.std, reg.base.expressions(), [None] * b, written.flags[:b]
-        ),
+        parameters=parameters,
+        base_parameters=base,
         physical_fit=_physical(reg, written, steps.evaluation),
         write_back=written.method,
         drives="currents"
