@@ -275,15 +275,18 @@ def lever_options(prefix: str = "") -> Callable[[F], F]:
 #: the options only a URScript program takes, and those only a task takes (the Pareto front)
 PROGRAM_ONLY = ("configurations", "tool_symmetry", "via", "no_blends", "standby", "motions")
 TASK_ONLY = ("points", "fixed_shares", "plot")
+#: the values of those options that ask for nothing (--pareto-points 0: no front)
+NEUTRAL: dict[str, object] = {"points": 0}
 
 
 def _for_its_kind(task: str) -> None:
     """Refuse, in one line, an option given on the command line that the kind of TASK does not
-    take (it would be left unused)."""
+    take (it would be left unused; a value that asks for nothing, :data:`NEUTRAL`, passes)."""
     ctx = click.get_current_context()
     script = task.endswith(".script")
     for name in TASK_ONLY if script else PROGRAM_ONLY:
-        if ctx.get_parameter_source(name) is click.core.ParameterSource.COMMANDLINE:
+        unused = ctx.params[name] != NEUTRAL.get(name, object())
+        if ctx.get_parameter_source(name) is click.core.ParameterSource.COMMANDLINE and unused:
             flag = flag_of(ctx.command, name)
             if script:
                 raise KinergyError(
