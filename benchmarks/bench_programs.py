@@ -103,7 +103,6 @@ def run(name: str, via: str) -> dict[str, Any]:
         robot,
         program,
         options,
-        compare_timing=True,
         progress=lambda m: print(f"  {time.perf_counter() - t0:6.1f} s {m}", file=sys.stderr),
     )
     seconds, cpu = time.perf_counter() - t0, time.process_time() - c0

@@ -175,7 +175,7 @@ def _levers_table(levers: Sequence[Lever]) -> str:
             f"{supply(lv.result):.1f}",
             f"{lv.result.e_elec:.1f}",
             "yes" if lv.result.ok else "NO",
-            "" if lv.name in ("program", "timing only") else f"{lv.saved:+.1f}",
+            "" if lv.name == "program" else f"{lv.saved:+.1f}",
             lv.status.value + (f" ({lv.repaired})" if lv.repaired else ""),
             lv.note,
         ]

@@ -73,8 +73,7 @@ class LeverStatus(enum.Enum):
     """What became of a lever: ``KEPT`` (it beat the program before it), ``NOT_BETTER``,
     ``OVER_LIMITS`` (it breaks a limit even after its repair), ``NOT_POSSIBLE`` (its program
     cannot run: a target out of reach, a line through a singularity, ...), ``NO_CHANGE`` (it
-    changes nothing on this program), ``AS_WRITTEN`` (the program itself, the reference),
-    ``COMPARISON`` (re-timing alone, for the table)."""
+    changes nothing on this program), ``AS_WRITTEN`` (the program itself, the reference)."""
 
     KEPT = "kept"
     NOT_BETTER = "not better"
@@ -82,7 +81,6 @@ class LeverStatus(enum.Enum):
     NOT_POSSIBLE = "not possible"
     NO_CHANGE = "no change"
     AS_WRITTEN = "as written"
-    COMPARISON = "comparison"
 
 
 @dataclass(frozen=True, eq=False)

@@ -53,7 +53,7 @@ from kinergy.optimize.program_levers import (
     via_blends,
     with_timing,
 )
-from kinergy.optimize.program_repair import Caps, at_cycle, timing_checks
+from kinergy.optimize.program_repair import Caps, timing_checks
 from kinergy.optimize.program_timing import retime
 from kinergy.optimize.program_verify import PathRun, TargetCheck, simulate_path, target_errors
 from kinergy.trajectory.program_path import ProgramPath, program_path
@@ -119,8 +119,8 @@ class ProgramOptimization:
     program, optimized : PathRun
         The program as written and the optimised one, each re-simulated at 500 Hz.
     levers : tuple of Lever
-        Each lever's figure in order, then ``timing only`` (the comparison: re-timing alone)
-        when asked for.
+        Each lever's figure in order, the last ``timing only``: the program as written, only
+        re-timed (kept when it beats the levers before it).
     targets : list of TargetCheck
         The optimised program at every target of the original.
     settings : ProgramSettings
@@ -183,21 +183,20 @@ def _as_written(
     return checked, caps
 
 
-def _timing_only(
-    robot: Robot,
-    path: ProgramPath,
-    objective: Objective,
-    caps: Caps,
-    budget: float,
-    say: Callable[[str], None],
-) -> Lever:
-    """The program as written, only re-timed (the comparison)."""
+def _timing_only(search: LeverSearch, path: ProgramPath, say: Callable[[str], None]) -> None:
+    """The program as written, only re-timed, judged against the levers' best: kept when it
+    beats them (a lever chain whose own re-timing stopped short of it), recorded either way
+    (what re-timing alone saves)."""
     say("timing only: re-timing the program as written")
-    result, verified = retime(timing_checks(robot, path, objective, caps), budget)
-    written = program_path(robot, with_timing(path, result))
-    run = at_cycle(robot, written, budget, objective, caps, "timing only")
-    note = f"the program as written, re-timed: {verified.words}"
-    return Lever("timing only", run.result, LeverStatus.COMPARISON, note=note)
+    checks = timing_checks(search.robot, path, search.objective, search.caps)
+    result, verified = retime(checks, search.budget)
+    none = np.zeros(path.moves, dtype=bool)
+    search.judge(
+        "timing only",
+        with_timing(path, result),
+        f"the program as written, re-timed: {verified.words}",
+        left_out=(none, none),
+    )
 
 
 @serial
@@ -206,7 +205,6 @@ def optimize_program(
     program: RobotProgram,
     options: ProgramOptions | None = None,
     *,
-    compare_timing: bool = False,
     progress: Callable[[str], None] | None = None,
 ) -> ProgramOptimization:
     """The energy-optimal program doing the same job at a cycle time (module docstring).
@@ -218,9 +216,6 @@ def optimize_program(
     options : ProgramOptions, optional
         The levers and limits (default :class:`ProgramOptions`: configurations and via points
         kept, no tool symmetry, blends, the program's own cycle time and peaks).
-    compare_timing : bool
-        Also re-time the program as written alone (the last lever, ``timing only``: what
-        re-timing alone saves).
     progress : callable, optional
         Called with a line before each long step.
 
@@ -261,10 +256,9 @@ def optimize_program(
         best = search.best.path
         search.judge("blends", best.program.with_moves(via_blends(robot, best)), "blended")
     timed(search, say)
+    _timing_only(search, path, say)
     optimized = search.best
     found = tuple(search.levers)
-    if compare_timing:
-        found += (_timing_only(robot, path, objective, caps, budget, say),)
     say("checking the targets")
     targets = target_errors(
         robot,
