@@ -29,6 +29,7 @@ from typing import Any, TypeVar
 from kinergy.accounting.energy import EnergyReport
 from kinergy.accounting.energy import energy as _energy_of_motion
 from kinergy.errors import KinergyError
+from kinergy.files import check_replaceable
 from kinergy.identification.options import IdentifyOptions, Method, Solver, Target
 from kinergy.identification.result import IdentificationResult
 from kinergy.identification.validation import ValidationReport
@@ -161,6 +162,8 @@ def identify(
         ridge=ridge,
     )
     reading = _reading(r, columns, repair, cutoff, accept, topic, effort)
+    if out is not None:
+        check_replaceable(out)
     return identify_logs(r, list(logs), out, reading=reading, options=options)
 
 
@@ -275,6 +278,8 @@ def optimize_program(
         One line naming the option or the program's line at fault.
     """
     r = _robot(model)
+    if urscript is not None:
+        check_replaceable(urscript)
     if os.fspath(program).endswith(".script"):
         options = ProgramOptions(
             configurations=Configurations.parse(configurations),

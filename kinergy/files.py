@@ -12,6 +12,7 @@ folder, a symbolic link), which renaming over would destroy.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 import shutil
 import signal
@@ -36,6 +37,7 @@ __all__ = [
     "check_folder",
     "check_output",
     "check_outputs",
+    "check_replaceable",
     "output_folder",
     "raise_pending",
     "read_text",
@@ -43,8 +45,10 @@ __all__ = [
     "terminate_on_signals",
 ]
 
-#: a file kinergy puts into every folder it writes, so it may replace that folder later
+#: a file kinergy puts into every folder it writes, listing every file it wrote there (SHA-256
+#: and path), so it may replace that folder later when nothing else is in it
 MARKER = ".kinergy-output"
+_MARKER_HEAD = "written by kinergy; it may replace this folder while it holds only these files"
 #: a TOML file larger than this is refused before it is read (robot and task files are a few kB)
 MAX_TOML_BYTES = 16 * 1024 * 1024
 
@@ -108,6 +112,25 @@ def terminate_on_signals() -> Iterator[None]:
         _PENDING.clear()
 
 
+#: bytes of an existing output's start and end searched for kinergy's mark
+MARK_SPAN = 65536
+
+
+def _marked(path: Path, size: int) -> bool:
+    """Whether kinergy wrote the file at ``path`` (``size`` bytes): its name in the first or
+    last :data:`MARK_SPAN` bytes (the header comment of a robot file, a URDF, an MJCF model or
+    a URScript program; a PNG's ``Software`` text; a Parquet file's footer metadata). A log
+    (CSV, as UR's record.py writes it) carries no mark: kinergy never replaces one."""
+    try:
+        with path.open("rb") as f:
+            head = f.read(MARK_SPAN)
+            f.seek(max(0, size - MARK_SPAN))
+            tail = f.read(MARK_SPAN)
+    except OSError:
+        return False
+    return b"kinergy" in head or b"kinergy" in tail
+
+
 def check_output(path: PathLike) -> Path:
     """``path`` as an output: refused when it exists and is not a regular file (device, FIFO,
     socket, folder) or is a symbolic link, or when its folder exists as a file.
@@ -129,9 +152,28 @@ def check_output(path: PathLike) -> Path:
         if not stat.S_ISREG(info.st_mode):
             kind = "a folder" if stat.S_ISDIR(info.st_mode) else "not a regular file"
             raise KinergyError(f"{target}: is {kind}; kinergy writes only regular files")
+
     parent = target.parent
     if parent.exists() and not parent.is_dir():
         raise KinergyError(f"{target}: {parent} is not a folder")
+    return target
+
+
+def check_replaceable(path: PathLike) -> Path:
+    """``path`` as a user's output (``--out``, ``out=``): :func:`check_output`, and refused when
+    it exists with content kinergy did not write (:func:`_marked`: a log, a program, any file
+    of the user's is never replaced).
+
+    Returns the path. Raises KinergyError, one line naming the path.
+    """
+    target = check_output(path)
+    if target.is_file():
+        size = target.stat().st_size
+        if size > 0 and not _marked(target, size):
+            raise KinergyError(
+                f"{target}: exists and kinergy did not write it (a log, a program, a file of "
+                "yours): kinergy replaces only its own outputs; give a new name or remove it"
+            )
     return target
 
 
@@ -225,28 +267,63 @@ def atomic_write(
     return target
 
 
-def _replaceable(folder: Path) -> bool:
-    """A folder kinergy may replace: missing, empty, or one it wrote itself (:data:`MARKER`)."""
-    if folder.is_symlink():
-        return False
-    if not folder.exists():
-        return True
-    if not folder.is_dir():
-        return False
-    return not any(folder.iterdir()) or (folder / MARKER).is_file()
+def _sha256(path: Path) -> str:
+    digest = hashlib.sha256()
+    with path.open("rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def _files(folder: Path) -> list[Path]:
+    """Everything below ``folder`` but the marker and the folders themselves, in order."""
+    return sorted(p for p in folder.rglob("*") if not p.is_dir() and p != folder / MARKER)
+
+
+def _manifest(folder: Path) -> str:
+    """The marker's text for ``folder`` as it is: a header, then a line ``SHA-256 path`` per file."""
+    lines = [_MARKER_HEAD]
+    lines += [f"{_sha256(f)} {f.relative_to(folder).as_posix()}" for f in _files(folder)]
+    return "\n".join(lines) + "\n"
+
+
+def _foreign(folder: Path) -> Path | None:
+    """A file in ``folder`` that kinergy did not write there or that changed since (None: there
+    is none, the folder is kinergy's to replace). Without a marker listing its files, every file
+    is foreign."""
+    written: dict[str, str] = {}
+    marker = folder / MARKER
+    if marker.is_file() and not marker.is_symlink():
+        text = marker.read_text(encoding="utf-8", errors="replace").splitlines()
+        if text[:1] == [_MARKER_HEAD]:
+            for line in text[1:]:
+                digest, _, rel = line.partition(" ")
+                written[rel] = digest
+    for f in _files(folder):
+        rel = f.relative_to(folder).as_posix()
+        if f.is_symlink() or not f.is_file() or written.get(rel) != _sha256(f):
+            return f
+    return None
 
 
 def check_folder(path: PathLike) -> Path:
     """``path`` as a folder of outputs (:func:`atomic_folder`): refused, before any work, when it
-    is a file, a link, or a folder holding files kinergy did not write.
+    is a file or a link, or a folder holding a file kinergy did not write there (or changed since:
+    the marker lists what it wrote, by SHA-256); an empty folder is taken.
 
     Returns the path. Raises KinergyError, one line naming it.
     """
     target = Path(path)
-    if not _replaceable(target):
-        raise KinergyError(
-            f"{target}: exists and holds files kinergy did not write; give an empty or new folder"
-        )
+    if target.is_symlink() or (target.exists() and not target.is_dir()):
+        raise KinergyError(f"{target}: is not a folder; give an empty or new folder")
+    if target.is_dir():
+        other = _foreign(target)
+        if other is not None:
+            raise KinergyError(
+                f"{target}: holds {other.relative_to(target)}, which kinergy did not write there "
+                "(or which changed since): replacing the folder would delete it; give an empty "
+                "or new folder"
+            )
     if target.parent.exists() and not target.parent.is_dir():
         raise KinergyError(f"{target}: {target.parent} is not a folder")
     return target
@@ -272,10 +349,11 @@ def atomic_folder(path: PathLike) -> Iterator[Path]:
     except OSError as exc:
         raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
     try:
-        (building / MARKER).write_text("written by kinergy; it may replace this folder\n")
         yield building
+        (building / MARKER).write_text(_manifest(building), encoding="utf-8")
         os.chmod(building, 0o755)
         raise_pending()
+        check_folder(target)  # nothing appeared in it while the outputs were computed
         old = None
         if target.exists():
             old = target.with_name(f".{target.name}.old-{os.getpid()}")

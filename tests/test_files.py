@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+import kinergy
 from kinergy.errors import KinergyError
 from kinergy.files import (
     MARKER,
@@ -30,14 +31,14 @@ def _leftovers(folder: Path) -> list[str]:
 
 def test_a_failed_write_keeps_the_old_file_and_leaves_no_temporary(tmp_path: Path) -> None:
     target = tmp_path / "model.toml"
-    target.write_text("old")
+    target.write_text("# kinergy: old")
 
     def fail(fh: object) -> None:
         raise RuntimeError("boom")
 
     with pytest.raises(RuntimeError):
         atomic_write(target, fail)
-    assert target.read_text() == "old"
+    assert target.read_text() == "# kinergy: old"
     assert _leftovers(tmp_path) == []
     atomic_write(target, lambda fh: fh.write("new"))
     assert target.read_text() == "new" and _leftovers(tmp_path) == []
@@ -96,10 +97,39 @@ def test_a_folder_is_built_beside_and_renamed_into_place(tmp_path: Path) -> None
     mine = tmp_path / "mine"
     mine.mkdir()
     (mine / "thesis.tex").write_text("precious")
-    with pytest.raises(KinergyError, match="holds files kinergy did not write"):
+    with pytest.raises(KinergyError, match="holds thesis.tex, which kinergy did not write"):
         with atomic_folder(mine):
             pass
     assert (mine / "thesis.tex").read_text() == "precious"
+
+
+def test_a_folder_kinergy_wrote_is_kept_once_anything_else_is_put_or_changed_in_it(
+    tmp_path: Path,
+) -> None:
+    """The marker lists every file kinergy wrote (SHA-256): a file added anywhere below the
+    folder, or one of kinergy's changed, makes the folder the user's; an old marker without the
+    list vouches for nothing."""
+    target = tmp_path / "demo"
+    with atomic_folder(target) as folder:
+        (folder / "logs").mkdir()
+        (folder / "logs" / "test-a.csv").write_text("t,q\n")
+        (folder / "report.html").write_text("<html>")
+    for change in ("add", "edit", "old marker"):
+        if change == "add":
+            (target / "logs" / "my-notes.txt").write_text("mine")
+            what = "logs/my-notes.txt"
+        elif change == "edit":
+            (target / "logs" / "my-notes.txt").unlink()
+            (target / "report.html").write_text("<html> my edits")
+            what = "report.html"
+        else:
+            (target / "report.html").write_text("<html>")
+            (target / MARKER).write_text("written by kinergy; it may replace this folder\n")
+            what = "logs/test-a.csv"
+        with pytest.raises(KinergyError, match=f"holds {what}, which kinergy did not write"):
+            with atomic_folder(target):
+                pass
+        assert (target / "logs" / "test-a.csv").read_text() == "t,q\n"
 
 
 def test_toml_that_nests_too_deeply_is_one_line(tmp_path: Path) -> None:
@@ -200,3 +230,82 @@ def test_a_signal_dropped_by_a_c_callback_still_stops_the_write(tmp_path: Path, 
     assert "Traceback" not in err, err
     assert target.read_text() == "before"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv"]
+
+
+def test_a_folder_of_outputs_is_never_replaced_over_the_users_files_or_an_input(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``report --out`` over a demo folder whose log is the report's input, ``validate --plots``
+    into a folder with the user's files or the input log: refused in one line, nothing changed."""
+    from kinergy.cli import main
+
+    demo = tmp_path / "d"
+    with atomic_folder(demo) as folder:  # a folder kinergy wrote, with a log in it
+        (folder / "logs").mkdir()
+        assert (
+            main(
+                [
+                    "simulate",
+                    "ur5e",
+                    "--trajectory",
+                    "test-a",
+                    "--out",
+                    str(folder / "logs" / "a.csv"),
+                ]
+            )
+            == 0
+        )
+    log = demo / "logs" / "a.csv"
+    before = log.read_bytes()
+    capsys.readouterr()
+    assert main(["report", "ur5e", "--energy", str(log), "--out", str(demo)]) == 1
+    err = capsys.readouterr().err
+    assert f"--out {demo}: holds an input ({log})" in err and err.count("\n") == 1
+    assert log.read_bytes() == before
+    plots = tmp_path / "plots"
+    plots.mkdir()
+    (plots / "torque_errors.png").write_text("my plot")
+    assert main(["validate", "ur5e", str(log), "--plots", str(plots)]) == 1
+    err = capsys.readouterr().err
+    assert "--plots" in err and "holds torque_errors.png, which kinergy did not write" in err
+    assert (plots / "torque_errors.png").read_text() == "my plot"
+    for inside in (demo / "logs", demo):
+        assert main(["validate", "ur5e", str(log), "--plots", str(inside)]) == 1
+        assert "--plots" in capsys.readouterr().err and log.read_bytes() == before
+    assert main(["validate", "ur5e", str(log), "--plots", str(tmp_path / "new")]) == 0
+    assert (tmp_path / "new" / "a_current.png").is_file() and (tmp_path / "new" / MARKER).is_file()
+    assert main(["validate", "ur5e", str(log), "--plots", str(tmp_path / "new")]) == 0  # again
+
+
+def test_an_existing_file_kinergy_did_not_write_is_never_replaced(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--out`` over a log or a user's file is refused in one line and the file kept; over a
+    file kinergy wrote (its mark in the header, a PNG's Software text) it is replaced."""
+    from kinergy.cli import main
+
+    log = tmp_path / "a.csv"
+    assert main(["simulate", "ur5e", "--trajectory", "test-a", "--out", str(log)]) == 0
+    precious = tmp_path / "keep.toml"
+    precious.write_text("precious = true\n")
+    before = log.read_bytes()
+    capsys.readouterr()
+    for argv, path in (
+        (["robot", "export", "ur5e", "--format", "urdf", "--out", str(log)], log),
+        (["simulate", "ur5e", "--trajectory", "test-b", "--out", str(log)], log),
+        (["robot", "export", "ur5e", "--format", "mjcf", "--out", str(precious)], precious),
+    ):
+        assert main(argv) == 1
+        err = capsys.readouterr().err
+        assert f"--out: {path}: exists and kinergy did not write it" in err and err.count("\n") == 1
+    assert log.read_bytes() == before and precious.read_text() == "precious = true\n"
+    urdf = tmp_path / "ur5e.urdf"
+    for _ in range(2):  # the second time over its own output
+        assert main(["robot", "export", "ur5e", "--format", "urdf", "--out", str(urdf)]) == 0
+    plot = tmp_path / "front.png"
+    for _ in range(2):
+        assert (
+            main(["optimize", "ur5e", "test-a", "--pareto-points", "2", "--plot", str(plot)]) == 0
+        )
+    with pytest.raises(kinergy.KinergyError, match="exists and kinergy did not write it"):
+        kinergy.identify([log], "ur5e", out=precious)

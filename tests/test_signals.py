@@ -22,7 +22,7 @@ from clicase import snapshot
 from kinergy import load_robot
 from kinergy.cli import main
 from kinergy.errors import KinergyError
-from kinergy.files import MARKER
+from kinergy.files import MARKER, _manifest
 from kinergy.io.rtde import read_log
 
 #: the child restores Python's Ctrl-C handler: a shell's background job starts with SIGINT ignored
@@ -72,8 +72,8 @@ def test_killing_a_command_leaves_no_temporary_and_every_file_as_it_was(
             for out in outputs:  # an old output that must survive unless replaced whole
                 if name == "report":
                     (folder / out).mkdir()
-                    (folder / out / MARKER).write_text("old\n")
                     (folder / out / "report.html").write_text("old report\n")
+                    (folder / out / MARKER).write_text(_manifest(folder / out))
                 else:
                     (folder / out).write_text("old output\n")
             before = snapshot(folder)

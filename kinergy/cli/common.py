@@ -19,7 +19,7 @@ from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElaps
 
 from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
-from kinergy.files import check_folder, check_output, check_outputs
+from kinergy.files import check_folder, check_outputs, check_replaceable
 from kinergy.io.columns import parse_columns
 from kinergy.io.rosbag import bag_options
 from kinergy.jsonable import dumps, to_jsonable
@@ -262,6 +262,11 @@ def _given(value: Any) -> list[str]:
     return [str(v) for v in value] if isinstance(value, tuple | list) else [str(value)]
 
 
+def _within(path: Path, folder: Path) -> bool:
+    """Whether ``path`` is ``folder`` or lies below it (links resolved)."""
+    return path.resolve().is_relative_to(folder.resolve())
+
+
 def writes(
     *,
     files: Sequence[str] = (),
@@ -271,8 +276,10 @@ def writes(
 ) -> Callable[[F], F]:
     """Declare what a command writes and reads, by parameter name; before the command does any
     work, refuse (one line naming the flag) an output that is an input or another output, an
-    existing output that is not a regular file (:func:`kinergy.files.check_output`) and a folder
-    of outputs holding files kinergy did not write (:func:`kinergy.files.check_folder`).
+    existing output that is not a regular file or that kinergy did not write
+    (:func:`kinergy.files.check_replaceable`), and a folder
+    of outputs holding files kinergy did not write (:func:`kinergy.files.check_folder`) or an
+    input (it is replaced whole).
     ``into``: folders the command adds files to (only checked against the inputs and outputs).
 
     Inputs that are not existing files (built-in names such as ``ur5e``, ``test-a``) are skipped.
@@ -291,7 +298,17 @@ def writes(
             for flag, path in outputs:
                 if not path.strip():
                     raise KinergyError(f"{flag}: an empty path names no file or folder")
-            for name, check in [(n, check_output) for n in files] + [
+            sources = [p for name in inputs for p in _given(kwargs[name]) if Path(p).exists()]
+            check_outputs(outputs, [p for p in sources if Path(p).is_file()])
+            for name in folders:  # a folder of outputs is replaced whole: no input inside it
+                for folder in _given(kwargs[name]):
+                    inside = [p for p in sources if _within(Path(p), Path(folder))]
+                    if inside:
+                        raise KinergyError(
+                            f"{flag_of(cmd, name)} {folder}: holds an input ({inside[0]}), which "
+                            "replacing the folder would delete; choose another folder"
+                        )
+            for name, check in [(n, check_replaceable) for n in files] + [
                 (n, check_folder) for n in folders
             ]:
                 for path in _given(kwargs[name]):
@@ -299,8 +316,6 @@ def writes(
                         check(path)
                     except KinergyError as exc:
                         raise exc.prefixed(flag_of(cmd, name)) from None
-            sources = [p for name in inputs for p in _given(kwargs[name]) if Path(p).is_file()]
-            check_outputs(outputs, sources)
             return command(**kwargs)
 
         checked.kinergy_inputs = tuple(inputs)  # type: ignore[attr-defined]

@@ -127,12 +127,13 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
     "plots",
     type=click.Path(file_okay=False),
     default=None,
-    help="Write plots (measured vs predicted, error box plots) to this folder.",
+    help="Write plots (measured vs predicted, error box plots) to this folder (new, empty, or "
+    "one kinergy wrote: it is replaced whole).",
 )
 @cutoff_option
 @payload_option
 @repair_option
-@writes(into=("plots",), inputs=("model", "logs"))
+@writes(folders=("plots",), inputs=("model", "logs"))
 def validate(
     model: str,
     logs: tuple[str, ...],

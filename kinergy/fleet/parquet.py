@@ -41,7 +41,8 @@ def write_cycles(path: str | os.PathLike[str], rows: Sequence[dict[str, object]]
             ("segment", pa.int32()),
             ("cycle", pa.int32()),
             *((name, pa.float64()) for name in COLUMNS[6:]),
-        ]
+        ],
+        metadata={"written_by": "kinergy"},  # in the footer: kinergy may replace the file
     )
     table = pa.Table.from_pylist(list(rows), schema=schema)
     return atomic_write(path, lambda fh: pq.write_table(table, fh), binary=True)

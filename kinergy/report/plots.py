@@ -612,4 +612,8 @@ def save(fig: Figure, path: str | os.PathLike[str]) -> Path:
     KinergyError
         If the folder cannot be created or the file cannot be written.
     """
-    return atomic_write(path, lambda fh: fig.savefig(fh, format="png", dpi=DPI), binary=True)
+    return atomic_write(
+        path,
+        lambda fh: fig.savefig(fh, format="png", dpi=DPI, metadata={"Software": "kinergy"}),
+        binary=True,
+    )

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from kinergy.files import atomic_folder
 from kinergy.identification.validation import (
     PLOT_SAMPLES,
     LogValidation,
@@ -95,9 +96,14 @@ def write_validation_plots(
 ) -> None:
     """Per log (or segment), measured against predicted torque and current (``STEM_torque.png``,
     ``STEM_current.png``, :func:`_stems`) from its :attr:`~kinergy.identification.validation.LogValidation.series`;
-    over all logs, the error box plots (``torque_errors.png``, ...)."""
-    out = Path(folder)
-    out.mkdir(parents=True, exist_ok=True)
+    over all logs, the error box plots (``torque_errors.png``, ...). The folder is built
+    beside ``folder`` and replaces it whole (:func:`kinergy.files.atomic_folder`: refused when
+    it holds a file kinergy did not write)."""
+    with atomic_folder(folder) as out:
+        _plots(robot, logs, out)
+
+
+def _plots(robot: Robot, logs: Sequence[LogValidation], out: Path) -> None:
     errors: dict[str, dict[str, Any]] = {"torque": {}, "current": {}}
     for log, stem in zip(logs, _stems([log.log for log in logs]), strict=True):
         for key, unit, label in (
