@@ -7,6 +7,7 @@ import contextlib
 import enum
 import functools
 import hashlib
+import math
 import textwrap
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
@@ -29,6 +30,7 @@ from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
     "TABLE_WIDTH",
+    "Finite",
     "accept_option",
     "bag_options",
     "columns_option",
@@ -60,6 +62,19 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 #: the widest line :func:`table` prints, characters
 TABLE_WIDTH = 120
+
+
+class Finite(click.FloatRange):
+    """A number option that must be finite (NaN and infinities refused, naming the flag), within
+    the range when one is given: ``Finite()``, ``Finite(0.0, 1.0)``, ``Finite(min=0.0)``."""
+
+    name = "number"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        x = super().convert(value, param, ctx)
+        if not math.isfinite(x):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        return x
 
 
 def prose(text: str, width: int = TABLE_WIDTH) -> str:
@@ -225,7 +240,7 @@ accept_option = click.option(
 )
 cutoff_option = click.option(
     "--cutoff",
-    type=click.FloatRange(0.0, 1e6, min_open=True),
+    type=Finite(0.0, 1e6, min_open=True),
     default=None,
     help="Low-pass cutoff for measured speeds, Hz [min(10, fs/5)].",
 )

@@ -18,7 +18,14 @@ from typing import Any
 import click
 import numpy as np
 
-from kinergy.cli.common import json_result, output_file_option, progress, seed_option, writes
+from kinergy.cli.common import (
+    Finite,
+    json_result,
+    output_file_option,
+    progress,
+    seed_option,
+    writes,
+)
 from kinergy.errors import KinergyError
 from kinergy.experiments.excitation_regression import CRITERIA
 from kinergy.model import Robot, load_robot
@@ -149,7 +156,7 @@ def excite_text(run: ExciteRun) -> str:
 @click.command()
 @click.argument("robot_name", metavar="ROBOT")
 @click.option("--harmonics", type=int, default=5, show_default=True, help="Harmonics N (>= 2).")
-@click.option("--period", type=float, default=10.0, show_default=True, help="Period T, s.")
+@click.option("--period", type=Finite(), default=10.0, show_default=True, help="Period T, s.")
 @click.option(
     "--periods",
     type=int,
@@ -188,7 +195,7 @@ def excite_text(run: ExciteRun) -> str:
 )
 @click.option(
     "--floor",
-    type=float,
+    type=Finite(),
     default=0.05,
     show_default=True,
     help="Height above the base plane the flange and link frames from the elbow on must keep, m.",
@@ -209,15 +216,15 @@ def excite_text(run: ExciteRun) -> str:
 @click.option(
     "--range-deg",
     "range_deg",
-    type=float,
+    type=Finite(),
     default=90.0,
     show_default=True,
     help="Half-width of each joint's range about the start pose, deg (within the robot's limits).",
 )
-@click.option("--speed", type=float, default=None, help="Speed limit, rad/s [the robot's].")
+@click.option("--speed", type=Finite(), default=None, help="Speed limit, rad/s [the robot's].")
 @click.option(
     "--acceleration",
-    type=float,
+    type=Finite(),
     default=None,
     help="Acceleration limit, rad/s^2 [the robot's; 2/s times the speed limit where it has none].",
 )

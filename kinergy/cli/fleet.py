@@ -2,18 +2,21 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import click
 
 from kinergy.cli.common import (
+    Finite,
     accept_option,
     bag_options,
     effort_option,
     json_result,
-    note,
     output_file_option,
     progress,
     table,
     topic_option,
+    warn,
 )
 from kinergy.fleet.analysis import LogResult
 from kinergy.logs.checks import parse_accept
@@ -28,14 +31,18 @@ def fleet() -> None:
 
 
 @fleet.command("energy")
-@click.argument("logs", nargs=-1, metavar="LOGS...", type=click.Path())
+@click.argument("logs", nargs=-1, metavar="[LOGS]...", type=click.Path())
 @click.option("--manifest", required=True, type=click.Path(dir_okay=False), help="FLEET.toml.")
 @output_file_option("--out", "FLEET.parquet.", required=True)
 @click.option("--report", type=click.Path(file_okay=False), help="Write the HTML report here.")
 @click.option("--scheduler", metavar="ADDRESS", help="A Dask scheduler (default: a local cluster).")
 @click.option("--workers", type=int, help="Local cluster worker processes [one per core].")
 @click.option(
-    "--min-rise", type=float, default=0.05, show_default=True, help="Smallest rise called drift."
+    "--min-rise",
+    type=Finite(min=0.0),
+    default=0.05,
+    show_default=True,
+    help="Smallest rise called drift.",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the robots as JSON.")
 @topic_option
@@ -63,8 +70,8 @@ def energy(
     """
 
     def tick(done: int, total: int, result: LogResult) -> None:
-        if result.error is not None:
-            note(result.error)
+        if result.error is not None:  # a log left out: the robot's figures lack it
+            warn(f"{result.error} (left out of {result.robot}'s figures)")
         if done == total or done % max(1, total // 10) == 0:
             say(f"{done}/{total} logs")
 
@@ -94,8 +101,10 @@ def energy(
                 f"{r.name}: {c.metric} per cycle of {c.program} changed on {c.date} "
                 f"({100 * c.relative:+.1f} %): a change, not drift"
             )
-    where = f"; report {report}/report.html" if report else ""
+    where = f"; report {Path(report) / 'report.html'}" if report else ""
     click.echo(
-        f"{result.logs} logs on {result.workers} worker(s) in {result.seconds:.1f} s: {out}{where}",
+        f"{result.logs} logs"
+        + (f" ({len(result.skipped)} more left out: refused)" if result.skipped else "")
+        + f" on {result.workers} worker(s) in {result.seconds:.1f} s: {out}{where}",
         err=True,
     )

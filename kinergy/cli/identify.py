@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from kinergy.cli.common import (
+    Finite,
     accept_option,
     columns_option,
     cutoff_option,
@@ -213,7 +214,7 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 @click.option(
     "--ridge",
     "ridge",
-    type=click.FloatRange(0.0, 1e12),
+    type=Finite(0.0, 1e12),
     default=0.0,
     show_default=True,
     help="Full method: ridge weight.",

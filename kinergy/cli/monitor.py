@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import accept_option, fmt, json_result, load, progress
+from kinergy.cli.common import Finite, accept_option, fmt, json_result, load, progress
 from kinergy.live.monitor import CycleEnergy
 from kinergy.logs.checks import parse_accept
 from kinergy.workflows.monitor import monitor_cycles
@@ -28,8 +28,8 @@ def _line(c: CycleEnergy) -> str:
 @click.option(
     "--model", "model", required=True, metavar="ROBOT", help="Robot model (name or file)."
 )
-@click.option("--frequency", type=float, default=500.0, show_default=True, help="Hz.")
-@click.option("--duration", type=float, help="Stop after this many seconds of controller time.")
+@click.option("--frequency", type=Finite(), default=500.0, show_default=True, help="Hz.")
+@click.option("--duration", type=Finite(), help="Stop after this many seconds of controller time.")
 @click.option("--json", "as_json", is_flag=True, help="At the end, print the cycles as JSON.")
 @accept_option
 def monitor(

@@ -14,6 +14,7 @@ from typing import Any, TypeVar
 import click
 
 from kinergy.cli.common import (
+    Finite,
     flag_of,
     json_result,
     load,
@@ -258,7 +259,7 @@ def lever_options(prefix: str = "") -> Callable[[F], F]:
         click.option("--no-blends", is_flag=True, help=said("no blend radii on via points.")),
         click.option(
             "--standby",
-            type=click.FloatRange(min=0.0),
+            type=Finite(min=0.0),
             default=None,
             help=said("standby power (W) counted over the cycle time [default: the robot file's]."),
         ),
@@ -348,12 +349,12 @@ def program_options(
 )
 @payload_option
 @click.option(
-    "--v-max", "v_max", type=float, default=None, help="Cap on every joint's speed, rad/s."
+    "--v-max", "v_max", type=Finite(), default=None, help="Cap on every joint's speed, rad/s."
 )
 @click.option(
     "--a-max",
     "a_max",
-    type=float,
+    type=Finite(),
     default=None,
     help="Cap on every joint's acceleration, rad/s^2 [default: the model's limits; a UR model "
     "has none, so the torque limits bound it].",

@@ -14,6 +14,7 @@ import math
 import click
 
 from kinergy.cli.common import (
+    Finite,
     json_result,
     load,
     output_file_option,
@@ -112,9 +113,11 @@ def place_text(run: PlaceRun) -> str:
 @click.option(
     "--yaw", "yaw", default=None, metavar="MIN:MAX", help="Base turn about the vertical, deg [0:0]."
 )
-@click.option("--step", type=float, default=0.1, show_default=True, help="Grid step of x, y, z, m.")
 @click.option(
-    "--yaw-step", "yaw_step", type=float, default=15.0, show_default=True, help="Grid step, deg."
+    "--step", type=Finite(), default=0.1, show_default=True, help="Grid step of x, y, z, m."
+)
+@click.option(
+    "--yaw-step", "yaw_step", type=Finite(), default=15.0, show_default=True, help="Grid step, deg."
 )
 @output_file_option("--urscript", "Write the best placement's optimised program to this file.")
 @output_file_option("--plot", "Write the energy map to this PNG.", metavar="FILE.png")
@@ -129,11 +132,11 @@ def place_text(run: PlaceRun) -> str:
     help="Cycle time of every candidate; 'same': today's program's own.",
 )
 @click.option(
-    "--v-max", "v_max", type=float, default=None, help="Cap on every joint's speed, rad/s "
+    "--v-max", "v_max", type=Finite(), default=None, help="Cap on every joint's speed, rad/s "
     "[default: today's program's peak]."
 )  # fmt: skip
 @click.option(
-    "--a-max", "a_max", type=float, default=None, help="Cap on every joint's acceleration, "
+    "--a-max", "a_max", type=Finite(), default=None, help="Cap on every joint's acceleration, "
     "rad/s^2 [default: today's program's peak]."
 )  # fmt: skip
 @lever_options()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import output_file_option, progress, writes
+from kinergy.cli.common import Finite, output_file_option, progress, writes
 from kinergy.workflows.record import record_to_file
 
 __all__ = ["record"]
@@ -14,14 +14,14 @@ __all__ = ["record"]
 @click.argument("address", metavar="HOST[:PORT]")
 @output_file_option("--out", "Log file to write.", required=True)
 @click.option(
-    "--frequency", type=float, default=500.0, show_default=True, help="Packages per second, Hz."
+    "--frequency", type=Finite(), default=500.0, show_default=True, help="Packages per second, Hz."
 )
-@click.option("--duration", type=float, help="Stop after this many seconds of controller time.")
+@click.option("--duration", type=Finite(), help="Stop after this many seconds of controller time.")
 @click.option(
-    "--rotate", "rotate_minutes", type=float, metavar="MINUTES", help="New file every MINUTES."
+    "--rotate", "rotate_minutes", type=Finite(), metavar="MINUTES", help="New file every MINUTES."
 )
 @click.option(
-    "--rotate-size", "rotate_megabytes", type=float, metavar="MB", help="New file every MB."
+    "--rotate-size", "rotate_megabytes", type=Finite(), metavar="MB", help="New file every MB."
 )
 @writes(files=("out",))
 def record(

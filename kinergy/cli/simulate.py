@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from kinergy.cli.common import (
+    Finite,
     accept_option,
     columns_option,
     load,
@@ -48,29 +49,27 @@ __all__ = ["simulate"]
     dest="truth_out",
 )
 @click.option("--exact", is_flag=True, help="No lag and no noise: the model's equations exactly.")
-@click.option(
-    "--lag", type=click.FloatRange(0.0, 1.0), help="Real motion behind the target, s [0.004]."
-)
+@click.option("--lag", type=Finite(0.0, 1.0), help="Real motion behind the target, s [0.004].")
 @click.option(
     "--speed-noise",
-    type=click.FloatRange(0.0, 10.0),
+    type=Finite(0.0, 10.0),
     help="Measured speed noise std, rad/s [0.01].",
 )
 @click.option(
     "--current-noise",
-    type=click.FloatRange(0.0, 100.0),
+    type=Finite(0.0, 100.0),
     help="Measured current noise std, A [0.04].",
 )
 @click.option(
     "--ambient",
-    type=click.FloatRange(-50.0, 100.0),
+    type=Finite(-50.0, 100.0),
     default=25.0,
     show_default=True,
     help="Air, deg C.",
 )
 @click.option(
     "--initial-temperature",
-    type=click.FloatRange(-50.0, 200.0),
+    type=Finite(-50.0, 200.0),
     default=None,
     help="The joints' temperature at the start, deg C [the ambient: a cold start].",
 )

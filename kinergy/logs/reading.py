@@ -404,8 +404,21 @@ class InputLogs:
         return out
 
     def add(self, log: CheckedLog) -> None:
-        """Record ``log`` once it has been read to the end."""
+        """Record ``log`` once it has been read to the end.
+
+        Raises
+        ------
+        KinergyError
+            The same log given twice (the same SHA-256 as one recorded before): it would count
+            twice and make every standard error look smaller than it is.
+        """
         assert log.provenance is not None and log.checks is not None
+        for seen in self.provenance:
+            if seen.sha256 == log.provenance.sha256 and log.provenance.size > 0:
+                raise KinergyError(
+                    f"{log.provenance.path}: the same log as {seen.path} (same SHA-256): given "
+                    "twice, it would count twice; give each log once"
+                )
         self.provenance.append(log.provenance)
         self.checks.append(log.checks)
         self.notes.extend(log.notes)

@@ -190,6 +190,11 @@ class Link:
         _check_inertia(self.inertia, "inertia", allow_zero=False)
 
 
+#: m: farthest a payload's centre of mass may be from the flange (a tool held by an arm; a
+#: larger figure is a unit slip, mm for m)
+PAYLOAD_REACH = 1.0
+
+
 @dataclass(frozen=True, eq=False)
 class Payload:
     """A load rigidly fixed to the flange (what a UR program sets with ``set_payload``).
@@ -213,6 +218,17 @@ class Payload:
         object.__setattr__(self, "com", _vector(self.com, 3, "payload com"))
         object.__setattr__(self, "inertia", _vector(self.inertia, 6, "payload inertia"))
         _check_inertia(self.inertia, "payload inertia", allow_zero=True)
+
+    def check_reach(self) -> Payload:
+        """This payload, refused when its centre of mass is farther than :data:`PAYLOAD_REACH`
+        from the flange (a unit slip in what a user wrote: mm for m)."""
+        reach = float(np.linalg.norm(self.com))
+        if reach > PAYLOAD_REACH:
+            raise KinergyError(
+                f"payload com is {reach:g} m from the flange, beyond {PAYLOAD_REACH:g} m: given in "
+                "mm instead of m?"
+            )
+        return self
 
 
 @dataclass(frozen=True, eq=False)

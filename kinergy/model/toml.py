@@ -286,7 +286,7 @@ def robot_from_dict(data: Mapping[str, Any]) -> Robot:
     if "payload" in data:
         pdata = _known(data["payload"], ("mass", "com", "inertia"), "payload")
         optional = {"com": [0.0, 0.0, 0.0], "inertia": [0.0] * 6}
-        payload = Payload(**_fields(pdata, "payload", ("mass",), optional))
+        payload = Payload(**_fields(pdata, "payload", ("mass",), optional)).check_reach()
     sources = {}
     for cat, sdata in _table(data.get("sources", {}), "sources").items():
         sdata = _known(sdata, ("status", "ref"), f"sources.{cat}")
@@ -489,5 +489,7 @@ def parse_payload(text: str) -> Payload:
     inertia = values[4:10] if len(values) == 10 else [0.0] * 6
     return _at(
         "--payload",
-        lambda: Payload(mass=values[0], com=np.asarray(com), inertia=np.asarray(inertia)),
+        lambda: Payload(
+            mass=values[0], com=np.asarray(com), inertia=np.asarray(inertia)
+        ).check_reach(),
     )

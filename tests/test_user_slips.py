@@ -1,0 +1,56 @@
+"""Slips a person makes at the command line, each refused in one line before anything is
+written: a number that is not one, a payload's centre of mass in mm, the same log twice."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from kinergy.cli import main
+
+
+@pytest.fixture(scope="module")
+def log(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("slips") / "a.csv"
+    assert main(["-q", "simulate", "ur5e", "--trajectory", "test-a", "--out", str(path)]) == 0
+    return path
+
+
+@pytest.mark.parametrize(
+    ("argv", "flag"),
+    [
+        (["simulate", "ur5e", "--trajectory", "test-a", "--ambient", "nan"], "--ambient"),
+        (["simulate", "ur5e", "--trajectory", "test-a", "--initial-temperature", "inf"], None),
+        (["optimize", "ur5e", "test-a", "--v-max", "nan"], "--v-max"),
+        (["excite", "ur5e", "--period", "nan"], "--period"),
+    ],
+)
+def test_a_number_that_is_not_finite_is_refused_naming_the_flag(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], flag: str | None
+) -> None:
+    out = tmp_path / "out.csv"
+    assert main([*argv, "--out", str(out)] if argv[0] != "optimize" else argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and ("not a finite number" in err or "not in the range" in err)
+    assert flag is None or f"'{flag}'" in err
+    assert not out.exists()
+
+
+def test_a_payload_centre_of_mass_in_mm_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["energy", "ur5e", "test-a", "--payload", "1.5,0,0,60"]) == 1
+    err = capsys.readouterr().err
+    assert "--payload: payload com is 60 m from the flange" in err and "mm instead of m?" in err
+
+
+def test_the_same_log_twice_is_refused(
+    log: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    copy = tmp_path / "copy.csv"
+    copy.write_bytes(log.read_bytes())
+    out = tmp_path / "m.toml"
+    for logs in ([log, log], [log, copy]):
+        assert main(["identify", "--robot", "ur5e", "--out", str(out), *map(str, logs)]) == 1
+        err = capsys.readouterr().err
+        assert f"{logs[1]}: the same log as {log} (same SHA-256): given twice" in err
+        assert err.count("\n") == 1 and not out.exists()
