@@ -54,3 +54,34 @@ def test_the_same_log_twice_is_refused(
         err = capsys.readouterr().err
         assert f"{logs[1]}: the same log as {log} (same SHA-256): given twice" in err
         assert err.count("\n") == 1 and not out.exists()
+
+
+def test_a_supply_signal_that_cannot_be_is_refused(
+    log: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The supply's voltage stuck at 0 V and its current with the sign flipped (the arm would
+    feed the supply) fail the ratings check; the current stuck at one value fails constant."""
+    header, *rows = log.read_text().splitlines()
+    names = header.split(" ")
+    v, i = names.index("actual_robot_voltage"), names.index("actual_robot_current")
+
+    def edited(name: str, change: object) -> Path:
+        out = tmp_path / name
+        lines = []
+        for row in rows:
+            cells = row.split(" ")
+            change(cells)  # type: ignore[operator]
+            lines.append(" ".join(cells))
+        out.write_text("\n".join([header, *lines]) + "\n")
+        return out
+
+    cases = {
+        "volt0.csv": (lambda c: c.__setitem__(v, "0"), "ratings check failed: actual_robot_voltage never exceeds 0 V"),
+        "flipped.csv": (lambda c: c.__setitem__(i, str(-abs(float(c[i])))), "actual_robot_current is never positive"),
+        "stuck.csv": (lambda c: c.__setitem__(i, "1.5"), "constant check failed: actual_robot_current holds 1.5"),
+    }  # fmt: skip
+    for name, (change, words) in cases.items():
+        assert main(["energy", "ur5e", str(edited(name, change))]) == 1
+        err = capsys.readouterr().err
+        assert words in err and err.count("\n") == 1, err
+    assert main(["-q", "energy", "ur5e", str(log)]) == 0

@@ -628,6 +628,20 @@ class LogCheck:
                         f"{name} of {_joint(robot, j)} reaches {peak[j]:.4g} {unit}, more than "
                         f"{RATING_FACTOR:g} times its rating of {rating[j]:.3g} {unit}{hint}",
                     )
+        bus = float(self.hi.get("actual_robot_voltage", np.nan))
+        if bus < 0.5 * robot.bus_voltage:
+            found.fail(
+                Check.RATINGS,
+                f"actual_robot_voltage never exceeds {bus:.4g} V, under half the {robot.bus_voltage:g} V "
+                "bus it measures: another signal, or another unit?",
+            )
+        drawn = float(self.hi.get("actual_robot_current", np.nan))
+        if drawn <= 0.0 and self._moving().any():
+            found.fail(
+                Check.RATINGS,
+                f"actual_robot_current is never positive ({drawn + 0.0:.4g} A at most) while the arm "
+                "moves, yet the arm draws from its supply: its sign flipped?",
+            )
         for name, limit, unit in (
             ("actual_robot_voltage", 5.0 * robot.bus_voltage, "V"),
             ("actual_robot_current", RATING_FACTOR * float(np.sum(current)), "A"),
@@ -663,6 +677,15 @@ class LogCheck:
                     f"{name} of {joints} holds {_values(self.lo[name][stuck])} on every sample "
                     "while the joint moves: not logged?",
                 )
+        for name in ("actual_robot_current",):  # the supply's (an ideal voltage may be constant)
+            if name in self.lo and moving.any():
+                ran = True
+                if float(self.lo[name]) == float(self.hi[name]):
+                    found.fail(
+                        Check.CONSTANT,
+                        f"{name} holds {float(self.lo[name]):.4g} on every sample while the arm "
+                        "moves: not logged?",
+                    )
         found.verdict(Check.CONSTANT, ran, "no measured signal")
 
     def _check_robot(self, found: _Findings) -> None:
