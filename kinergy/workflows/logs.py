@@ -101,7 +101,15 @@ def chunked_logs(
             inputs.add(checked)
             t, segment = spill.state.t, spill.state.signals.get("segment")
             for name, ab in _segments(checked.path, t, segment, inputs.notes):
-                segments.append(prepare_segment(spill, ab, name, robot.n, reading.cutoff))
+                prepared = prepare_segment(spill, ab, name, robot.n, reading.cutoff)
+                if prepared.grid is not None:
+                    rows = prepared.rows.stop - prepared.rows.start
+                    inputs.notes.append(
+                        f"{name}: irregular time stamps: its {rows} rows resampled to "
+                        f"{prepared.grid[1]} samples {prepared.grid[0] * 1e3:.4g} ms apart (the "
+                        "counts identify and validate give)"
+                    )
+                segments.append(prepared)
         yield segments, inputs
 
 
