@@ -106,3 +106,26 @@ def test_a_folder_of_two_runs_asks_for_one_and_columns_are_refused(tmp_path: Pat
         read_log(tmp_path)
     with pytest.raises(KinergyError, match="no --columns"):
         read_log(tmp_path / "a_time.txt", columns="timestamp,actual_q:7")
+
+
+def test_a_set_is_the_same_log_by_its_folder_or_its_time_file(tmp_path: Path) -> None:
+    """The SHA-256 of a set covers its own files, whichever names it: so ``validate`` knows a
+    model was identified from it either way; another file in the folder changes nothing, a
+    changed signal file changes it."""
+    from kinergy.logs.reading import _file_hash
+
+    def sha(path: Path) -> str:
+        import threading
+
+        out: list[str] = []
+        _file_hash(path, out, threading.Event())
+        return out[0]
+
+    time = _layout(tmp_path)
+    (tmp_path / "README.txt").write_text("notes")
+    assert sha(tmp_path) == sha(time)
+    torques = tmp_path / "run_torques.txt"
+    before = sha(time)
+    text = torques.read_text()
+    torques.write_text(text[:-2] + ("1" if text[-2] != "1" else "2") + text[-1])
+    assert sha(time) != before

@@ -26,6 +26,7 @@ from kinergy.io.columns import printable
 from kinergy.io.fields import closest, is_known
 from kinergy.io.formats import CHUNK_ROWS, iter_log
 from kinergy.io.log import Log
+from kinergy.io.panda_layout import is_panda_layout, panda_files
 from kinergy.io.rosbag import BagOptions
 from kinergy.logs.checks import Check, LogCheck, LogChecks
 from kinergy.model.robot import Robot
@@ -100,28 +101,35 @@ class Provenance:
     rows: int
 
 
-def _files(path: Path) -> list[Path]:
-    """The files a log is: the file itself, or every file of a log that is a folder (a rosbag2
-    folder, the panda-gaz layout), in sorted order."""
+def _files(path: Path) -> tuple[Path, list[Path]]:
+    """The files a log is and the folder their names are taken relative to: the file itself;
+    the files of a panda-gaz set (its time file and the signals' files beside it), whether
+    named by its folder or its time file; every file of another folder (a rosbag2 folder), in
+    sorted order."""
+    if is_panda_layout(path):
+        found = panda_files(path)
+        return found.time.parent, sorted([found.time, *found.signals.values()])
     if path.is_dir():
-        return sorted(p for p in path.rglob("*") if p.is_file())
-    return [path]
+        return path, sorted(p for p in path.rglob("*") if p.is_file())
+    return path.parent, [path]
 
 
 def _file_hash(path: Path, out: list[str], stop: threading.Event) -> None:
     """SHA-256 of the log at ``path`` into ``out`` (nothing when ``stop`` is set first): of the
-    file's bytes, or of a folder's files, each by its relative name and bytes."""
+    file's bytes, or of a log of several files (:func:`_files`), each by its relative name and
+    bytes."""
     digest = hashlib.sha256()
     try:
-        for part in _files(path):
-            if path.is_dir():
-                digest.update(part.relative_to(path).as_posix().encode() + b"\0")
+        base, files = _files(path)
+        for part in files:
+            if len(files) > 1 or path.is_dir():
+                digest.update(part.relative_to(base).as_posix().encode() + b"\0")
             with part.open("rb") as fh:
                 while block := fh.read(1 << 20):
                     if stop.is_set():
                         return
                     digest.update(block)
-    except OSError:
+    except (OSError, KinergyError):
         return
     out.append(digest.hexdigest())
 
@@ -352,7 +360,7 @@ class CheckedLog:
         else:
             assert hasher is not None
             hasher.join()
-            size = sum(p.stat().st_size for p in _files(Path(self.source)))
+            size = sum(p.stat().st_size for p in _files(Path(self.source))[1])
             digest = hashed[0] if hashed else ""
         self.provenance = Provenance(self.path, digest, size, rows)
 
