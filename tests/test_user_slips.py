@@ -85,3 +85,22 @@ def test_a_supply_signal_that_cannot_be_is_refused(
         err = capsys.readouterr().err
         assert words in err and err.count("\n") == 1, err
     assert main(["-q", "energy", "ur5e", str(log)]) == 0
+
+
+def test_validate_with_nothing_to_compare_is_refused(
+    log: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    header, *rows = log.read_text().splitlines()
+    names = header.split(" ")
+    keep = [
+        k
+        for k, n in enumerate(names)
+        if not n.startswith(("target_moment", "actual_current", "target_current"))
+    ]
+    bare = tmp_path / "bare.csv"
+    bare.write_text(
+        "\n".join(" ".join(line.split(" ")[k] for k in keep) for line in [header, *rows]) + "\n"
+    )
+    assert main(["validate", "ur5e", str(bare)]) == 1
+    err = capsys.readouterr().err
+    assert "nothing to compare the model with" in err and err.count("\n") == 1

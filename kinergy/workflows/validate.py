@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from kinergy.errors import KinergyError
 from kinergy.files import atomic_folder
 from kinergy.identification.validation import (
     PLOT_SAMPLES,
@@ -54,6 +55,12 @@ def validate_logs(
     with chunked_logs(sources, robot, reading or LogReading()) as (segments, inputs):
         report = validation_report(
             robot, segments, plot_samples=PLOT_SAMPLES if plots is not None else 0
+        )
+    if report.torque is None and report.current is None and report.joint_torque is None:
+        names = ", ".join(os.fspath(p) if not isinstance(p, Log) else p.path for p in logs)
+        raise KinergyError(
+            f"{names}: nothing to compare the model with: no target_moment, actual_current or "
+            "measured joint torques (a ROS 2 bag without effort?)"
         )
     inputs.notes += [
         f"{log}: the realistic twin of {robot.name} (seed 0) running the built-in motion {log}: "
