@@ -459,3 +459,25 @@ def test_the_energy_of_a_bag_read_ahead_in_a_thread_is_the_csv_logs(
     # the bag's time starts at 0 and the CSV's at 1141.591 s: the same to round-off
     np.testing.assert_allclose(from_bag.e_elec, from_csv.e_elec, rtol=1e-12)
     assert from_bag.supply.drawn == pytest.approx(from_csv.supply.drawn, rel=1e-12)
+
+
+def test_a_bad_message_is_named_by_its_number(tmp_path: Path) -> None:
+    """A value that is not a number and a joint under two names are refused naming the bag,
+    the message and the joint; --repair drops the bad message."""
+    t, q, qd, effort = _motion(200)
+    q = q.copy()
+    q[100, 2] = np.nan
+    bag = write_bag(tmp_path / "nan", t, q, qd, effort)
+    with pytest.raises(KinergyError, match=r"nan: /joint_states: message 101: position of elbow"):
+        read_log(bag, joints=UR)
+    assert len(read_log(bag, joints=UR, repair=True)) == 199
+    names = list(UR_DRIVER_JOINTS)
+    names[2] = "elbow"
+    twice = write_bag(
+        tmp_path / "twice", t, np.column_stack([q, q[:, 2]]), names=[*names, "elbow_joint"],
+        extra=None,
+    )  # fmt: skip
+    with pytest.raises(
+        KinergyError, match=r"joint elbow is in the bag twice \(elbow, elbow_joint\)"
+    ):
+        read_log(twice, joints=UR)

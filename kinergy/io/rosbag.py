@@ -226,6 +226,13 @@ def match_joints(names: Sequence[str], joints: Sequence[str], where: str) -> tup
             f"{where}: the bag has the joints of {len(fits)} arms (prefixes "
             f"{', '.join(repr(p) for p, _ in fits)}); record one arm's joint states per bag"
         )
+    twice = [j for j in joints if sum(n in _spellings(j) for n in names) > 1]
+    if twice:
+        spelled = [n for n in names if n in _spellings(twice[0])]
+        raise KinergyError(
+            f"{where}: joint {twice[0]} is in the bag twice ({', '.join(spelled)}): which one "
+            "is the robot's? record one arm's joint states under one name each"
+        )
     missing = [j for j in joints if not any(n in _spellings(j) for n in names)]
     what = ", ".join(missing) if missing else ", ".join(joints)
     raise KinergyError(
@@ -455,7 +462,9 @@ def _read(
             else:
                 found = _match(names, joints, prefix)
                 if found is None:
-                    index, _ = match_joints(names, [prefix + j for j in joints], where)
+                    index, _ = match_joints(
+                        names, [prefix + j for j in joints], f"{where}: message {count}"
+                    )
                 else:
                     index = found
             if len(orders) >= _ORDERS:
@@ -496,6 +505,16 @@ def _read(
                     f"{len(names)} joint names"
                 )
             arrays[signal] = values[order]
+        bad = next((k for k, x in arrays.items() if not np.all(np.isfinite(x))), None)
+        if bad is not None:
+            if not repair:
+                j = int(np.flatnonzero(~np.isfinite(arrays[bad]))[0])
+                raise KinergyError(
+                    f"{where}: message {count}: {fields[bad]} of {joints[j]} is "
+                    f"{arrays[bad][j]}: not a finite number; --repair drops such messages"
+                )
+            dropped += 1
+            continue
         previous = stamp
         if pending is not None:
             yield pending
@@ -503,8 +522,8 @@ def _read(
     assert chunks is not None  # _topic saw messages
     if dropped:
         chunks.notes.append(
-            f"{where}: {dropped} message(s) whose header stamp was not after the one before "
-            "dropped (--repair)"
+            f"{where}: {dropped} message(s) whose header stamp was not after the one before, "
+            "or with a value that is not a number, dropped (--repair)"
         )
     last = chunks.flush()
     if pending is not None:
