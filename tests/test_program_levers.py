@@ -357,3 +357,21 @@ def test_blends_go_only_between_joint_moves_so_straight_lines_stay_whole() -> No
         off = np.linalg.norm(rel - np.outer(along, u), axis=1)
         near = on & (off < 0.02)  # the samples of this line (others are elsewhere in the cell)
         assert near.sum() > 20 and off[near].max() < 1e-4, k
+
+
+def test_no_lever_buys_its_saving_with_a_longer_cycle() -> None:
+    """A program at its own limits leaves no room: a lever whose program holds the limits only
+    when it takes longer is not kept, and the timing reports itself not possible (it claimed
+    17.8 % by taking 2.774 s for a 2.390 s cycle)."""
+    from kinergy.optimize.program_levers import CYCLE_TOLERANCE, LeverStatus
+
+    robot = load_robot("ur5e")
+    text = "movej([0,-1.57,0,-1.57,0,0], a=1.4, v=1.05)\nmovej([0.5,-1.2,0.3,-1.57,0,0], a=1.4, v=1.05)\n"
+    result = optimize_program(robot, parse_program(text, path="tight.script"))
+    own = result.program.result.cycle_time
+    assert result.optimized.result.cycle_time <= own + CYCLE_TOLERANCE
+    for lever in result.levers:
+        if lever.status is LeverStatus.KEPT:
+            assert lever.result.cycle_time <= own + CYCLE_TOLERANCE, lever.name
+    blends = next(lv for lv in result.levers if lv.name == "blends")
+    assert blends.status is LeverStatus.OVER_LIMITS and "over the cycle time" in blends.note

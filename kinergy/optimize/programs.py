@@ -189,7 +189,12 @@ def _timing_only(search: LeverSearch, path: ProgramPath, say: Callable[[str], No
     (what re-timing alone saves)."""
     say("timing only: re-timing the program as written")
     checks = timing_checks(search.robot, path, search.objective, search.caps)
-    result, verified = retime(checks, search.budget)
+    try:
+        result, verified = retime(checks, search.budget)
+    except KinergyError as exc:  # the timing model's fastest is above the budget
+        note = f"the program as written, re-timed: {exc}"
+        search.record(Lever("timing only", search.best.result, LeverStatus.NOT_POSSIBLE, note=note))
+        return
     none = np.zeros(path.moves, dtype=bool)
     search.judge(
         "timing only",
