@@ -75,7 +75,8 @@ def test_headerless_with_columns_and_trailing_delimiter(tmp_path: Path) -> None:
             "rows have 2 fields but the --columns spec names 3",
         ),
         ("", None, "empty log"),
-        ("timestamp a_0 a_2\n0.0 1 2\n0.1 3 4\n", None, r"columns a_\* are not numbered"),
+        ("timestamp a_0 a_2\n0.0 1 2\n0.1 3 4\n", None, r"no column a_1 although a_0, _2 are"),
+        ("timestamp ab_1 ac_0\n0.0 1 2\n0.1 3 4\n", None, r"no column ab_0 .* 'ac_0' misspelled\?"),
     ],
 )
 def test_malformed_logs_are_one_line(

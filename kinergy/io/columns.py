@@ -167,10 +167,17 @@ def group_columns(columns: Sequence[str], path: str) -> dict[str, list[str]]:
     for name, members in groups.items():
         idx = sorted(members)
         if idx != list(range(len(idx))):
+            missing = [f"{name}_{i}" for i in range(idx[-1] + 1) if i not in members]
             shown = idx if len(idx) <= 8 else [*idx[:8], "..."]
+            index = missing[0].rsplit("_", 1)[1]
+            others = [  # a column of another known vector is not a misspelling
+                c for c in columns if c.endswith(f"_{index}") and not is_known(c.rsplit("_", 1)[0])
+            ]
+            near = [c for c in [closest(missing[0], others)] if c is not None]
+            hint = f"; {printable(near[0])!r} misspelled?" if near else ""
             raise KinergyError(
-                f"{path}: columns {printable(name)}_* are not numbered 0..{len(idx) - 1} "
-                f"(have {shown})"
+                f"{path}: no column {printable(missing[0])} although {printable(name)}_"
+                f"{', _'.join(map(str, shown))} are there (numbered from 0){hint}"
             )
         out[name] = [members[i] for i in idx]
     for col in scalars:
