@@ -104,3 +104,20 @@ def test_validate_with_nothing_to_compare_is_refused(
     assert main(["validate", "ur5e", str(bare)]) == 1
     err = capsys.readouterr().err
     assert "nothing to compare the model with" in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize(
+    ("argv", "words"),
+    [
+        (["simulate", "ur5e", "--trajectory", "test-a", "--exact", "--lag", "0.1"], "--exact and --lag together"),
+        (["simulate", "ur5e", "--trajectory", "test-a", "--truth", "t.toml"], "--truth: only with --mismatch realistic"),
+        (["excite", "ur5e", "--no-floor", "--floor", "0.2"], "--no-floor and --floor together"),
+    ],
+)  # fmt: skip
+def test_flags_that_contradict_each_other_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], words: str
+) -> None:
+    out = tmp_path / "out.csv"
+    assert main([*argv, "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert words in err and err.count("\n") == 1 and not out.exists()

@@ -47,6 +47,7 @@ __all__ = [
     "payload_option",
     "print_tables",
     "progress",
+    "refuse_together",
     "repair_option",
     "report_folder_option",
     "seed_option",
@@ -275,6 +276,21 @@ def _given(value: Any) -> list[str]:
     if value is None:
         return []
     return [str(v) for v in value] if isinstance(value, tuple | list) else [str(value)]
+
+
+def refuse_together(*pairs: tuple[str, str, str]) -> None:
+    """Refuse, in one line naming both flags, two options given together on the command line
+    that contradict each other: each pair is (parameter, parameter, why)."""
+    ctx = click.get_current_context()
+
+    def given(name: str) -> bool:
+        return ctx.get_parameter_source(name) is click.core.ParameterSource.COMMANDLINE
+
+    for a, b, why in pairs:
+        if given(a) and given(b):
+            raise KinergyError(
+                f"{flag_of(ctx.command, a)} and {flag_of(ctx.command, b)} together: {why}"
+            )
 
 
 def _within(path: Path, folder: Path) -> bool:

@@ -23,6 +23,7 @@ from kinergy.cli.common import (
     json_result,
     output_file_option,
     progress,
+    refuse_together,
     seed_option,
     writes,
 )
@@ -251,6 +252,10 @@ def excite(robot_name: str, as_json: bool, quiet: bool, **flags: Any) -> None:
     condition number of the stacked base regressor within the joint, speed, acceleration and
     floor limits. Progress goes to stderr.
     """
+    refuse_together(
+        ("no_floor", "floor", "no floor constraint, or one at that height?"),
+        ("no_floor", "flange_only", "the flange above which floor?"),
+    )
     robot = load_robot(robot_name)
     options = excite_options(robot, flags)
     with progress(quiet=quiet) as say:

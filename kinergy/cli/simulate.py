@@ -13,10 +13,12 @@ from kinergy.cli.common import (
     output_file_option,
     payload_option,
     prose,
+    refuse_together,
     seed_option,
     tell,
     writes,
 )
+from kinergy.errors import KinergyError
 from kinergy.twin import MISMATCHES, TwinSettings
 from kinergy.workflows.twin import simulate_to_file
 
@@ -100,6 +102,16 @@ def simulate(
     ROBOT is a built-in name or a model file: the model the twin's truth is (--mismatch none) or
     differs from (--mismatch realistic).
     """
+    exact_means = "--exact means no lag and no noise"
+    refuse_together(
+        ("exact", "lag", exact_means),
+        ("exact", "speed_noise", exact_means),
+        ("exact", "current_noise", exact_means),
+    )
+    if truth_out is not None and mismatch != "realistic":
+        raise KinergyError(
+            "--truth: only with --mismatch realistic (with none the twin's truth is ROBOT itself)"
+        )
     r = load(robot_name, payload)
     reading = log_reading(r, columns=columns, accept=accept)
     if exact:
