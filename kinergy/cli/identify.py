@@ -180,7 +180,10 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     type=click.Choice(METHODS),
     default="sequential",
     show_default=True,
-    help="sequential: the UR5e doc's procedure; full: base-parameter regression.",
+    help="sequential: the UR5e doc's procedure (drives from the currents); full: base-parameter "
+    "regression (links and drives); nursing: the nursing doc's method (friction from constant-"
+    "speed runs, Makkar curves, ridge regression on filtered, period-averaged excitation "
+    "logs).",
 )
 @output_file_option("--out", "Model file to write (TOML).", required=True)
 @columns_option

@@ -160,8 +160,8 @@ def energy_tables(reports: Mapping[str, EnergyReport], paper: bool) -> list[Tabl
         ]
         if key:
             total += [
-                f"{sum(r[0] for r in seed.TABLE_VIII[key]):.1f}",
-                f"{sum(r[1] for r in seed.TABLE_VIII[key]):.1f}",
+                f"{seed.TABLE_VIII_TOTAL[key][0]:.1f}",
+                f"{seed.TABLE_VIII_TOTAL[key][1]:.1f}",
                 f"{100 * seed.TABLE_VIII_EFFICIENCY[key]:.2f}",
             ]
         rows.append(total)
