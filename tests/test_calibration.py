@@ -148,3 +148,20 @@ def test_cli_import_calibration_writes_a_calibration_robot(
     )
     assert "bad.txt:9: expected 6 numbers" in capsys.readouterr().err
     assert not (tmp_path / "x.toml").exists()
+
+
+@real
+def test_a_calibration_of_another_robot_is_refused_naming_the_one_it_fits(tmp_path: Path) -> None:
+    """The UR5e's calibration imported into a UR3e or a UR10e model: refused, naming the joint
+    whose torque constant is off and the built-in robots it fits; nothing written."""
+    from kinergy.errors import KinergyError
+    from kinergy.model.library import load_robot
+    from kinergy.workflows.calibration import import_calibration
+
+    for name in ("ur3e", "ur10e"):
+        out = tmp_path / f"{name}.toml"
+        with pytest.raises(
+            KinergyError, match=r"a calibration of another robot \(it fits ur5, ur5e\)"
+        ):
+            import_calibration(load_robot(name), CALIBRATION, out=out)
+        assert not out.exists()

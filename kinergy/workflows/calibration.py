@@ -35,6 +35,7 @@ from kinergy.identification.friction_curve import (
     points_from,
 )
 from kinergy.io.ur_calibration import JointCalibration, read_ur_calibration
+from kinergy.model.library import library_names, load_robot
 from kinergy.model.robot import Friction, Robot, Source
 from kinergy.model.toml import save_robot
 
@@ -158,6 +159,35 @@ def _calibrated(robot: Robot, joints: list[CalibrationJoint], ref: str) -> Robot
     return dataclasses.replace(staged, sources=sources)
 
 
+#: a calibrated torque constant more than this factor from the model's is another robot's
+KT_FACTOR = 2.0
+
+
+def _check_robot(robot: Robot, path: str, k_tau: list[float]) -> None:
+    """Refuse a calibration whose torque constants are not ``robot``'s (more than
+    :data:`KT_FACTOR` from the model's on some joint), naming the joint and the built-in robots
+    whose torque constants it matches."""
+    model = np.array([j.drive.torque_constant for j in robot.joints])
+    ratio = np.asarray(k_tau) / model
+    off = np.flatnonzero((ratio > KT_FACTOR) | (ratio < 1.0 / KT_FACTOR))
+    if not off.size:
+        return
+    j = int(off[np.argmax(np.abs(np.log(ratio[off])))])
+    fits = []
+    for name in library_names():
+        other = load_robot(name)
+        if other.n == robot.n and name != robot.name:
+            r = np.asarray(k_tau) / [jt.drive.torque_constant for jt in other.joints]
+            if np.all((r <= 1.25) & (r >= 0.8)):
+                fits.append(name)
+    hint = f" (it fits {', '.join(fits)})?" if fits else "?"
+    raise KinergyError(
+        f"{path}: joint {j + 1} ({robot.joint_names[j]}): K_tau {k_tau[j]:.4g} N m/A is "
+        f"{ratio[j]:.2g} times {robot.name}'s {model[j]:.4g}: a calibration of another robot"
+        f"{hint}"
+    )
+
+
 def import_calibration(
     robot: Robot,
     path: str | os.PathLike[str],
@@ -177,6 +207,7 @@ def import_calibration(
     cal = read_ur_calibration(path)
     if len(cal.joints) != robot.n:
         raise KinergyError(f"{cal.path}: {len(cal.joints)} joints but {robot.name} has {robot.n}")
+    _check_robot(robot, cal.path, [c.torque_constant for c in cal.joints])
     joints = [_joint(robot, j, c, friction) for j, c in enumerate(cal.joints)]
     revision = cal.joints[0].revision
     ref = f"UR joint calibration summary {os.path.basename(cal.path)} (revision {revision})"
