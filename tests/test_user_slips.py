@@ -121,3 +121,14 @@ def test_flags_that_contradict_each_other_are_refused(
     assert main([*argv, "--out", str(out)]) == 1
     err = capsys.readouterr().err
     assert words in err and err.count("\n") == 1 and not out.exists()
+
+
+def test_a_motion_the_arm_cannot_run_is_a_warning(capsys: pytest.CaptureFixture[str]) -> None:
+    """50 kg on a UR5e (rated 5 kg): the energy is given, with a warning naming the joint and
+    how far past its torque limit the motion goes; the rated payload gives none."""
+    assert main(["-q", "energy", "ur5e", "test-a", "--payload", "50"]) == 0
+    err = capsys.readouterr().err
+    assert "warning: the motion needs" in err and "with a 50 kg payload" in err
+    assert "times its 150 N m limit: the arm cannot run it" in err
+    assert main(["-q", "energy", "ur5e", "test-a", "--payload", "5"]) == 0
+    assert capsys.readouterr().err == ""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -34,6 +35,7 @@ class LogEnergy(EnergyFigures):
     :meth:`to_dict` is ``kinergy energy --json`` (without where the command came from)."""
 
     inputs: InputLogs = field(default_factory=InputLogs)
+    said: tuple[str, ...] = ()  # the result's own warnings (a motion beyond the torque limits)
 
     @property
     def notes(self) -> list[str]:
@@ -41,7 +43,7 @@ class LogEnergy(EnergyFigures):
 
     @property
     def warnings(self) -> list[str]:
-        return list(self.inputs.warnings)
+        return [*self.inputs.warnings, *self.said]
 
     def to_dict(self) -> dict[str, Any]:
         out = super().to_dict()
@@ -49,9 +51,11 @@ class LogEnergy(EnergyFigures):
         return out
 
 
-def _with(figures: EnergyFigures, inputs: InputLogs) -> LogEnergy:
+def _with(figures: EnergyFigures, inputs: InputLogs, said: Sequence[str] = ()) -> LogEnergy:
     return LogEnergy(
-        **{k: getattr(figures, k) for k in EnergyFigures.__dataclass_fields__}, inputs=inputs
+        **{k: getattr(figures, k) for k in EnergyFigures.__dataclass_fields__},
+        inputs=inputs,
+        said=tuple(said),
     )
 
 
@@ -108,6 +112,28 @@ def _derived(signals: list[str] | None) -> str | None:
     return None
 
 
+#: how far past a joint's torque limit the modelled torque of a motion may go before the
+#: energy says the arm cannot run it (a model's peaks overshoot a real arm's a little)
+TORQUE_MARGIN = 1.5
+
+
+def _beyond_limits(robot: Robot, peak: Array) -> list[str]:
+    """A warning when the motion needs more than :data:`TORQUE_MARGIN` times a joint's torque
+    limit (``peak``: the largest joint-side torque of the model, (n,) N m): a payload the arm
+    cannot carry or a motion it cannot run, whose energy the figures give all the same."""
+    limits = np.array([j.limits.torque for j in robot.joints])
+    ratio = peak / limits
+    j = int(np.argmax(ratio))
+    if not ratio[j] > TORQUE_MARGIN:
+        return []
+    load = f" with a {robot.payload.mass:g} kg payload" if robot.payload is not None else ""
+    return [
+        f"the motion needs {peak[j]:.0f} N m at {robot.joint_names[j]}{load}, "
+        f"{ratio[j]:.1f} times its {limits[j]:.0f} N m limit: the arm cannot run it (a payload "
+        "too heavy, a motion too fast?); the energy is the model's all the same"
+    ]
+
+
 def program_energy(
     robot: Robot, path: str | os.PathLike[str], *, recovery: bool = True
 ) -> EnergyReport:
@@ -143,14 +169,18 @@ def energy_of_log(
     integrated across. A URScript program (``*.script``) is run as the controller would, with
     the loads it sets (:func:`program_energy`)."""
     inputs = InputLogs()
-    if is_builtin(path):  # test-a, test-b: the motion as planned for the robot
-        motion = paper_trajectory(robot, os.fspath(path))
-        inputs.notes.append(f"{path}: the built-in motion {path} planned for {robot.name}")
-        return _with(energy(robot, motion, recovery=recovery).figures(), inputs)
-    if os.fspath(path).endswith(".script"):
-        return _with(program_energy(robot, path, recovery=recovery).figures(), inputs)
+    if is_builtin(path) or os.fspath(path).endswith(".script"):
+        if is_builtin(path):  # test-a, test-b: the motion as planned for the robot
+            motion = paper_trajectory(robot, os.fspath(path))
+            inputs.notes.append(f"{path}: the built-in motion {path} planned for {robot.name}")
+            report = energy(robot, motion, recovery=recovery)
+        else:
+            report = program_energy(robot, path, recovery=recovery)
+        said = _beyond_limits(robot, np.abs(report.drive.tau_sim).max(axis=0))
+        return _with(report.figures(), inputs, said)
     acc = EnergyAccumulator(robot, recovery=recovery)
     measured = False
+    peak = np.zeros(robot.n)
     log = CheckedLog(path, robot, reading or LogReading(), rows=rows, ahead=True)
     log.select = _signals_used(log, source)
     for part in iter_motion(log.chunks(), n_joints=robot.n, source=source):
@@ -159,7 +189,9 @@ def energy_of_log(
         power = _measured_power(part.log)
         measured = power is not None
         acc.add(m.t, state, starts=part.starts, measured_power=power)
+        if len(m.t):
+            peak = np.maximum(peak, np.abs(state.tau_sim).max(axis=0))
     inputs.add(log)
     if derived := _derived(log.select):
         inputs.notes.append(f"{log.path}: {derived}")
-    return _with(acc.figures(measured=measured), inputs)
+    return _with(acc.figures(measured=measured), inputs, _beyond_limits(robot, peak))
