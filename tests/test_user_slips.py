@@ -132,3 +132,18 @@ def test_a_motion_the_arm_cannot_run_is_a_warning(capsys: pytest.CaptureFixture[
     assert "times its 150 N m limit: the arm cannot run it" in err
     assert main(["-q", "energy", "ur5e", "test-a", "--payload", "5"]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_a_task_in_radians_that_says_degrees_is_refused(tmp_path: Path) -> None:
+    from kinergy.errors import KinergyError
+    from kinergy.io.task import load_task
+
+    task = tmp_path / "t.toml"
+    task.write_text(
+        'unit = "deg"\n[[move]]\nq = [0.1, -1.57, 1.2, -1.2, -1.57, 0.0]\n'
+        "[[move]]\nq = [0.6, -1.2, 1.0, -1.4, -1.57, 0.3]\n"
+    )
+    with pytest.raises(KinergyError, match=r'unit = "deg", but every joint angle is within 1.57'):
+        load_task(task)
+    task.write_text(task.read_text().replace('"deg"', '"rad"'))
+    assert load_task(task).waypoints.shape == (3, 6)

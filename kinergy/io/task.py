@@ -187,6 +187,12 @@ def task_from_dict(
     targets = [row[0] for row in rows]
     settings = np.array([row[1:] for row in rows])  # (K, 4): v, a, r, ur_r
     start = _angles(data["start"], "start", scale, n) if "start" in data else targets[-1].copy()
+    largest = float(np.max(np.abs(np.vstack([start, *targets])))) / scale
+    if unit == "deg" and largest <= 2.0 * math.pi:
+        raise KinergyError(
+            f'unit = "deg", but every joint angle is within {largest:.3g}, as angles in rad '
+            'are: radians in a file that says degrees? (unit = "rad")'
+        )
     return Task(
         name=str(data.get("name", name)),
         robot=robot,
