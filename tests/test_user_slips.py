@@ -147,3 +147,13 @@ def test_a_task_in_radians_that_says_degrees_is_refused(tmp_path: Path) -> None:
         load_task(task)
     task.write_text(task.read_text().replace('"deg"', '"rad"'))
     assert load_task(task).waypoints.shape == (3, 6)
+
+
+def test_validating_on_a_few_samples_is_a_warning(
+    log: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    short = tmp_path / "short.csv"
+    short.write_text("\n".join(log.read_text().splitlines()[:4]) + "\n")
+    assert main(["-q", "validate", "ur5e", str(short)]) == 0
+    err = capsys.readouterr().err
+    assert "3 samples over 0.004 s: too short for these figures" in err

@@ -20,7 +20,7 @@ from kinergy.io.log import Log
 from kinergy.logs.reading import InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.report.plots import error_boxplot, save, time_series
-from kinergy.workflows.logs import chunked_logs
+from kinergy.workflows.logs import MIN_SEGMENT, chunked_logs
 from kinergy.workflows.twin import builtin_log, is_builtin
 
 __all__ = ["identified_from", "validate_logs", "write_validation_plots"]
@@ -56,6 +56,12 @@ def validate_logs(
         report = validation_report(
             robot, segments, plot_samples=PLOT_SAMPLES if plots is not None else 0
         )
+        short = [
+            f"{s.path}: {len(s)} samples over {(len(s) - 1) * s.dt:.3g} s: too short for these "
+            f"figures to tell how the model predicts (identify asks for {MIN_SEGMENT:g} s)"
+            for s in segments
+            if (len(s) - 1) * s.dt < MIN_SEGMENT
+        ]
     if report.torque is None and report.current is None and report.joint_torque is None:
         names = ", ".join(os.fspath(p) if not isinstance(p, Log) else p.path for p in logs)
         raise KinergyError(
@@ -77,7 +83,7 @@ def validate_logs(
             for s in list(log.series.values())[:1]
             if s.step > 1
         ]
-    warnings = [*inputs.warnings, *identified_from(robot, inputs)]
+    warnings = [*inputs.warnings, *short, *identified_from(robot, inputs)]
     return dataclasses.replace(
         report, inputs=inputs, notes=tuple(inputs.notes), warnings=tuple(warnings)
     )
