@@ -37,7 +37,7 @@ __all__ = ["excite", "excite_options", "excite_text"]
 #: flags that count something, and the least and most each may be (the most: sizes that fit in
 #: memory and finish in minutes)
 _COUNTS = {
-    "harmonics": (0, 50),
+    "harmonics": (2, 50),
     "periods": (1, 100),
     "starts": (1, 1000),
     "maxiter": (1, 100_000),

@@ -258,7 +258,8 @@ def check_cutoff(fs: float, cutoff: float) -> None:
     """Raise unless ``0 < cutoff < fs / 2`` (Hz)."""
     if not 0.0 < cutoff < fs / 2.0:
         raise KinergyError(
-            f"filter cutoff must be between 0 and {fs / 2:g} Hz (half of {fs:g} Hz), got {cutoff:g}"
+            f"--cutoff: the filter cutoff must be between 0 and {fs / 2:g} Hz (half of the log's "
+            f"{fs:g} Hz), got {cutoff:g}"
         )
 
 
