@@ -481,3 +481,23 @@ def test_a_bad_message_is_named_by_its_number(tmp_path: Path) -> None:
         KinergyError, match=r"joint elbow is in the bag twice \(elbow, elbow_joint\)"
     ):
         read_log(twice, joints=UR)
+
+
+def test_the_effort_hint_is_given_for_bags_only(tmp_path: Path) -> None:
+    """Joint torques in a bag's effort read as currents: the ratings check names --effort; the
+    same mistake in a CSV log names the kind only."""
+    from kinergy.logs.reading import CheckedLog, LogReading
+    from kinergy.model import load_robot as robot_of
+
+    t, q, qd, _ = _motion(3000)
+    torques = np.full_like(q, 100.0) * np.sign(np.sin(t))[:, None]  # N m, beyond amps
+    bag = write_bag(tmp_path / "torques", t, q, qd, torques)
+    with pytest.raises(KinergyError, match=r"--effort torque"):
+        CheckedLog(bag, robot_of("ur10e"), LogReading()).read()
+    from kinergy.io.rtde import write_log
+
+    csv = tmp_path / "torques.csv"
+    write_log(csv, t, {"actual_q": q, "actual_qd": qd, "actual_current": torques})
+    with pytest.raises(KinergyError, match=r"\(joint torques in N m logged as currents\?\)") as e:
+        CheckedLog(csv, robot_of("ur10e"), LogReading()).read()
+    assert "bag" not in str(e.value)

@@ -35,8 +35,10 @@ from __future__ import annotations
 
 import enum
 import math
+import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
@@ -453,6 +455,13 @@ class LogCheck:
         with np.errstate(all="ignore"):  # absurd values are judged, not warned about
             return self._finish()
 
+    def _is_bag(self) -> bool:
+        """Whether the log is a ROS 2 bag (its hints name --effort)."""
+        p = Path(self.path)
+        if p.suffix in (".mcap", ".db3") or p.name == "metadata.yaml":
+            return True
+        return p.is_dir() and (p / "metadata.yaml").is_file()
+
     def _finish(self) -> LogChecks:
         self._check_magnitudes()
         found = _Findings()
@@ -463,6 +472,9 @@ class LogCheck:
         self._check_ratings(found)
         self._check_constant(found, moving)
         self._check_robot(found)
+        if not self._is_bag():  # the --effort hints are for bags only
+            for texts in found.failed.values():
+                texts[:] = [_without_effort(t) for t in texts]
         accepted: list[str] = []
         for check, texts in found.failed.items():
             text = _first(texts)
@@ -889,6 +901,12 @@ def robot_match(robot: Robot, rows: dict[str, Array]) -> RobotMatch:
     return RobotMatch(
         ratios, correlations, failures, off, warnings, math.inf if math.isnan(score) else score
     )
+
+
+def _without_effort(text: str) -> str:
+    """``text`` without its hint for ROS 2 bags (``(a ROS 2 bag: --effort ...)``)."""
+    text = re.sub(r" \(a ROS 2 bag: --effort \w+\)", "", text)
+    return re.sub(r" a ROS 2 bag: --effort \w+\)", ")", text)
 
 
 def _kind_hint(robot: Robot, name: str, ratio: Array, joints: Sequence[int]) -> str:
