@@ -157,3 +157,22 @@ def test_validating_on_a_few_samples_is_a_warning(
     assert main(["-q", "validate", "ur5e", str(short)]) == 0
     err = capsys.readouterr().err
     assert "3 samples over 0.004 s: too short for these figures" in err
+
+
+def test_a_file_that_is_not_a_log_is_named_for_what_it_is(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    task = tmp_path / "task.toml"
+    task.write_text('robot = "ur5e"\n')
+    assert main(["validate", "ur5e", str(task)]) == 1
+    err = capsys.readouterr().err
+    assert f"{task}: a TOML file (a robot or task file), not a log" in err
+
+
+def test_a_yaw_range_is_shown_in_the_degrees_it_was_given(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    program = str(Path(__file__).parent / "programs" / "small.script")
+    argv = ["place", "ur5e", program, "--x", "0:0", "--y", "0:0", "--yaw", "0:720"]
+    assert main(argv) == 1
+    assert "--yaw: 0:720 reaches beyond 360 deg" in capsys.readouterr().err

@@ -121,6 +121,15 @@ def _format_of(path: Path, name: str | None) -> LogFormat:
     )
 
 
+#: files a log is not, by suffix: what they are
+_NOT_LOGS = {
+    ".toml": "a TOML file (a robot or task file)",
+    ".urdf": "a URDF model",
+    ".script": "a URScript program",
+    ".png": "an image",
+}
+
+
 def iter_log(
     path: str | os.PathLike[str],
     *,
@@ -166,6 +175,11 @@ def iter_log(
     if rows < 2:
         raise KinergyError(f"chunks of {rows} rows: need at least 2")
     path = Path(path)
+    if path.suffix.lower() in _NOT_LOGS and format is None:
+        raise KinergyError(
+            f"{path}: {_NOT_LOGS[path.suffix.lower()]}, not a log; give a log (record.py layout, "
+            "a headerless file with --columns, a ROS 2 bag, the panda-gaz layout)"
+        )
     if isinstance(columns, str):
         columns = parse_columns(columns)
     fmt = _format_of(path, format)

@@ -120,10 +120,12 @@ class PlacementGrid:
                     f"{name}: the range {r.low:g}:{r.high:g} runs backwards (MIN:MAX with MIN <= MAX)"
                 )
             if max(abs(r.low), abs(r.high)) > limit:
-                shown = f"{limit:g} {unit}" if unit == "m" else "360 deg"
-                raise KinergyError(
-                    f"{name}: {r.low:g}:{r.high:g} reaches beyond {shown} from today's base"
-                )
+                if unit == "m":
+                    given, shown = f"{r.low:g}:{r.high:g}", f"{limit:g} m"
+                else:  # the flag is in degrees
+                    given = f"{math.degrees(r.low):g}:{math.degrees(r.high):g}"
+                    shown = "360 deg"
+                raise KinergyError(f"{name}: {given} reaches beyond {shown} from today's base")
         count = self.count
         if count > MAX_CANDIDATES:
             raise KinergyError(
