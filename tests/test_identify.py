@@ -197,7 +197,11 @@ def test_a_torque_log_is_sent_to_the_method_that_can_use_it(
     kinergy.io.rtde.write_log(path, log.t, {**signals, "actual_joint_torque": log["target_moment"]})
     args = ["identify", str(path), "--robot", "ur5e", "--accept", "robot"]
     assert main([*args, "--out", str(tmp_path / "m.toml")]) == 1
-    err = [line for line in capsys.readouterr().err.splitlines() if "compiling" not in line]
+    err = [
+        line
+        for line in capsys.readouterr().err.splitlines()
+        if "preparing the dynamics" not in line
+    ]
     assert len(err) == 1 and "use --method full --target torque" in err[0]
     assert not (tmp_path / "m.toml").exists()
     full = ["--method", "full", "--target", "torque", "--out", str(tmp_path / "f.toml")]

@@ -41,8 +41,9 @@ __all__ = [
 SERIAL_ROWS = 256
 #: samples a thread takes at a time (a whole number of the kernels' lanes)
 CHUNK = 8 * _kernels.LANES
-#: the notice is printed when compiling takes longer than this, s
-_NOTICE_AFTER = 1.0
+#: the notice is printed when preparing a kernel takes longer than this, s (loading it from the
+#: cache takes well under a second, even on a loaded machine, most of the time)
+_NOTICE_AFTER = 2.0
 
 
 class Kernel(enum.Enum):
@@ -62,10 +63,11 @@ _pool: ThreadPoolExecutor | None = None
 
 
 def _with_notice(compile_one: Callable[[], None], kernel: Kernel) -> None:
-    """Run ``compile_one``, printing a notice on stderr if it takes over a second."""
+    """Run ``compile_one``, printing a notice on stderr if it takes over :data:`_NOTICE_AFTER`
+    (a compile, or a slow load from the cache: the notice says both)."""
     notice = (
-        f"kinergy: compiling the dynamics {kernel.value} kernel "
-        f"(once, about {_COMPILE_SECONDS[kernel]} s)"
+        f"kinergy: preparing the dynamics {kernel.value} kernel (compiling it takes about "
+        f"{_COMPILE_SECONDS[kernel]} s, once per install; later runs load it)"
     )
     timer = threading.Timer(_NOTICE_AFTER, lambda: print(notice, file=sys.stderr, flush=True))
     timer.daemon = True
