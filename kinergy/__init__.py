@@ -44,6 +44,7 @@ _API = {
     "EnergyReport": "kinergy.accounting.energy",
     "energy": "kinergy.api",
     "identify": "kinergy.api",
+    "identify_payload": "kinergy.api",
     "optimize_program": "kinergy.api",
     "read_log": "kinergy.api",
     "simulate": "kinergy.api",
@@ -80,6 +81,7 @@ __all__ = [
     "forward_dynamics",
     "gravity_torque",
     "identify",
+    "identify_payload",
     "inertial_parameters",
     "jacobian",
     "library_names",
@@ -99,7 +101,15 @@ __all__ = [
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from kinergy.accounting.energy import EnergyReport
-    from kinergy.api import energy, identify, optimize_program, read_log, simulate, validate
+    from kinergy.api import (
+        energy,
+        identify,
+        identify_payload,
+        optimize_program,
+        read_log,
+        simulate,
+        validate,
+    )
     from kinergy.dynamics.kinematics import flange_pose, jacobian, link_poses
     from kinergy.dynamics.regressor import (
         BaseParameters,

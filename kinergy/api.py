@@ -10,6 +10,7 @@ with its checks), ``notes`` and ``warnings``.
 ``read_log(path, columns, robot)``  a log read whole (through the plausibility checks when a
                                     robot is given)
 ``identify(logs, robot, ...)``      ``kinergy identify``: :class:`IdentificationResult`
+``identify_payload(logs, robot)``   ``kinergy identify --payload-only``: a :class:`PayloadRun`
 ``validate(model, logs, ...)``      ``kinergy validate``: :class:`ValidationReport`
 ``energy(model, log_or_motion)``    ``kinergy energy``: :class:`LogEnergy` of a log or motion
                                     file, :class:`EnergyReport` of a :class:`Motion`
@@ -47,13 +48,21 @@ from kinergy.trajectory.programs import TEST_TRAJECTORIES, paper_trajectory
 from kinergy.twin import TwinSettings
 from kinergy.twin import simulate as _simulate
 from kinergy.workflows.energy import LogEnergy, energy_of_log
-from kinergy.workflows.identify import identify_logs
+from kinergy.workflows.identify import PayloadRun, identify_logs, identify_payload_model
 from kinergy.workflows.optimize import OptimizeRun, run_optimize
 from kinergy.workflows.optimize_program import ProgramRun, run_program_optimize
 from kinergy.workflows.twin import twin_truth
 from kinergy.workflows.validate import validate_logs
 
-__all__ = ["energy", "identify", "optimize_program", "read_log", "simulate", "validate"]
+__all__ = [
+    "energy",
+    "identify",
+    "identify_payload",
+    "optimize_program",
+    "read_log",
+    "simulate",
+    "validate",
+]
 
 PathLike = str | os.PathLike[str]
 RobotLike = Robot | PathLike
@@ -165,6 +174,32 @@ def identify(
     if out is not None:
         check_replaceable(out)
     return identify_logs(r, list(logs), out, reading=reading, options=options)
+
+
+def identify_payload(
+    logs: Sequence[PathLike | Log],
+    robot: RobotLike,
+    *,
+    out: PathLike,
+    columns: str | Sequence[str] | None = None,
+    repair: bool = False,
+    cutoff: float | None = None,
+    accept: str | Sequence[str] = (),
+    topic: str | None = None,
+    effort: str | None = None,
+) -> PayloadRun:
+    """``kinergy identify --payload-only``: the payload ``robot`` (the model without it)
+    carried in ``logs``, with standard errors, written to ``out`` as the robot carrying it.
+
+    Raises
+    ------
+    KinergyError
+        A log that fails its checks, logs that do not show a payload.
+    """
+    r = _robot(robot)
+    check_replaceable(out)
+    reading = _reading(r, columns, repair, cutoff, accept, topic, effort)
+    return identify_payload_model(r, list(logs), out, reading)
 
 
 def validate(

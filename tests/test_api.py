@@ -167,3 +167,35 @@ def test_energy_repairs_a_log_cut_short_when_asked(
     out = json.loads(capsys.readouterr().out)
     api = kinergy.energy("ur5e", log, repair=True)
     assert out["samples"] == api.samples == text.count("\n") - 2
+
+
+def test_identify_payload_equals_the_command(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``kinergy.identify_payload`` is ``identify --payload-only``: the same JSON and the same
+    robot file values, on a twin log of a UR5e carrying 2 kg."""
+    import tomllib
+
+    from kinergy.io.rtde import write_log
+    from kinergy.model import Payload
+    from kinergy.trajectory.programs import paper_trajectory
+    from kinergy.twin import TwinSettings, simulate
+
+    ur5e = kinergy.load_robot("ur5e")
+    loaded = ur5e.with_payload(Payload(mass=2.0, com=[0.01, -0.02, 0.05]))
+    twin = simulate(loaded, paper_trajectory(ur5e, "test-a", dt=0.004), TwinSettings(seed=4))
+    log = tmp_path / "loaded.csv"
+    write_log(log, twin.t, twin.signals)
+    run = kinergy.identify_payload([log], "ur5e", out=tmp_path / "api.toml")
+    argv = ["identify", str(log), "--robot", "ur5e", "--payload-only", "--json"]
+    cli = _cli([*argv, "--out", str(tmp_path / "cli.toml")], capsys)
+    for record in cli["inputs"]:
+        record["path"] = str(log)
+    _same(_plain(run.to_dict()), cli)
+    assert run.payload.mass == pytest.approx(2.0, rel=0.02)
+    api, cmd = (
+        tomllib.loads((tmp_path / f).read_text())["payload"] for f in ("api.toml", "cli.toml")
+    )
+    assert api == cmd
+    with pytest.raises(kinergy.KinergyError, match="exists and kinergy did not write it"):
+        kinergy.identify_payload([log], "ur5e", out=log)

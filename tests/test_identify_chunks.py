@@ -188,13 +188,13 @@ def test_the_payload_does_not_depend_on_the_chunks(tmp_path: Path, ur5e: Robot) 
     truth = realistic_truth(ur5e, seed=3)  # the arm the twin simulated, without the payload
     whole = identify_payload(truth, prepared_logs([path], ur5e, LogReading())[0])
     chunked = identify_payload_model(truth, [path], model, rows=997)
-    for got, want in zip(chunked[1:2], whole[1:], strict=True):
+    for got, want in zip([chunked.payload], whole[1:], strict=True):
         np.testing.assert_allclose(
             [got.mass, got.mass_std, *got.com, *got.com_std],
             [want.mass, want.mass_std, *want.com, *want.com_std],
             rtol=1e-8,
         )
-    assert chunked[1].mass == pytest.approx(2.0, rel=0.02)
+    assert chunked.payload.mass == pytest.approx(2.0, rel=0.02)
 
 
 def test_friction_held_through_standstill_crosses_chunks(twin_log: Path, ur5e: Robot) -> None:

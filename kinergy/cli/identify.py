@@ -268,25 +268,15 @@ def identify(
     with progress() as say:
         if payload_only:
             say(f"reading {len(logs)} log(s) and identifying the payload")
-            _, report, inputs = identify_payload_model(r, logs, out, reading)
+            run = identify_payload_model(r, logs, out, reading)
         else:
             say(f"reading and identifying {len(logs)} log(s) ({method} method)")
             result = identify_logs(r, logs, out, reading=reading, options=options)
     if payload_only:
-        # the checks' "a payload the model lacks" is what this identifies: routine here
-        lacks = [w for w in inputs.warnings if "that the model lacks" in w]
-        notes = [*inputs.notes, *lacks, *report.notes]
-        warnings = [w for w in inputs.warnings if w not in lacks]
-        tell(notes, warnings)
-        summary = {
-            "robot": r.name,
-            "method": "payload",
-            "payload": report,
-            "inputs": inputs.records(),
-            "notes": notes,
-            "warnings": warnings,
-        }
-        click.echo(json_result(summary, inputs) if as_json else _payload_text(report, out))
+        tell(run.notes, run.warnings)
+        click.echo(
+            json_result(run.to_dict(), run.inputs) if as_json else _payload_text(run.payload, out)
+        )
         return
     tell(result.notes, result.warnings)
     click.echo(

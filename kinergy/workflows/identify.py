@@ -11,6 +11,8 @@ import dataclasses
 import datetime
 import os
 from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -30,10 +32,11 @@ from kinergy.identification.sequential import sequential
 from kinergy.io.columns import compact_columns
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
+from kinergy.jsonable import to_jsonable
 from kinergy.logs.checks import Check
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs, LogReading
-from kinergy.model import Payload, Robot, save_robot
+from kinergy.model import Robot, save_robot
 from kinergy.model.robot import Identified, InputRecord, Source
 from kinergy.predict import drive_state
 from kinergy.workflows.logs import chunked_logs
@@ -41,6 +44,7 @@ from kinergy.workflows.logs import chunked_logs
 __all__ = [
     "METHODS",
     "MIN_SECONDS",
+    "PayloadRun",
     "identify_chunks",
     "identify_logs",
     "identify_model",
@@ -302,6 +306,40 @@ def measured_electrics(result: IdentificationResult, logs: LogChunks) -> Identif
     return dataclasses.replace(result, robot=robot, fit=fit)
 
 
+@dataclass(frozen=True, eq=False)
+class PayloadRun:
+    """``identify --payload-only``: the payload found (:class:`PayloadEstimate`), the robot
+    written with it, and what the logs were. :meth:`to_dict` is the command's ``--json``
+    (without where the command came from)."""
+
+    robot: Robot
+    payload: PayloadEstimate
+    inputs: InputLogs
+
+    @property
+    def lacks(self) -> list[str]:
+        """The checks' "a payload the model lacks": what this identifies, so routine here."""
+        return [w for w in self.inputs.warnings if "that the model lacks" in w]
+
+    @property
+    def notes(self) -> list[str]:
+        return [*self.inputs.notes, *self.lacks, *self.payload.notes]
+
+    @property
+    def warnings(self) -> list[str]:
+        return [w for w in self.inputs.warnings if w not in self.lacks]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "robot": self.robot.name,
+            "method": "payload",
+            "payload": to_jsonable(self.payload),
+            "inputs": self.inputs.records(),
+            "notes": self.notes,
+            "warnings": self.warnings,
+        }
+
+
 def identify_payload_model(
     robot: Robot,
     logs: Sequence[str | os.PathLike[str] | Log],
@@ -309,7 +347,7 @@ def identify_payload_model(
     reading: LogReading | None = None,
     *,
     rows: int = CHUNK_ROWS,
-) -> tuple[Payload, PayloadEstimate, InputLogs]:
+) -> PayloadRun:
     """Identify the payload of ``robot`` (the model without it) from ``logs`` taken with it
     (read through the checks, in chunks of ``rows`` samples) and write the model with it."""
     reading = reading or LogReading()
@@ -320,5 +358,6 @@ def identify_payload_model(
         finally:
             chunks.close()
     what = f"{robot.name} with the payload identified"
-    save_robot(robot.with_payload(found), out, header=_header(what, list(chunks.paths)))
-    return found, report, inputs
+    loaded = robot.with_payload(found)
+    save_robot(loaded, out, header=_header(what, list(chunks.paths)))
+    return PayloadRun(loaded, report, inputs)
