@@ -170,8 +170,14 @@ def check_replaceable(path: PathLike) -> Path:
     if target.is_file():
         size = target.stat().st_size
         if size > 0 and not _marked(target, size):
+            if target.suffix.lower() in (".csv", ".txt", ".log"):
+                raise KinergyError(
+                    f"{target}: exists: kinergy never replaces a log, not even one it simulated "
+                    "(a log carries no mark to tell it from one recorded on a robot); give a new "
+                    "name or remove it"
+                )
             raise KinergyError(
-                f"{target}: exists and kinergy did not write it (a log, a program, a file of "
+                f"{target}: exists and kinergy did not write it (a program, a model, a file of "
                 "yours): kinergy replaces only its own outputs; give a new name or remove it"
             )
     return target

@@ -197,5 +197,5 @@ def test_identify_payload_equals_the_command(
         tomllib.loads((tmp_path / f).read_text())["payload"] for f in ("api.toml", "cli.toml")
     )
     assert api == cmd
-    with pytest.raises(kinergy.KinergyError, match="exists and kinergy did not write it"):
+    with pytest.raises(kinergy.KinergyError, match="exists: kinergy never replaces a log"):
         kinergy.identify_payload([log], "ur5e", out=log)

@@ -290,14 +290,14 @@ def test_an_existing_file_kinergy_did_not_write_is_never_replaced(
     precious.write_text("precious = true\n")
     before = log.read_bytes()
     capsys.readouterr()
-    for argv, path in (
-        (["robot", "export", "ur5e", "--format", "urdf", "--out", str(log)], log),
-        (["simulate", "ur5e", "--trajectory", "test-b", "--out", str(log)], log),
-        (["robot", "export", "ur5e", "--format", "mjcf", "--out", str(precious)], precious),
-    ):
+    for argv, words in (
+        (["robot", "export", "ur5e", "--format", "urdf", "--out", str(log)], f"{log}: exists: kinergy never replaces a log"),
+        (["simulate", "ur5e", "--trajectory", "test-b", "--out", str(log)], f"{log}: exists: kinergy never replaces a log, not even one it simulated"),
+        (["robot", "export", "ur5e", "--format", "mjcf", "--out", str(precious)], f"{precious}: exists and kinergy did not write it"),
+    ):  # fmt: skip
         assert main(argv) == 1
         err = capsys.readouterr().err
-        assert f"--out: {path}: exists and kinergy did not write it" in err and err.count("\n") == 1
+        assert f"--out: {words}" in err and err.count("\n") == 1
     assert log.read_bytes() == before and precious.read_text() == "precious = true\n"
     urdf = tmp_path / "ur5e.urdf"
     for _ in range(2):  # the second time over its own output

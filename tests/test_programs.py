@@ -150,3 +150,18 @@ def test_the_energy_of_a_program_carries_the_load_it_sets(tmp_path: Path) -> Non
     np.testing.assert_allclose(got.e_elec, loaded.e_elec, rtol=1e-12)
     np.testing.assert_allclose(got.breakdown["copper"], loaded.breakdown["copper"], rtol=1e-12)
     assert got.total_e_elec > unloaded.total_e_elec * 1.01
+
+
+def test_a_payload_the_program_overrides_before_it_moves_is_a_warning(tmp_path: Path) -> None:
+    """``--payload`` (the robot's own payload) on a program that sets its own before its first
+    move is carried by no sample: the energy says so (it was silently the same figure)."""
+    from kinergy.model import Payload
+    from kinergy.workflows.energy import energy_of_log
+
+    program = Path(__file__).parent / "programs" / "small.script"
+    robot = load_robot("ur5e")
+    bare = energy_of_log(robot, program)
+    heavy = energy_of_log(robot.with_payload(Payload(mass=8.0)), program)
+    np.testing.assert_allclose(heavy.e_elec, bare.e_elec, rtol=1e-12)
+    assert bare.warnings == []
+    assert any("sets its payload before its first move" in w for w in heavy.warnings)

@@ -25,6 +25,7 @@ from kinergy.io.rosbag import (
     effort_scale,
     match_joints,
 )
+from kinergy.logs.checks import parse_accept
 from kinergy.model import load_robot
 
 DATASETS = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "ur10e-innopolis"
@@ -501,3 +502,29 @@ def test_the_effort_hint_is_given_for_bags_only(tmp_path: Path) -> None:
     with pytest.raises(KinergyError, match=r"\(joint torques in N m logged as currents\?\)") as e:
         CheckedLog(csv, robot_of("ur10e"), LogReading()).read()
     assert "bag" not in str(e.value)
+
+
+def test_a_bag_is_the_same_log_by_its_folder_or_its_storage_file(tmp_path: Path) -> None:
+    """A bag given as its folder and again as its storage file (or metadata.yaml) is one log:
+    the same SHA-256, refused as given twice."""
+    from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
+    from kinergy.model import load_robot as robot_of
+
+    t, q, qd, effort = _motion(400)
+    bag = write_bag(tmp_path / "b", t, q, qd, 0.2 * effort)
+    (storage,) = [p for p in bag.iterdir() if p.suffix == ".mcap"]
+    shas = []
+    for path in (bag, storage, bag / "metadata.yaml"):
+        log = CheckedLog(path, robot_of("ur10e"), LogReading(accept=parse_accept(["all"])))
+        log.read()
+        assert log.provenance is not None
+        shas.append(log.provenance.sha256)
+    assert shas[0] == shas[1] == shas[2]
+    inputs = InputLogs()
+    first = CheckedLog(bag, robot_of("ur10e"), LogReading(accept=parse_accept(["all"])))
+    first.read()
+    inputs.add(first)
+    again = CheckedLog(storage, robot_of("ur10e"), LogReading(accept=parse_accept(["all"])))
+    again.read()
+    with pytest.raises(KinergyError, match="the same log as"):
+        inputs.add(again)

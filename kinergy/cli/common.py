@@ -22,6 +22,7 @@ from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_outputs, check_replaceable
 from kinergy.io.columns import parse_columns
+from kinergy.io.formats import NOT_LOGS
 from kinergy.io.rosbag import bag_options
 from kinergy.jsonable import dumps, to_jsonable
 from kinergy.logs.checks import Check, parse_accept
@@ -41,6 +42,7 @@ __all__ = [
     "fmt_vector",
     "json_result",
     "load",
+    "log_output",
     "log_reading",
     "note",
     "output_file_option",
@@ -281,6 +283,15 @@ def _given(value: Any) -> list[str]:
     if value is None:
         return []
     return [str(v) for v in value] if isinstance(value, tuple | list) else [str(value)]
+
+
+def log_output(flag: str, path: str) -> None:
+    """Refuse a log (CSV) to be written under a name that says it is something else (a robot or
+    task file, a URDF, a program, an image): ``--out model.toml`` would replace a model with a
+    log."""
+    what = NOT_LOGS.get(Path(path).suffix.lower())
+    if what is not None:
+        raise KinergyError(f"{flag} {path}: a log is written there, but the name says {what}")
 
 
 def refuse_together(*pairs: tuple[str, str, str]) -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import Finite, output_file_option, progress, writes
+from kinergy.cli.common import Finite, log_output, output_file_option, progress, writes
 from kinergy.workflows.record import record_to_file
 
 __all__ = ["record"]
@@ -37,6 +37,7 @@ def record(
     Every package is kept, with the controller's own time stamps, in UR's record.py layout plus a
     `segment` column that counts reconnections. Ctrl-C or SIGTERM stops with complete files.
     """
+    log_output("--out", out)
     with progress() as say:
         result = record_to_file(
             address,

@@ -9,6 +9,7 @@ from kinergy.cli.common import (
     accept_option,
     columns_option,
     load,
+    log_output,
     log_reading,
     output_file_option,
     payload_option,
@@ -112,6 +113,7 @@ def simulate(
         raise KinergyError(
             "--truth: only with --mismatch realistic (with none the twin's truth is ROBOT itself)"
         )
+    log_output("--out", out)
     r = load(robot_name, payload)
     reading = log_reading(r, columns=columns, accept=accept)
     if exact:

@@ -31,7 +31,7 @@ from kinergy.io.log import Log
 if TYPE_CHECKING:  # the bag options live with the bag reader, which registers itself here
     from kinergy.io.rosbag import BagOptions
 
-__all__ = ["CHUNK_ROWS", "LogFormat", "formats", "iter_log", "read_log", "register"]
+__all__ = ["CHUNK_ROWS", "NOT_LOGS", "LogFormat", "formats", "iter_log", "read_log", "register"]
 
 #: rows per chunk of :func:`iter_log`: 100 s of a 500 Hz log, about 30 MB of 40 columns
 CHUNK_ROWS = 50_000
@@ -122,7 +122,7 @@ def _format_of(path: Path, name: str | None) -> LogFormat:
 
 
 #: files a log is not, by suffix: what they are
-_NOT_LOGS = {
+NOT_LOGS = {
     ".toml": "a TOML file (a robot or task file)",
     ".urdf": "a URDF model",
     ".script": "a URScript program",
@@ -175,9 +175,9 @@ def iter_log(
     if rows < 2:
         raise KinergyError(f"chunks of {rows} rows: need at least 2")
     path = Path(path)
-    if path.suffix.lower() in _NOT_LOGS and format is None:
+    if path.suffix.lower() in NOT_LOGS and format is None:
         raise KinergyError(
-            f"{path}: {_NOT_LOGS[path.suffix.lower()]}, not a log; give a log (record.py layout, "
+            f"{path}: {NOT_LOGS[path.suffix.lower()]}, not a log; give a log (record.py layout, "
             "a headerless file with --columns, a ROS 2 bag, the panda-gaz layout)"
         )
     if isinstance(columns, str):

@@ -104,11 +104,17 @@ class Provenance:
 def _files(path: Path) -> tuple[Path, list[Path]]:
     """The files a log is and the folder their names are taken relative to: the file itself;
     the files of a panda-gaz set (its time file and the signals' files beside it), whether
-    named by its folder or its time file; every file of another folder (a rosbag2 folder), in
-    sorted order."""
+    named by its folder or its time file; a ROS 2 bag's storage files (``.mcap``, ``.db3``),
+    whether named by its folder, its ``metadata.yaml`` or a storage file; every file of another
+    folder; in sorted order."""
     if is_panda_layout(path):
         found = panda_files(path)
         return found.time.parent, sorted([found.time, *found.signals.values()])
+    folder = path.parent if path.name == "metadata.yaml" else path
+    if folder.is_dir() and (folder / "metadata.yaml").is_file():  # a ROS 2 bag: its storage
+        storage = sorted(p for p in folder.iterdir() if p.suffix in (".mcap", ".db3"))
+        if storage:
+            return folder, storage
     if path.is_dir():
         return path, sorted(p for p in path.rglob("*") if p.is_file())
     return path.parent, [path]
@@ -122,7 +128,7 @@ def _file_hash(path: Path, out: list[str], stop: threading.Event) -> None:
     try:
         base, files = _files(path)
         for part in files:
-            if len(files) > 1 or path.is_dir():
+            if len(files) > 1:  # one file is its bytes alone, however it was named
                 digest.update(part.relative_to(base).as_posix().encode() + b"\0")
             with part.open("rb") as fh:
                 while block := fh.read(1 << 20):

@@ -23,9 +23,10 @@ from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.program_motion import payload_index, program_motion
 from kinergy.trajectory.program_path import program_path
 from kinergy.trajectory.programs import paper_trajectory
+from kinergy.trajectory.robot_program import Move
 from kinergy.workflows.twin import is_builtin
 
-__all__ = ["ENERGY_ROWS", "LogEnergy", "energy_of_log", "program_energy"]
+__all__ = ["ENERGY_ROWS", "LogEnergy", "energy_of_log", "program_energy", "unused_payload"]
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -148,6 +149,23 @@ def program_energy(
     return energy(robot, motion, recovery=recovery, state=state)
 
 
+def unused_payload(robot: Robot, path: str | os.PathLike[str]) -> list[str]:
+    """A warning when the program sets its payload before it moves, so the robot's own payload
+    (``--payload`` or the robot file's) is carried by no sample of it."""
+    if robot.payload is None:
+        return []
+    steps = read_program(path).steps
+    first = next((s for s in steps if getattr(s, "kind", "") == "payload"), None)
+    moves = [s for s in steps if isinstance(s, Move)]
+    if first is None or (moves and moves[0].line < first.line):
+        return []
+    return [
+        f"{path}:{first.line}: the program sets its payload before its first move, so the "
+        f"robot's own ({robot.payload.mass:g} kg, --payload or the robot file) is carried by "
+        "none of it"
+    ]
+
+
 def energy_of_log(
     robot: Robot,
     path: str | os.PathLike[str],
@@ -177,6 +195,8 @@ def energy_of_log(
         else:
             report = program_energy(robot, path, recovery=recovery)
         said = _beyond_limits(robot, np.abs(report.drive.tau_sim).max(axis=0))
+        if not is_builtin(path):
+            said += unused_payload(robot, path)
         return _with(report.figures(), inputs, said)
     acc = EnergyAccumulator(robot, recovery=recovery)
     measured = False
