@@ -26,7 +26,7 @@ from kinergy.model.robot import Robot
 from kinergy.optimize.objectives import Objective
 from kinergy.optimize.options import ToolSymmetry
 from kinergy.optimize.path_costs import TargetStates, move_costs, refined_turns, target_states
-from kinergy.optimize.program_repair import Caps, at_cycle, repair, timing_checks
+from kinergy.optimize.program_repair import NO_ROOM, Caps, at_cycle, repair, timing_checks
 from kinergy.optimize.program_search import (
     cheapest_cycle,
     chosen_moves,
@@ -378,6 +378,7 @@ def timed(search: LeverSearch, say: Callable[[str], None]) -> None:
     try:
         result, verified = retime(checks, search.budget)
     except KinergyError as exc:  # the timing model's fastest is above the cycle time
-        search.record(Lever("timing", search.best.result, LeverStatus.NOT_POSSIBLE, note=str(exc)))
+        note = f"no room to re-time: the solver keeps {NO_ROOM}; {exc}"
+        search.record(Lever("timing", search.best.result, LeverStatus.NOT_POSSIBLE, note=note))
         return
     search.judge("timing", with_timing(path, result), verified.words)

@@ -45,6 +45,10 @@ _MARGIN = 1.005
 #: the timing solver's caps are this share below the program's: its iterations end a few ms off
 #: the cycle time, and the uniform rescaling to it must stay within the caps
 _SLACK = 0.005
+#: why the timing solver may find no timing for a program that runs within its caps as written
+NO_ROOM = (
+    f"{100 * _SLACK:g} % below the speed caps (its iterations end a few ms off the cycle time)"
+)
 
 
 @dataclass(frozen=True)

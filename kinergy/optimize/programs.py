@@ -53,7 +53,7 @@ from kinergy.optimize.program_levers import (
     via_blends,
     with_timing,
 )
-from kinergy.optimize.program_repair import Caps, timing_checks
+from kinergy.optimize.program_repair import NO_ROOM, Caps, timing_checks
 from kinergy.optimize.program_timing import retime
 from kinergy.optimize.program_verify import PathRun, TargetCheck, simulate_path, target_errors
 from kinergy.trajectory.program_path import ProgramPath, program_path
@@ -192,7 +192,7 @@ def _timing_only(search: LeverSearch, path: ProgramPath, say: Callable[[str], No
     try:
         result, verified = retime(checks, search.budget)
     except KinergyError as exc:  # the timing model's fastest is above the budget
-        note = f"the program as written, re-timed: {exc}"
+        note = f"the program as written, re-timed: no room: the solver keeps {NO_ROOM}; {exc}"
         search.record(Lever("timing only", search.best.result, LeverStatus.NOT_POSSIBLE, note=note))
         return
     none = np.zeros(path.moves, dtype=bool)
