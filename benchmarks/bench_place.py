@@ -71,7 +71,7 @@ def run(name: str, grid: PlacementGrid, via: str, maps: Path | None) -> dict[str
             "z": best.placement.z,
             "yaw": math.degrees(best.placement.yaw),
         },
-        "e_today_written": search.today.result.program.result.score,
+        "e_today_written": search.today.result.program.result.e_supply,
         "e_today": search.today.e_supply,
         "e_today_readback": result.today_readback,
         "e_best": best.e_supply,

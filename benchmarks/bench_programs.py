@@ -35,10 +35,10 @@ from typing import Any
 from kinergy.io.urscript import program_script
 from kinergy.io.urscript_reader import parse_program, read_program
 from kinergy.model.library import load_robot
+from kinergy.optimize.floor import energy_floor
 from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
-from kinergy.optimize.program_floor import energy_floor
-from kinergy.optimize.program_verify import simulate_path
 from kinergy.optimize.programs import optimize_program
+from kinergy.optimize.verify import simulate_path
 from kinergy.trajectory.program_path import program_path
 
 HERE = Path(__file__).parent / "programs"
@@ -51,6 +51,8 @@ SETTINGS = {
     "ur10e_bin_to_fixture": ("z2", "keep"),
     "ur10e_depalletising": ("z4", "free"),
     "ur10e_palletising": ("z2", "free"),
+    "ur10e_palletising_layer": ("z2", "free"),
+    "ur5e_kitting": ("z", "free"),
 }
 
 
@@ -59,7 +61,7 @@ def slow_host(factor: float) -> None:
     runs ``factor`` times fast, and every drive-model evaluation of the optimiser sleeps
     ``factor - 1`` times its own duration."""
     import kinergy.optimize.path_costs as path_costs
-    import kinergy.optimize.program_samples as program_samples
+    import kinergy.optimize.samples as samples
 
     for name in ("process_time", "perf_counter", "monotonic", "time", "thread_time"):
         real = getattr(time, name)
@@ -81,7 +83,7 @@ def slow_host(factor: float) -> None:
 
         return wrapper
 
-    for module in (path_costs, program_samples):
+    for module in (path_costs, samples):
         module.drive_by_payload = slowed(module.drive_by_payload)  # type: ignore[attr-defined]
 
 
@@ -108,7 +110,7 @@ def run(name: str, via: str) -> dict[str, Any]:
     seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     text = program_script(result.written)
     back = parse_program(text, path=f"{name}_optimized.script")
-    again = simulate_path(robot, program_path(robot, back), objective=None)
+    again = simulate_path(robot, program_path(robot, back), standby=result.settings.standby)
     own = result.program.result.score
     assert own is not None and again.result.score is not None
     opt = result.optimized.result.score

@@ -50,7 +50,6 @@ from kinergy.twin import simulate as _simulate
 from kinergy.workflows.energy import LogEnergy, energy_of_log
 from kinergy.workflows.identify import PayloadRun, identify_logs, identify_payload_model
 from kinergy.workflows.optimize import OptimizeRun, run_optimize
-from kinergy.workflows.optimize_program import ProgramRun, run_program_optimize
 from kinergy.workflows.twin import twin_truth
 from kinergy.workflows.validate import validate_logs
 
@@ -289,23 +288,26 @@ def optimize_program(
     tool_symmetry: str = "none",
     via: str = "keep",
     blends: bool = True,
+    fixed_shares: bool = False,
     standby: float | None = None,
     cycle_time: float | None = None,
     v_max: float | None = None,
     a_max: float | None = None,
+    pareto_points: int = 0,
     urscript: PathLike | None = None,
-) -> ProgramRun | OptimizeRun:
+) -> OptimizeRun:
     """``kinergy optimize``: the same job with less energy from the supply, at the same cycle
     time (``cycle_time``, s: another; None: the program's own).
 
-    ``program``: a URScript program (``*.script``: the levers ``configurations`` (``keep`` or
-    ``free``), ``tool_symmetry`` (``none``, ``z``, ``z2``, ``z4``), ``via`` (``keep`` or
-    ``free``), ``blends`` and the timing, judged by the supply energy with ``standby`` W; a
-    :class:`~kinergy.workflows.optimize_program.ProgramRun`), or a task file or built-in task
-    (``"test-a"``, ``"test-b"``: the timing only; an
-    :class:`~kinergy.workflows.optimize.OptimizeRun`). ``v_max`` (rad/s) and ``a_max``
-    (rad/s²) cap every joint (None: a program's own peaks; a task: the robot's limits).
-    ``urscript``: write the optimised program there.
+    ``program``: a URScript program (``*.script``), a task file or a built-in task
+    (``"test-a"``, ``"test-b"``), all one program type through the same levers:
+    ``configurations`` (``keep`` or ``free``), ``tool_symmetry`` (``none``, ``z``, ``z2``,
+    ``z4``), ``via`` (``keep`` or ``free``), ``blends`` and the timing (``fixed_shares``: each
+    move keeps its share of the cycle time), judged by the supply energy with ``standby`` W (None:
+    the robot file's standing draw). ``v_max`` (rad/s) and ``a_max`` (rad/s²) cap every joint
+    (None: the program's own peaks). ``pareto_points``: the Pareto front at that many cycle
+    times (0: none). ``urscript``: write the optimised program there. Returns an
+    :class:`~kinergy.workflows.optimize.OptimizeRun`.
 
     Raises
     ------
@@ -315,31 +317,15 @@ def optimize_program(
     r = _robot(model)
     if urscript is not None:
         check_replaceable(urscript)
-    if os.fspath(program).endswith(".script"):
-        options = ProgramOptions(
-            configurations=Configurations.parse(configurations),
-            tool_symmetry=ToolSymmetry.parse(tool_symmetry),
-            via=ViaPoints.parse(via),
-            blends=blends,
-            standby=standby,
-            cycle_time=cycle_time,
-            v_max=v_max,
-            a_max=a_max,
-        )
-        return run_program_optimize(r, program, urscript=urscript, options=options)
-    levers = {
-        "configurations": configurations != "keep",
-        "tool_symmetry": tool_symmetry != "none",
-        "via": via != "keep",
-        "blends": not blends,
-        "standby": standby is not None,
-    }
-    for name, given in levers.items():
-        if given:
-            raise KinergyError(
-                f"{name}: only for a URScript program (*.script); {program} is a task, whose "
-                "timing alone is optimised"
-            )
-    return run_optimize(
-        r, program, cycle_time=cycle_time, v_max=v_max, a_max=a_max, points=0, urscript=urscript
+    options = ProgramOptions(
+        configurations=Configurations.parse(configurations),
+        tool_symmetry=ToolSymmetry.parse(tool_symmetry),
+        via=ViaPoints.parse(via),
+        blends=blends,
+        fixed_shares=fixed_shares,
+        standby=standby,
+        cycle_time=cycle_time,
+        v_max=v_max,
+        a_max=a_max,
     )
+    return run_optimize(r, program, options=options, points=pareto_points, urscript=urscript)

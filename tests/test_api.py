@@ -117,11 +117,11 @@ def test_optimize_program_equals_the_command(
     api["written"], cli["written"] = [], []
     _same(api, cli)
     assert (tmp_path / "a.script").read_text() == (tmp_path / "c.script").read_text()
-    task = kinergy.optimize_program("ur5e", "test-a")
-    cli = _cli(["optimize", "ur5e", "test-a", "--pareto-points", "0", "--json"], capsys)
+    task = kinergy.optimize_program("ur5e", "test-a", blends=False)
+    cli = _cli(["optimize", "ur5e", "test-a", "--no-blends", "--json"], capsys)
     cli.pop("inputs")
     api = _plain(task.to_dict())
-    api["solver"].pop("seconds"), cli["solver"].pop("seconds")  # wall time
+    api["written"], cli["written"] = [], []
     _same(api, cli)
     with pytest.raises(kinergy.KinergyError, match="tool symmetry: expected one of none, z"):
         kinergy.optimize_program("ur5e", small, tool_symmetry="z3")
@@ -132,24 +132,21 @@ def test_a_wrong_option_is_one_kinergy_error_naming_it() -> None:
         kinergy.identify(["x.csv"], "ur5e", method="payload")
     with pytest.raises(kinergy.KinergyError, match=r"target='voltage': not one of"):
         kinergy.identify(["x.csv"], "ur5e", method="full", target="voltage")
-    with pytest.raises(kinergy.KinergyError, match=r"via: only for a URScript program"):
-        kinergy.optimize_program("ur5e", "test-a", via="free")
+    with pytest.raises(kinergy.KinergyError, match=r"via points: expected keep or free"):
+        kinergy.optimize_program("ur5e", "test-a", via="open")
 
 
-def test_an_option_the_kind_of_task_does_not_take_is_refused(
+def test_a_task_and_a_urscript_program_take_the_same_options(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """``optimize`` of a task takes no lever of a URScript program, and of a program no Pareto
-    front: given, it is refused in one line naming the flag (it was left unused)."""
+    """A task is a movej program: the levers and the Pareto front are taken for either kind (no
+    option is refused for the kind of program); a plot without a front is refused."""
     small = str(Path(__file__).parent / "programs" / "small.script")
-    for argv, flag in (
-        (["optimize", "ur5e", "test-a", "--via", "free"], "--via"),
-        (["optimize", "ur5e", "test-a", "--tool-symmetry", "z"], "--tool-symmetry"),
-        (["optimize", "ur5e", small, "--pareto-points", "3"], "--pareto-points"),
-    ):
-        assert main(argv) == 1
-        err = capsys.readouterr().err
-        assert err.startswith(f"kinergy: error: {flag}: only for a") and err.count("\n") == 1
+    assert main(["optimize", "ur5e", small, "--pareto-points", "0", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["pareto"] == []
+    assert main(["optimize", "ur5e", "test-b", "--plot", "p.png", "--pareto-points", "0"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("kinergy: error: --plot: needs a Pareto front") and err.count("\n") == 1
 
 
 def test_energy_repairs_a_log_cut_short_when_asked(

@@ -49,7 +49,7 @@ def test_demo_writes_a_report_whose_images_all_exist(demo_run) -> None:
 def test_demo_prints_the_five_tables_with_comparisons(demo_run) -> None:
     _out, (tables, _report, _seconds) = demo_run
     assert {"IV", "V", "VI", "VII", "VIII", "timing"} <= set(tables)
-    program, _uniform, optimised = tables["timing"][0].rows
+    program, optimised = tables["timing"][0].rows
     assert float(optimised[2]) < float(program[2]) and optimised[-1] == "yes"
     assert "twin J_m (Table IV)" in tables["IV"][0].headers
     assert [t.caption[-6:] for t in tables["VII"]] == ["test A", "test B"]

@@ -104,7 +104,7 @@ def test_the_task_file_example_loads(tmp_path: Path) -> None:
     path = tmp_path / "task.toml"
     path.write_text(_example("files.md", "task"), encoding="utf-8")
     task = load_task(path, robot=load_robot("ur5e"))
-    assert np.degrees(task.waypoints[1]).tolist() == pytest.approx([10, -80, 30, -90, 0, 0])
+    assert np.degrees(task.moves[0].target).tolist() == pytest.approx([10, -80, 30, -90, 0, 0])
 
 
 def test_the_fleet_manifest_example_reads(tmp_path: Path) -> None:

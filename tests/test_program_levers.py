@@ -11,17 +11,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import kinergy.optimize.program_samples as program_samples
+import kinergy.optimize.samples as samples_module
 from kinergy.errors import KinergyError
 from kinergy.io.urscript import program_script
 from kinergy.io.urscript_reader import parse_program
 from kinergy.model.library import load_robot
 from kinergy.optimize.objectives import SupplyEnergy
 from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
-from kinergy.optimize.program_repair import Caps, at_cycle, repair
-from kinergy.optimize.program_verify import simulate_path
+from kinergy.optimize.problem import Caps, path_checks
 from kinergy.optimize.programs import optimize_program
+from kinergy.optimize.repair import Context, at_cycle, repair
 from kinergy.optimize.solve import Outcome
+from kinergy.optimize.verify import simulate_path
 from kinergy.trajectory.program_path import program_path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -49,7 +50,7 @@ def test_the_same_program_on_a_host_a_thousand_times_slower(
         real = getattr(time, name)
         start = real()
         monkeypatch.setattr(time, name, lambda r=real, s=start: s + 1000.0 * (r() - s))
-    drive = program_samples.drive_by_payload
+    drive = samples_module.drive_by_payload
     sleep = time.sleep
     calls = []
 
@@ -58,7 +59,7 @@ def test_the_same_program_on_a_host_a_thousand_times_slower(
         sleep(0.002)
         return drive(*args, **kwargs)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(program_samples, "drive_by_payload", slow)
+    monkeypatch.setattr(samples_module, "drive_by_payload", slow)
     slowed = _small()
     assert len(calls) > 20  # the slowdown was in the path
     assert slowed == fast
@@ -95,7 +96,6 @@ def test_solver_outcomes_are_typed_and_worded_without_jargon() -> None:
     [
         *sorted((ROOT / "kinergy" / "optimize").glob("*.py")),
         ROOT / "kinergy" / "workflows" / "optimize.py",
-        ROOT / "kinergy" / "workflows" / "optimize_program.py",
         ROOT / "kinergy" / "workflows" / "place.py",
         ROOT / "kinergy" / "cli" / "optimize.py",
         ROOT / "kinergy" / "cli" / "place.py",
@@ -130,9 +130,10 @@ def test_a_run_over_the_caps_is_repaired_at_the_same_cycle_time() -> None:
     )
     budget = own.result.cycle_time
     objective = SupplyEnergy()
-    first = at_cycle(robot, path, budget, objective, caps, "first")
+    ctx = Context(robot, budget, objective, caps, 0.0)
+    first = at_cycle(ctx, path, "first")
     assert not first.result.ok
-    fixed = repair(robot, first, budget, objective, caps)
+    fixed = repair(ctx, first)
     assert fixed is not None and fixed.how in ("per move", "re-timed")
     assert fixed.run.result.ok
     assert fixed.run.result.cycle_time == pytest.approx(budget, abs=2e-3)
@@ -233,7 +234,7 @@ def test_the_budget_shared_per_move_is_the_brute_force_optimum() -> None:
     step, where a combination fits it), at the least energy."""
     import itertools
 
-    from kinergy.optimize import program_timing
+    from kinergy.optimize import timing as program_timing
 
     rng = np.random.default_rng(7)
     total = 3.2
@@ -274,14 +275,13 @@ def test_straight_lines_from_tables_match_the_inverse_kinematics() -> None:
 
 
 def test_the_timing_solver_starts_from_the_better_start_and_keeps_the_cycle_time() -> None:
-    from kinergy.optimize.program_repair import timing_checks
-    from kinergy.optimize.program_timing import allocated, retime
+    from kinergy.optimize.timing import allocated, retime
 
     robot = load_robot("ur5e")
     path = program_path(robot, parse_program(SMALL, path="small.script"))
     own = simulate_path(robot, path)
     caps = Caps(float(np.max(np.abs(own.motion.qd))), float(np.max(np.abs(own.motion.qdd))))
-    checks = timing_checks(robot, path, SupplyEnergy(), caps)
+    checks = path_checks(robot, path, SupplyEnergy(), caps)
     budget = own.result.cycle_time
     shared = allocated(checks, budget)
     assert shared is not None
@@ -317,7 +317,7 @@ def test_blends_go_only_between_joint_moves_so_straight_lines_stay_whole() -> No
     movel: the approach and the retreat of a pick stay straight in the 500 Hz simulation of the
     optimised program (the tool within 0.1 mm of each line)."""
     from kinergy.dynamics.poses import tcp_pose
-    from kinergy.optimize.program_levers import via_blends
+    from kinergy.optimize.levers import via_blends
     from kinergy.trajectory.program_motion import program_motion
     from kinergy.trajectory.robot_program import Move
 
@@ -363,7 +363,7 @@ def test_no_lever_buys_its_saving_with_a_longer_cycle() -> None:
     """A program at its own limits leaves no room: a lever whose program holds the limits only
     when it takes longer is not kept, and the timing reports itself not possible (it claimed
     17.8 % by taking 2.774 s for a 2.390 s cycle)."""
-    from kinergy.optimize.program_levers import CYCLE_TOLERANCE, LeverStatus
+    from kinergy.optimize.levers import CYCLE_TOLERANCE, LeverStatus
 
     robot = load_robot("ur5e")
     text = "movej([0,-1.57,0,-1.57,0,0], a=1.4, v=1.05)\nmovej([0.5,-1.2,0.3,-1.57,0,0], a=1.4, v=1.05)\n"

@@ -13,7 +13,7 @@ from click.testing import CliRunner
 from kinergy.cli.optimize import optimize
 from kinergy.io.rtde import read_log
 from kinergy.model.library import load_robot
-from kinergy.optimize.program_search import cheapest_cycle
+from kinergy.optimize.search import cheapest_cycle
 from kinergy.workflows.logs import read_motion
 
 SMALL = (Path(__file__).parent / "programs" / "small.script").read_text()
@@ -113,8 +113,8 @@ def test_refined_turns_keep_the_own_state_and_wrap() -> None:
 
 def test_energy_floor_is_below_the_friction_of_the_program() -> None:
     from kinergy.io.urscript_reader import parse_program
-    from kinergy.optimize.program_floor import energy_floor
-    from kinergy.optimize.program_verify import simulate_path
+    from kinergy.optimize.floor import energy_floor
+    from kinergy.optimize.verify import simulate_path
     from kinergy.trajectory.program_path import program_path
 
     robot = load_robot("ur5e")

@@ -1,8 +1,10 @@
-"""``kinergy optimize``: energy-optimal speeds and accelerations of a movej program.
+"""``kinergy optimize``: a robot program (a URScript program or a task) doing the same job with
+less energy at a cycle time.
 
-Parses the options, runs :func:`kinergy.workflows.optimize.run_optimize` (the optimum at a
-cycle time against the program as written and uniform time scaling, all re-simulated at 500 Hz,
-the Pareto front, the URScript and plot files) and prints its result as text or JSON.
+Parses the options into :class:`~kinergy.optimize.options.ProgramOptions`, runs
+:func:`kinergy.workflows.optimize.run_optimize` (the levers and the timing, all re-simulated at
+500 Hz, the Pareto front where asked, the URScript, plot and motion files) and prints its result
+as text or JSON.
 """
 
 from __future__ import annotations
@@ -15,7 +17,6 @@ import click
 
 from kinergy.cli.common import (
     Finite,
-    flag_of,
     json_result,
     load,
     output_file_option,
@@ -26,23 +27,23 @@ from kinergy.cli.common import (
     writes,
 )
 from kinergy.errors import KinergyError
-from kinergy.optimize import ParetoPoint, ProgramResult, TimingResult
+from kinergy.optimize import ParetoPoint, ProgramResult
+from kinergy.optimize.levers import Lever
 from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
-from kinergy.optimize.programs import Lever, supply
 from kinergy.workflows.optimize import OptimizeRun, run_optimize
-from kinergy.workflows.optimize_program import ProgramRun, run_program_optimize
 
-__all__ = ["lever_options", "optimize", "optimize_text", "program_options", "program_text"]
+__all__ = ["lever_options", "optimize", "optimize_text", "program_options"]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-_PARTS = ("friction", "copper", "inertial", "gravity")
 #: the longest cycle time optimised, s (each is re-simulated at 500 Hz, Pareto points and all)
 MAX_CYCLE_TIME = 600.0
 #: the smallest and largest speed (rad/s) and acceleration (rad/s^2) caps taken (below 1e-3,
 #: 0.06 deg/s, a move takes longer than any cycle-time budget and its profile underflows)
 _MIN_CAP = 1e-3
 _MAX_CAP = {"--v-max": 100.0, "--a-max": 1e4}
+#: Pareto points when --plot asks for the front and --pareto-points does not say how many
+_PLOT_POINTS = 8
 
 
 def _cycle_time(text: str) -> float | None:
@@ -85,56 +86,14 @@ def _moves_table(prog: ProgramResult, opt: ProgramResult) -> str:
         ]
         for k in range(prog.speeds.size)
     ]
-    headers = ["move", "v [rad/s]", "a [rad/s^2]", "t [s]", "E [J]", "v opt", "a opt", "t opt"]
+    headers = ["move", "v", "a", "t [s]", "E [J]", "v opt", "a opt", "t opt"]
     return table([*headers, "E opt"], rows)
 
 
-def _totals_table(result: TimingResult) -> str:
-    """Per program (as written, uniform scaling, optimum): cycle time, energy and its parts,
-    and whether it keeps the limits."""
-    rows = [
-        [
-            label,
-            f"{p.cycle_time:.3f}",
-            f"{p.e_elec:.1f}",
-            *(f"{p.breakdown[k]:.1f}" for k in _PARTS),
-            "yes" if p.ok else "NO: " + "; ".join(p.check.violations()),
-        ]
-        for label, p in (
-            ("program as written", result.program),
-            ("uniform scaling", result.uniform),
-            ("optimized", result.optimized),
-        )
-    ]
-    headers = ["", "cycle [s]", "E_elec [J]", *(f"{k} [J]" for k in _PARTS), "within limits"]
-    return table(headers, rows)
-
-
-def _summary(result: TimingResult) -> list[str]:
-    """The saving, the active limits, how close the optimum comes to each, the solver."""
-    opt = result.optimized
-    saving = (
-        f"saving: {100 * result.saving:.1f} % of E_elec against the program as written, "
-        f"{100 * result.saving_vs_uniform:.1f} % against uniform scaling (E_elec: the motors' "
-        "electrical energy with braking returned to the bus, UR5e eq 25; what the arm draws from "
-        "its supply, braking burnt in the shunt: kinergy energy of the written program)"
-    )
-    if opt.predicted is not None:
-        saving += f" (predicted by the optimiser {opt.predicted:.1f} J)"
-    closest = ", ".join(
-        f"{kind} {100 * ratio:.1f} % ({joint})"
-        for kind, (ratio, joint, _) in opt.check.worst().items()
-    )
-    return [
-        saving,
-        "active limits: " + "; ".join(result.active),
-        "closest to a limit: " + closest,
-        f"solver: {result.message} ({result.iterations} iterations, {result.seconds:.2f} s)",
-    ]
-
-
 def _pareto_table(front: Sequence[ParetoPoint]) -> str:
-    def energy(value: float, ok: bool) -> str:
+    def energy(value: float | None, ok: bool) -> str:
+        if value is None:
+            return "cannot run"
         return f"{value:.1f}" + ("" if ok else " (over a limit)")
 
     rows = [
@@ -148,34 +107,12 @@ def _pareto_table(front: Sequence[ParetoPoint]) -> str:
     return table(["cycle [s]", "optimized [J]", "uniform [J]"], rows)
 
 
-def optimize_text(run: OptimizeRun) -> str:
-    """The ``optimize`` report: per move, the totals, the saving and limits, the Pareto front."""
-    result, task = run.result, run.task
-    lines = [
-        f"{run.robot.name}, task {task.name}: {task.moves} moves, cycle time "
-        f"{result.cycle_time:.3f} s (program as written {result.program.cycle_time:.3f} s, "
-        f"fastest feasible {result.fastest_cycle_time:.3f} s)",
-        "",
-        "Per move: the program as written and the optimum (energies re-simulated at 500 Hz)",
-        _moves_table(result.program, result.optimized),
-        "",
-        f"Totals at a cycle time of {result.cycle_time:.3f} s",
-        _totals_table(result),
-        "",
-        *_summary(result),
-    ]
-    if run.front:
-        lines += ["", "Pareto front: energy against cycle time (re-simulated at 500 Hz)"]
-        lines.append(_pareto_table(run.front))
-    return "\n".join(lines)
-
-
 def _levers_table(levers: Sequence[Lever]) -> str:
     rows = [
         [
             lv.name,
             f"{lv.result.cycle_time:.3f}",
-            f"{supply(lv.result):.1f}",
+            f"{lv.result.e_supply:.1f}",
             f"{lv.result.e_elec:.1f}",
             "yes" if lv.result.ok else "NO",
             "" if lv.name == "program" else f"{lv.saved:+.1f}",
@@ -188,8 +125,34 @@ def _levers_table(levers: Sequence[Lever]) -> str:
     return table([*headers, "used", "note"], rows)
 
 
-def program_text(run: ProgramRun) -> str:
-    """The ``optimize`` report of a URScript program: per move, per lever, the targets."""
+def _saving(run: OptimizeRun) -> list[str]:
+    """The saving against the supply and against the motors, the read-back, the solver."""
+    result = run.result
+    own, opt = result.program.result, result.optimized.result
+    lines = [
+        f"Saving: {100 * result.saving_supply:.1f} % of what the arm draws from its supply per "
+        f"cycle ({own.e_supply:.1f} J -> {opt.e_supply:.1f} J: the motors on the DC bus, braking "
+        f"lost in the shunt, plus the standing draw of {result.settings.standby:g} W over the "
+        f"cycle); {100 * result.saving_motors:.1f} % of the motors' energy alone "
+        f"({own.e_elec:.1f} J -> {opt.e_elec:.1f} J); model-predicted",
+        f"The written program read back and simulated again: {run.readback:.1f} J "
+        f"({100 * (run.readback / opt.e_supply - 1.0):+.2f} %)",
+    ]
+    if result.timing is not None:
+        lines.append(
+            f"Timing solver: {result.timing.words} ({result.timing.iterations} iterations); "
+            "active limits: " + "; ".join(result.timing.active)
+        )
+    closest = ", ".join(
+        f"{kind} {100 * ratio:.1f} % ({joint})"
+        for kind, (ratio, joint, _) in opt.check.worst().items()
+    )
+    lines.append("Closest to a limit: " + closest)
+    return lines
+
+
+def optimize_text(run: OptimizeRun) -> str:
+    """The ``optimize`` report: per move, per lever, the saving, the targets, the Pareto front."""
     result = run.result
     own, opt = result.program.result, result.optimized.result
     name = result.program.path.program.name
@@ -198,22 +161,26 @@ def program_text(run: ProgramRun) -> str:
         f"{run.robot.name}, program {name}: {own.speeds.size} moves, cycle time "
         f"{opt.cycle_time:.3f} s (program as written {own.cycle_time:.3f} s)",
         "",
-        "Per move: the program as written and the optimum (energies re-simulated at 500 Hz)",
+        "Per move: the program as written and the optimum (v and a in the move's units: rad/s "
+        "and rad/s^2 for a movej, m/s and m/s^2 along a line; energies re-simulated at 500 Hz)",
         _moves_table(own, opt),
         "",
         "Levers, each on the program before it, at the cycle time (supply energy: motors on the "
-        "DC bus, braking surplus lost, plus standby; model-predicted)",
+        "DC bus, braking surplus lost, plus the standing draw; model-predicted)",
         _levers_table(result.levers),
         "",
-        f"Saving: {100 * result.saving:.1f} % of the supply energy ({supply(own):.1f} J -> "
-        f"{supply(opt):.1f} J); the written program read back and simulated again: "
-        f"{run.readback:.1f} J ({100 * (run.readback / supply(opt) - 1.0):+.2f} %)",
-        f"Targets: {len(stops)} stops, worst {1e3 * max(c.distance for c in stops):.3f} mm, "
-        f"{math.degrees(max(c.angle for c in stops)):.3f} deg, joint speed "
-        f"{max(c.speed for c in stops):.2g} rad/s; "
-        + ("all met" if result.targets_met else "NOT all met (1 mm, 0.5 deg, at rest)"),
-        f"Within limits: {'yes' if opt.ok else 'NO: ' + '; '.join(opt.check.violations())}",
+        *_saving(run),
     ]
+    if stops:
+        lines.append(
+            f"Targets: {len(stops)} stops, worst {1e3 * max(c.distance for c in stops):.3f} mm, "
+            f"{math.degrees(max(c.angle for c in stops)):.3f} deg, joint speed "
+            f"{max(c.speed for c in stops):.2g} rad/s; "
+            + ("all met" if result.targets_met else "NOT all met (1 mm, 0.5 deg, at rest)")
+        )
+    lines.append(
+        f"Within limits: {'yes' if opt.ok else 'NO: ' + '; '.join(opt.check.violations())}"
+    )
     left = [str(c.line) for c in result.targets if c.left_out]
     if left:
         lines.append(
@@ -221,11 +188,15 @@ def program_text(run: ProgramRun) -> str:
             f"{', '.join(left)} now take the joints of the target before them"
         )
     lines += [f"note: {n}" for n in run.notes]
-    return "\n".join(line if "\n" in line else prose(line) for line in lines)
+    out = [line if "\n" in line else prose(line) for line in lines]
+    if result.pareto:
+        out += ["", "Pareto front: supply energy against cycle time (re-simulated at 500 Hz)"]
+        out.append(_pareto_table(result.pareto))
+    return "\n".join(out)
 
 
 def lever_options(prefix: str = "") -> Callable[[F], F]:
-    """The levers of a URScript program's optimisation as options (``prefix`` starts each help
+    """The levers of a program's optimisation as options (``prefix`` starts each help
     text): --configurations, --tool-symmetry, --via, --no-blends, --standby."""
 
     def said(text: str) -> str:
@@ -275,33 +246,6 @@ def lever_options(prefix: str = "") -> Callable[[F], F]:
     return decorate
 
 
-#: the options only a URScript program takes, and those only a task takes (the Pareto front)
-PROGRAM_ONLY = ("configurations", "tool_symmetry", "via", "no_blends", "standby", "motions")
-TASK_ONLY = ("points", "fixed_shares", "plot")
-#: the values of those options that ask for nothing (--pareto-points 0: no front)
-NEUTRAL: dict[str, object] = {"points": 0}
-
-
-def _for_its_kind(task: str) -> None:
-    """Refuse, in one line, an option given on the command line that the kind of TASK does not
-    take (it would be left unused; a value that asks for nothing, :data:`NEUTRAL`, passes)."""
-    ctx = click.get_current_context()
-    script = task.endswith(".script")
-    for name in TASK_ONLY if script else PROGRAM_ONLY:
-        unused = ctx.params[name] != NEUTRAL.get(name, object())
-        if ctx.get_parameter_source(name) is click.core.ParameterSource.COMMANDLINE and unused:
-            flag = flag_of(ctx.command, name)
-            if script:
-                raise KinergyError(
-                    f"{flag}: only for a task (the Pareto front of its timing); {task} is a "
-                    "URScript program"
-                )
-            raise KinergyError(
-                f"{flag}: only for a URScript program (*.script); {task} is a task, whose "
-                "timing alone is optimised"
-            )
-
-
 def program_options(
     *,
     configurations: str,
@@ -312,9 +256,10 @@ def program_options(
     cycle_time: str,
     v_max: float | None,
     a_max: float | None,
+    fixed_shares: bool = False,
 ) -> ProgramOptions:
-    """The options of a URScript program's optimisation, parsed once into their types (one
-    line naming the flag for a bad value)."""
+    """The options of a program's optimisation, parsed once into their types (one line naming
+    the flag for a bad value)."""
     _cap("--v-max", v_max)
     _cap("--a-max", a_max)
     return ProgramOptions(
@@ -322,6 +267,7 @@ def program_options(
         tool_symmetry=ToolSymmetry.parse(tool_symmetry),
         via=ViaPoints.parse(via),
         blends=not no_blends,
+        fixed_shares=fixed_shares,
         standby=standby,
         cycle_time=_cycle_time(cycle_time),
         v_max=v_max,
@@ -331,7 +277,7 @@ def program_options(
 
 @click.command()
 @click.argument("model", metavar="MODEL")
-@click.argument("task_name", metavar="TASK")
+@click.argument("task_name", metavar="PROGRAM")
 @click.option(
     "--cycle-time",
     "cycle_time",
@@ -344,43 +290,48 @@ def program_options(
 @output_file_option(
     "--urscript",
     "Write the optimised program as URScript to this file (a URScript program: as written, "
-    "your names and comments kept; a task: movej per move).",
+    "your names and comments kept; a task: one movej per move).",
 )
 @output_file_option(
-    "--plot", "Write the Pareto plot (energy against cycle time) to this PNG.", metavar="FILE.png"
+    "--plot",
+    "Write the Pareto plot (supply energy against cycle time) to this PNG.",
+    metavar="FILE.png",
 )
 @payload_option
 @click.option(
-    "--v-max", "v_max", type=Finite(), default=None, help="Cap on every joint's speed, rad/s."
+    "--v-max",
+    "v_max",
+    type=Finite(),
+    default=None,
+    help="Cap on every joint's speed, rad/s [default: the program's own peak].",
 )
 @click.option(
     "--a-max",
     "a_max",
     type=Finite(),
     default=None,
-    help="Cap on every joint's acceleration, rad/s^2 [default: the model's limits; a UR model "
-    "has none, so the torque limits bound it].",
+    help="Cap on every joint's acceleration, rad/s^2 [default: the program's own peak].",
 )
 @click.option(
     "--pareto-points",
     "points",
     type=click.IntRange(0, 50),
-    default=8,
-    show_default=True,
-    help="Cycle times on the Pareto front (0: none).",
+    default=None,
+    help=f"Cycle times on the Pareto front (0: none) [default: {_PLOT_POINTS} with --plot, "
+    "else 0].",
 )
 @click.option(
     "--fixed-shares",
     is_flag=True,
     help="Keep each move's share of the cycle time; choose only speeds and accelerations.",
 )
-@lever_options("URScript programs: ")
+@lever_options()
 @click.option(
     "--motions",
     type=click.Path(file_okay=False),
     default=None,
     metavar="DIR",
-    help="URScript programs: write program.csv and optimized.csv (500 Hz) to this folder.",
+    help="Write program.csv and optimized.csv (500 Hz) to this folder.",
 )
 @writes(files=("urscript", "plot"), into=("motions",), inputs=("model", "task_name"))
 def optimize(
@@ -393,7 +344,7 @@ def optimize(
     payload: str | None,
     v_max: float | None,
     a_max: float | None,
-    points: int,
+    points: int | None,
     fixed_shares: bool,
     configurations: str,
     tool_symmetry: str,
@@ -402,66 +353,40 @@ def optimize(
     standby: float | None,
     motions: str | None,
 ) -> None:
-    """Energy-optimal speeds and accelerations of a movej program at a cycle time.
+    """A program doing the same job with less energy at the same cycle time.
 
-    MODEL is a built-in robot or a model file; TASK a task file (TOML: the movej's waypoints),
-    test-a / test-b (the UR5e doc's test programs), or a URScript program (*.script: its path
-    as well, with the levers --configurations, --tool-symmetry, --via and blends). Compares the
-    optimum with the program as written and with uniform time scaling to the same cycle time,
-    all re-simulated at 500 Hz with every speed, acceleration, torque and position limit
-    checked at every sample.
+    MODEL is a built-in robot or a model file; PROGRAM a URScript program (*.script), a task
+    file (TOML: a movej program's joint targets) or test-a / test-b (the UR5e doc's test
+    programs). Every lever (2 pi wraps, --configurations, --tool-symmetry, --via, blends,
+    timing) is judged by the supply energy the model predicts (the motors on the DC bus,
+    braking lost in the shunt, plus the arm's standing draw), re-simulated at 500 Hz with every
+    speed, acceleration, torque and position limit checked at every sample, and kept only when
+    it saves energy.
     """
-    budget = _cycle_time(cycle_time)
-    _cap("--v-max", v_max)
-    _cap("--a-max", a_max)
-    _for_its_kind(task_name)
-    if task_name.endswith(".script"):
-        options = program_options(
-            configurations=configurations,
-            tool_symmetry=tool_symmetry,
-            via=via,
-            no_blends=no_blends,
-            standby=standby,
-            cycle_time=cycle_time,
-            v_max=v_max,
-            a_max=a_max,
-        )
-        with progress() as say:
-            program = run_program_optimize(
-                load(model, payload),
-                task_name,
-                urscript=urscript,
-                motions=motions,
-                options=options,
-                progress=say,
-            )
-        click.echo(json_result(program.to_dict()) if as_json else program_text(program))
-        if not as_json:
-            for path in program.written:
-                click.echo(f"wrote {path}")
-        return
-    if plot is not None and points < 2:
-        raise KinergyError("--plot: needs a Pareto front (--pareto-points of at least 2)")
-    robot = load(model, payload)
+    options = program_options(
+        configurations=configurations,
+        tool_symmetry=tool_symmetry,
+        via=via,
+        no_blends=no_blends,
+        standby=standby,
+        cycle_time=cycle_time,
+        v_max=v_max,
+        a_max=a_max,
+        fixed_shares=fixed_shares,
+    )
+    count = (_PLOT_POINTS if plot is not None else 0) if points is None else points
     with progress() as say:
-        say(
-            f"optimising the timing of {task_name}"
-            + (f" and {points} Pareto points" if points else "")
-        )
         run = run_optimize(
-            robot,
+            load(model, payload),
             task_name,
-            cycle_time=budget,
-            v_max=v_max,
-            a_max=a_max,
-            points=points,
-            share_budget=not fixed_shares,
+            options=options,
+            points=count,
             urscript=urscript,
+            motions=motions,
             plot=plot,
+            progress=say,
         )
-    if as_json:
-        click.echo(json_result(run.to_dict()))
-        return
-    click.echo(optimize_text(run))
-    for path in run.written:
-        click.echo(f"wrote {path}")
+    click.echo(json_result(run.to_dict()) if as_json else optimize_text(run))
+    if not as_json:
+        for path in run.written:
+            click.echo(f"wrote {path}")

@@ -53,6 +53,10 @@ def parse_range(text: str | None, flag: str, unit: str, scale: float = 1.0) -> R
     return Range(low * scale, high * scale)
 
 
+def _percent(x: float | None) -> str:
+    return "-" if x is None else f"{100 * x:.1f} %"
+
+
 def _energy(c: Candidate) -> str:
     return f"{c.e_supply:.1f}" if c.e_supply is not None else "-"
 
@@ -91,14 +95,17 @@ def place_text(run: PlaceRun) -> str:
         *(["", "not reachable:", *why] if why else []),
         "",
         prose(
-            f"today's placement: {today.result.program.result.score:.1f} J as written, "
-            f"{_energy(today)} J optimised ({100 * today.result.saving:.1f} % by the levers); "
-            f"its optimised program read back: {run.today_readback:.1f} J",
+            f"today's placement: {today.result.program.result.e_supply:.1f} J as written, "
+            f"{_energy(today)} J optimised ({100 * today.result.saving_supply:.1f} % of the supply "
+            f"energy by the levers, {100 * today.result.saving_motors:.1f} % of the motors'); its "
+            f"optimised program read back: {run.today_readback:.1f} J",
         ),
         prose(
             f"best placement: {best.placement.label()}: {_energy(best)} J optimised; its "
             f"written program read back and simulated again: {run.readback:.1f} J, "
-            f"{100 * run.saving:.1f} % less than today's placement beyond the program levers",
+            f"{100 * run.saving:.1f} % less than today's placement beyond the program levers "
+            f"(supply energy: the motors and the standing draw of {best.result.settings.standby:g}"
+            f" W over the cycle; the motors' alone {_percent(search.saving_motors)} less)",
         ),
     ]
     return "\n".join(lines)

@@ -1,4 +1,6 @@
-"""Task files: the waypoints of a movej program, as TOML, for ``kinergy optimize``.
+"""Task files: a movej program as TOML, for ``kinergy optimize``, read into the same program
+type as a URScript program (:class:`~kinergy.trajectory.robot_program.RobotProgram`: one
+``movej`` to a joint target per move).
 
 A task is what a program must do (its joint targets) and, optionally, how fast the program as
 written does it. Every problem is reported as one line naming the file and the field::
@@ -19,10 +21,12 @@ written does it. Every problem is reported as one line naming the file and the f
 
 ``unit`` applies to the joint angles (``start``, ``q``) only: speeds, accelerations and blend
 radii are always in rad/s, rad/s^2 and rad, as URScript's ``movej`` and kinergy's planner take
-them. A move without ``v`` or ``a`` (and no default) runs at the fastest the robot allows.
-``r`` is the joint-space blend kinergy plans with (:mod:`kinergy.trajectory.movej`); UR's own
-``r`` is a tool-centre-point radius in metres that depends on the tool, so it is separate
-(``ur_r``) and only written into a URScript.
+them. A move without ``v`` or ``a`` (and no default) takes URScript's (1.05 rad/s, 1.4 rad/s^2),
+as a ``movej`` without them does. ``r`` is the joint-space blend kinergy plans with
+(:mod:`kinergy.trajectory.movej`, :attr:`Move.joint_blend`); UR's own ``r`` is a tool-centre-point
+radius in metres that depends on the tool, so it is separate (``ur_r``): the blend the program
+runs with where ``r`` is not given, and the one written into a URScript. Without ``start`` the
+program runs in cycles (it starts where its last move ends).
 
 The built-in tasks ``test-a`` and ``test-b`` are the UR5e doc's test programs
 (:func:`kinergy.trajectory.programs.paper_waypoints`, 3 rad/s and 6 rad/s^2, capped by the robot's limits).
@@ -32,7 +36,6 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -40,12 +43,13 @@ import numpy as np
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.files import read_toml
+from kinergy.files import read_text, read_toml
 from kinergy.model.library import library_names, load_robot
 from kinergy.model.robot import Robot
 from kinergy.trajectory.programs import paper_speed, paper_waypoints
+from kinergy.trajectory.robot_program import MOVE_DEFAULTS, Move, RobotProgram
 
-__all__ = ["BUILTIN_TASKS", "Task", "load_task", "task_from_dict"]
+__all__ = ["BUILTIN_TASKS", "load_task", "task_from_dict"]
 
 
 #: built-in task name -> seed of :func:`kinergy.trajectory.programs.paper_waypoints`
@@ -53,40 +57,6 @@ BUILTIN_TASKS = {"test-a": 1, "test-b": 2}
 
 _TOP_KEYS = {"robot", "unit", "speed", "acceleration", "start", "move", "name", "description"}
 _MOVE_KEYS = {"q", "v", "a", "r", "ur_r"}
-
-
-@dataclass(frozen=True, eq=False)
-class Task:
-    """A movej program's waypoints and settings.
-
-    Attributes
-    ----------
-    name : str
-        The file name or the built-in name.
-    robot : str or None
-        The robot the file names (a built-in name or a path), if any.
-    waypoints : ndarray, shape (K + 1, n)
-        The start pose and the K targets, rad.
-    speeds, accels : ndarray, shape (K,)
-        Each move's ``v`` (rad/s) and ``a`` (rad/s^2) as written; NaN where the task gives none
-        (the program then runs that move at the fastest the robot allows).
-    blends : ndarray, shape (K,)
-        Joint-space blend radii, rad (0: the move stops at its target).
-    ur_blends : ndarray, shape (K,)
-        UR blend radii for the URScript, m (tool centre point).
-    """
-
-    name: str
-    robot: str | None
-    waypoints: Array
-    speeds: Array
-    accels: Array
-    blends: Array
-    ur_blends: Array
-
-    @property
-    def moves(self) -> int:
-        return int(self.waypoints.shape[0] - 1)
 
 
 def _number(value: Any, what: str, *, low: float, strict: bool) -> float:
@@ -116,10 +86,10 @@ def _move(
     where: str,
     scale: float,
     n: int | None,
-    defaults: tuple[float | None, float | None],
+    defaults: tuple[float, float],
 ) -> tuple[Array, float, float, float, float]:
-    """One ``[[move]]`` table: its target (rad) and ``v``, ``a`` (NaN: not given), ``r``,
-    ``ur_r``; ``defaults`` are the task's ``speed`` and ``acceleration``."""
+    """One ``[[move]]`` table: its target (rad) and ``v``, ``a``, ``r``, ``ur_r``; ``defaults``
+    are the task's ``speed`` and ``acceleration``."""
     extra = sorted(set(move) - _MOVE_KEYS)
     if extra:
         raise KinergyError(
@@ -128,30 +98,62 @@ def _move(
     if "q" not in move:
         raise KinergyError(f"{where}.q: missing (the move's joint targets)")
     q = _angles(move["q"], f"{where}.q", scale, n)
-    v = move.get("v", defaults[0])
-    a = move.get("a", defaults[1])
     return (
         q,
-        math.nan if v is None else _number(v, f"{where}.v", low=0.0, strict=True),
-        math.nan if a is None else _number(a, f"{where}.a", low=0.0, strict=True),
+        _number(move["v"], f"{where}.v", low=0.0, strict=True) if "v" in move else defaults[0],
+        _number(move["a"], f"{where}.a", low=0.0, strict=True) if "a" in move else defaults[1],
         _number(move.get("r", 0.0), f"{where}.r", low=0.0, strict=False),
         _number(move.get("ur_r", 0.0), f"{where}.ur_r", low=0.0, strict=False),
     )
 
 
+def _program(
+    name: str,
+    path: str,
+    rows: list[tuple[Array, float, float, float, float]],
+    start: Array | None,
+    lines: list[int],
+) -> RobotProgram:
+    """The movej program of a task's moves (``lines``: each ``[[move]]``'s line, 0: unknown)."""
+    moves = [
+        Move(
+            "movej",
+            q,
+            pose=False,
+            a=a,
+            v=v,
+            r=ur_r,
+            joint_blend=r,
+            line=lines[k] if k < len(lines) else 0,
+            text=f"move[{k + 1}]",
+        )
+        for k, (q, v, a, r, ur_r) in enumerate(rows)
+    ]
+    return RobotProgram(name=name, steps=tuple(moves), path=path, start=start)
+
+
 def task_from_dict(
-    data: dict[str, Any], *, name: str = "task", n_joints: int | None = None
-) -> Task:
-    """A :class:`Task` from a parsed task file (see the module docstring).
+    data: dict[str, Any],
+    *,
+    name: str = "task",
+    n_joints: int | None = None,
+    path: str = "",
+    lines: list[int] | None = None,
+) -> RobotProgram:
+    """The movej program of a parsed task file (see the module docstring).
 
     Parameters
     ----------
     data : dict
         The TOML document.
     name : str
-        For the task's name (messages are prefixed by the caller).
+        The program's name unless the file gives one (messages are prefixed by the caller).
     n_joints : int, optional
         The robot's joint count, to check every pose against.
+    path : str
+        The file, for messages naming a move's line.
+    lines : list of int, optional
+        Each ``[[move]]`` table's line in the file.
 
     Raises
     ------
@@ -168,10 +170,11 @@ def task_from_dict(
     if unit not in ("rad", "deg"):
         raise KinergyError(f'unit: expected "rad" or "deg", got {unit!r}')
     scale = math.pi / 180.0 if unit == "deg" else 1.0
+    acc_default, speed_default = MOVE_DEFAULTS["movej"]
     speed = data.get("speed")
-    speed = None if speed is None else _number(speed, "speed", low=0.0, strict=True)
+    speed = speed_default if speed is None else _number(speed, "speed", low=0.0, strict=True)
     acc = data.get("acceleration")
-    acc = None if acc is None else _number(acc, "acceleration", low=0.0, strict=True)
+    acc = acc_default if acc is None else _number(acc, "acceleration", low=0.0, strict=True)
     moves = data.get("move")
     if moves is None:
         raise KinergyError("no [[move]] entries: a task needs at least one move")
@@ -185,44 +188,41 @@ def task_from_dict(
         rows.append(_move(move, f"move[{k + 1}]", scale, n, (speed, acc)))
         n = rows[-1][0].size
     targets = [row[0] for row in rows]
-    settings = np.array([row[1:] for row in rows])  # (K, 4): v, a, r, ur_r
-    start = _angles(data["start"], "start", scale, n) if "start" in data else targets[-1].copy()
-    largest = float(np.max(np.abs(np.vstack([start, *targets])))) / scale
+    start = _angles(data["start"], "start", scale, n) if "start" in data else None
+    every = np.vstack([targets[-1] if start is None else start, *targets])
+    largest = float(np.max(np.abs(every))) / scale
     if unit == "deg" and largest <= 2.0 * math.pi:
         raise KinergyError(
             f'unit = "deg", but every joint angle is within {largest:.3g}, as angles in rad '
             'are: radians in a file that says degrees? (unit = "rad")'
         )
-    return Task(
-        name=str(data.get("name", name)),
-        robot=robot,
-        waypoints=np.vstack([start, *targets]),
-        speeds=settings[:, 0].copy(),
-        accels=settings[:, 1].copy(),
-        blends=settings[:, 2].copy(),
-        ur_blends=settings[:, 3].copy(),
-    )
+    if start is not None and np.array_equal(start, targets[-1]):
+        start = None  # a cycle: the program starts where it ends
+    return _program(str(data.get("name", name)), path, rows, start, lines or [])
 
 
-def _builtin(name: str, robot: Robot | None) -> Task:
+def _builtin(name: str, robot: Robot | None) -> RobotProgram:
     if robot is None:
         raise KinergyError(f"task {name!r}: a built-in task needs the robot it runs on")
     waypoints = paper_waypoints(robot, BUILTIN_TASKS[name])
     speed, acc = paper_speed(robot)
-    moves = waypoints.shape[0] - 1
-    return Task(
-        name=name,
-        robot=robot.name,
-        waypoints=waypoints,
-        speeds=np.full(moves, speed),
-        accels=np.full(moves, acc),
-        blends=np.zeros(moves),
-        ur_blends=np.zeros(moves),
-    )
+    rows = [(q, speed, acc, 0.0, 0.0) for q in waypoints[1:]]
+    start = None if np.array_equal(waypoints[0], waypoints[-1]) else waypoints[0]
+    return _program(name, name, rows, start, list(range(1, len(rows) + 1)))
 
 
-def load_task(name_or_path: str | os.PathLike[str], *, robot: Robot | None = None) -> Task:
-    """Read a task file (TOML, see the module docstring) or build a built-in task.
+def _move_lines(text: str) -> list[int]:
+    """The line (1-based) of every ``[[move]]`` table header, in order."""
+    return [
+        i + 1
+        for i, line in enumerate(text.splitlines())
+        if line.split("#", 1)[0].strip().replace(" ", "") == "[[move]]"
+    ]
+
+
+def load_task(name_or_path: str | os.PathLike[str], *, robot: Robot | None = None) -> RobotProgram:
+    """Read a task file (TOML, see the module docstring) or build a built-in task, as the movej
+    program it describes.
 
     Parameters
     ----------
@@ -230,13 +230,14 @@ def load_task(name_or_path: str | os.PathLike[str], *, robot: Robot | None = Non
         ``test-a``, ``test-b`` (:data:`BUILTIN_TASKS`) or a task file.
     robot : Robot, optional
         The robot the task runs on: needed for a built-in task; for a file, every pose is
-        checked to have its joint count.
+        checked to have its joint count, and the robot the file names must be this one.
 
     Returns
     -------
-    Task
-        ``waypoints`` (K + 1, n) in rad; per-move ``speeds``, ``accels`` (NaN: not given),
-        ``blends`` and ``ur_blends``.
+    RobotProgram
+        One ``movej`` to a joint target (rad) per move, with its ``v``, ``a``, ``r`` (UR's, m,
+        from ``ur_r``) and kinergy's joint-space blend (``r``, rad); the start where the file
+        gives one (else the program runs in cycles). A move's line is its ``[[move]]`` table's.
 
     Raises
     ------
@@ -252,13 +253,21 @@ def load_task(name_or_path: str | os.PathLike[str], *, robot: Robot | None = Non
             f"{path}: no such task file (built-in tasks: {', '.join(BUILTIN_TASKS)})"
         )
     data = read_toml(path, "task file")
+    lines = _move_lines(read_text(path, "task file"))
     try:
-        task = task_from_dict(data, name=path.stem, n_joints=None if robot is None else robot.n)
+        program = task_from_dict(
+            data,
+            name=path.stem,
+            n_joints=None if robot is None else robot.n,
+            path=str(path),
+            lines=lines,
+        )
     except KinergyError as exc:
         raise exc.prefixed(str(path)) from None
-    if robot is not None and task.robot is not None:
-        _check_robot(path, task.robot, robot)
-    return task
+    named = data.get("robot")
+    if robot is not None and isinstance(named, str):
+        _check_robot(path, named, robot)
+    return program
 
 
 def _check_robot(path: Path, named: str, robot: Robot) -> None:

@@ -1,15 +1,15 @@
-"""URScript programs a UR controller can run, written from kinergy's motions.
+"""URScript programs a UR controller can run, written from kinergy's programs and motions.
 
-:func:`movej_program` writes a movej program: one ``movej(q, a=..., v=..., r=...)`` per move,
-joint angles in rad, URScript's ``a`` (rad/s^2) and ``v`` (rad/s) of the leading joint, as
-kinergy's :func:`kinergy.trajectory.movej.movej` plans them. :func:`program_script` writes a
-:class:`~kinergy.trajectory.robot_program.RobotProgram` read from a file back with changed moves:
-every other line kept as it was. :func:`write_script` puts any script on disk atomically.
+:func:`program_script` writes a :class:`~kinergy.trajectory.robot_program.RobotProgram` read from
+a file back with changed moves, every other line kept as it was, or a program built in code (a
+task's movej program) as one statement per line: ``movej(q, a=..., v=..., r=...)``, joint angles
+in rad, URScript's ``a`` (rad/s^2) and ``v`` (rad/s) of the leading joint, as kinergy's
+:mod:`kinergy.trajectory.movej` plans them. :func:`servoj_program` streams a sampled trajectory.
+:func:`write_script` puts any script on disk atomically.
 
 Blending: URScript's ``r`` is a blend radius in metres around the target's tool position, while
-kinergy plans blends as a joint-space radius (rad, on the leading joint). The two do not convert
-without the tool, so a program is written with ``r=0`` (every move stops at its target, as
-kinergy's unblended plan) unless the caller gives UR blend radii.
+a task may blend by a joint-space radius (rad, on the leading joint: :attr:`Move.joint_blend`).
+The two do not convert without the tool, so only ``r`` is written.
 """
 
 from __future__ import annotations
@@ -34,13 +34,11 @@ from kinergy.io.urscript_reader import (
     target_name,
 )
 from kinergy.trajectory.motion import CONTROLLER_DT
-from kinergy.trajectory.movej import check_waypoints, per_move
 from kinergy.trajectory.robot_program import Move, RobotProgram
 
 __all__ = [
     "SERVO_PERIOD",
     "move_statement",
-    "movej_program",
     "program_script",
     "servoj_program",
     "target_literal",
@@ -90,94 +88,6 @@ def _program(name: str, header: Sequence[str], body: Sequence[str]) -> str:
     lines.extend(f"  {line}" for line in body)
     lines.append("end")
     return "\n".join(lines) + "\n"
-
-
-def _move_settings(speeds: ArrayLike, accels: ArrayLike, blends: ArrayLike, moves: int) -> Array:
-    """Each move's ``v``, ``a`` (> 0) and ``r`` (>= 0) as rows, shape (3, K)."""
-    rows = []
-    for key, value, positive in (("v", speeds, True), ("a", accels, True), ("r", blends, False)):
-        arr = per_move(value, moves, key)
-        bad = ~np.isfinite(arr) | ((arr <= 0.0) if positive else (arr < 0.0))
-        if np.any(bad):
-            k = int(np.argmax(bad))
-            raise KinergyError(
-                f"{key} of move {k + 1}: must be {'> 0' if positive else '>= 0'}, got {arr[k]}"
-            )
-        rows.append(arr)
-    return np.array(rows)
-
-
-def _movej_header(
-    blended: bool, cycle_time: float | None, energy: float | None, comments: Sequence[str]
-) -> list[str]:
-    header = ["written by kinergy: a movej program, joint angles in rad"]
-    if cycle_time is not None:
-        header.append(f"predicted cycle time: {cycle_time:.3f} s")
-    if energy is not None:
-        header.append(f"predicted electrical energy per cycle: {energy:.1f} J")
-    header.append(
-        "r is UR's blend radius at the tool (m), as the task gives it"
-        if blended
-        else "r is UR's blend radius at the tool (m); kinergy's joint-space blends are not "
-        "written (r=0: each move stops at its target)"
-    )
-    return header + [str(c) for c in comments]
-
-
-def movej_program(
-    waypoints: ArrayLike,
-    speeds: ArrayLike,
-    accels: ArrayLike,
-    blends: ArrayLike | None = None,
-    *,
-    name: str = "kinergy_program",
-    cycle_time: float | None = None,
-    energy: float | None = None,
-    comments: Sequence[str] = (),
-) -> str:
-    """A URScript movej program through ``waypoints``.
-
-    Parameters
-    ----------
-    waypoints : array_like, shape (K + 1, n)
-        The start pose and the K targets, rad. The program first moves to the start pose (at
-        URScript's default ``a=1.4, v=1.05``: it is not part of the timed cycle), then runs the
-        K moves.
-    speeds, accels : float or array_like, shape (K,)
-        Each move's ``v`` (rad/s) and ``a`` (rad/s^2), > 0.
-    blends : float or array_like, shape (K,), optional
-        UR blend radii, m (tool centre point; URScript's ``r``); default 0 for every move. Not
-        kinergy's joint-space blend radii (see the module docstring).
-    name : str
-        The program's name (``def name():``).
-    cycle_time, energy : float, optional
-        Predicted cycle time (s) and electrical energy (J), written as comments.
-    comments : sequence of str
-        More comment lines for the header.
-
-    Returns
-    -------
-    str
-        ``def name():`` ... ``end``, newline-terminated.
-
-    Examples
-    --------
-    >>> text = movej_program([[0, 0, 0, 0, 0, 0], [0.5, 0, 0, 0, 0, 0]], 1.0, 2.0)
-    >>> text.splitlines()[-2].strip()
-    'movej([0.5, 0, 0, 0, 0, 0], a=2, v=1, r=0)'
-    """
-    w = check_waypoints(waypoints)
-    moves = w.shape[0] - 1
-    v, a, r = _move_settings(speeds, accels, 0.0 if blends is None else blends, moves)
-    body = ["# the start pose (not part of the cycle)", f"movej({_vector(w[0])}, a=1.4, v=1.05)"]
-    for k in range(moves):
-        body.append(f"# move {k + 1}")
-        body.append(
-            f"movej({_vector(w[k + 1])}, a={_decimal(a[k])}, v={_decimal(v[k])}, "
-            f"r={_decimal(r[k])})"
-        )
-    header = _movej_header(blends is not None, cycle_time, energy, comments)
-    return _program(name, header, body)
 
 
 def target_literal(move: Move) -> str:
@@ -321,8 +231,9 @@ def program_script(program: RobotProgram, header: Sequence[str] = ()) -> str:
     new names (``home_2 = ...``) on lines after it. Every other line (events, I/O, comments)
     stays as it was, and so does a variable whose moves all still go where its line says (the
     lines are read again to tell). ``header`` lines go in as comments after the
-    ``def`` line (or at the top). A program built in code (no ``lines``) is written as
-    ``def name():`` with one move per line and its events' statements.
+    ``def`` line (or at the top). A program built in code (no ``lines``: a task) is written as
+    ``def name():`` (its name made a URScript name) with one move per line and its events'
+    statements.
 
     Returns
     -------
@@ -331,7 +242,10 @@ def program_script(program: RobotProgram, header: Sequence[str] = ()) -> str:
     """
     if not program.lines:
         body = [move_statement(s) if isinstance(s, Move) else s.text for s in program.steps]
-        return _program(program.name, header, body)
+        name = "".join(c if c.isalnum() or c == "_" else "_" for c in program.name)
+        if not name or not (name[0].isalpha() or name[0] == "_"):
+            name = "kinergy_" + name
+        return _program(name, header, body)
     targets, rewritten, added = _named_targets(program)
     lines = list(program.lines)
     for index, line in rewritten.items():

@@ -1,60 +1,55 @@
-"""Energy-optimal programs: the timing of movej tasks, the levers of URScript programs, and
-where the robot stands.
+"""The optimiser: a robot program doing the same job with less energy, and where the robot
+stands.
 
-``problem`` builds a :class:`TimingProblem` (arrays and callables), ``solve`` minimises its
-objective (``objectives``: the electrical energy by default, pluggable) under the limits
-(``constraints``) on the batched program model (``program``), ``verify`` re-simulates every result
-at 500 Hz, and ``timing`` compares the program as written, uniform time scaling and the optimum at
-one cycle time (:func:`optimize_timing`) or many (:func:`pareto_front`). A URScript program's
-levers are in ``programs`` (options typed in ``options``: :class:`ProgramOptions`), the cell's
-placement in ``placement``. Every solver stops on iterations and tolerances, never on a clock
-(:class:`Outcome` says why it stopped).
+One program type (:class:`~kinergy.trajectory.robot_program.RobotProgram`: a URScript program,
+or a task file's movej program), one set of levers (``levers``: ``2 pi`` wraps, configurations,
+tool symmetry, via points, blends, timing), one timing solver (``timing`` on ``problem`` and
+``solve``), one limit type (:class:`Caps` beside the robot's limits, ``constraints``), one 500 Hz
+re-simulation (``verify``), one objective (``objectives``: the supply energy the model predicts)
+and one result (:class:`ProgramOptimization`), entered by :func:`optimize_program`; the Pareto
+front re-times its result at other cycle times (:func:`pareto_front`) and ``placement`` moves the
+robot's base. Every solver stops on iterations and tolerances, never on a clock (:class:`Outcome`
+says why it stopped).
 """
 
 from __future__ import annotations
 
 from kinergy.optimize.constraints import LIMIT_TOL, LimitCheck, limit_violations, torque_ratio
-from kinergy.optimize.objectives import ElectricalEnergy, Objective, bus_power
+from kinergy.optimize.objectives import Objective, SupplyEnergy
 from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
-from kinergy.optimize.problem import (
-    TimingProblem,
-    joint_caps,
-    program_settings,
-    timing_problem,
-    uniform_scaling,
+from kinergy.optimize.problem import Caps, TimingProblem
+from kinergy.optimize.programs import (
+    ParetoPoint,
+    ProgramOptimization,
+    optimize_program,
+    pareto_front,
 )
-from kinergy.optimize.program import ProgramSamples
+from kinergy.optimize.samples import ProgramSamples
 from kinergy.optimize.solve import Outcome, Solution, solve_timing
-from kinergy.optimize.timing import ParetoPoint, TimingResult, optimize_timing, pareto_front
-from kinergy.optimize.verify import VERIFY_DT, ProgramResult, program_energy, simulate_program
+from kinergy.optimize.verify import VERIFY_DT, ProgramResult, simulate_path
 
 __all__ = [
     "LIMIT_TOL",
     "VERIFY_DT",
+    "Caps",
     "Configurations",
-    "ElectricalEnergy",
     "LimitCheck",
     "Objective",
     "Outcome",
     "ParetoPoint",
+    "ProgramOptimization",
     "ProgramOptions",
     "ProgramResult",
     "ProgramSamples",
     "Solution",
+    "SupplyEnergy",
     "TimingProblem",
-    "TimingResult",
     "ToolSymmetry",
     "ViaPoints",
-    "bus_power",
-    "joint_caps",
     "limit_violations",
-    "optimize_timing",
+    "optimize_program",
     "pareto_front",
-    "program_energy",
-    "program_settings",
-    "simulate_program",
+    "simulate_path",
     "solve_timing",
-    "timing_problem",
     "torque_ratio",
-    "uniform_scaling",
 ]

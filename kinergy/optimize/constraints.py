@@ -17,7 +17,7 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.drives.transmission import joint_torque
 from kinergy.model.robot import Robot
-from kinergy.optimize.program import ProgramSamples
+from kinergy.optimize.samples import ProgramSamples
 from kinergy.predict import DriveState
 from kinergy.trajectory.motion import Motion
 

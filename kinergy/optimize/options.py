@@ -147,6 +147,8 @@ class ProgramOptions:
     via : ViaPoints
     blends : bool
         Whether via points may get blend radii.
+    fixed_shares : bool
+        The timing keeps each move's share of the cycle time (chooses only how each runs).
     standby : float or None
         Standby power, W (>= 0), counted over the cycle time; None: the robot file's.
     cycle_time : float or None
@@ -165,6 +167,7 @@ class ProgramOptions:
     tool_symmetry: ToolSymmetry = ToolSymmetry.NONE
     via: ViaPoints = ViaPoints.KEEP
     blends: bool = True
+    fixed_shares: bool = False
     standby: float | None = None
     cycle_time: float | None = None
     v_max: float | None = None
@@ -188,3 +191,4 @@ class ProgramOptions:
         for name in ("cycle_time", "v_max", "a_max"):
             object.__setattr__(self, name, _positive(name, getattr(self, name)))
         object.__setattr__(self, "blends", bool(self.blends))
+        object.__setattr__(self, "fixed_shares", bool(self.fixed_shares))

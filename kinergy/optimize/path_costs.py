@@ -34,10 +34,9 @@ from kinergy.dynamics.poses import rotation_about_z, tcp_pose
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 from kinergy.optimize.options import ToolSymmetry
-from kinergy.optimize.program import quadrature_nodes
-from kinergy.optimize.program_samples import drive_by_payload
+from kinergy.optimize.samples import drive_by_payload, piece_nodes
 from kinergy.trajectory.movej import trapezoid, trapezoid_timing
-from kinergy.trajectory.movel import joints_on_path, tool_motion, tool_segment
+from kinergy.trajectory.movel import joints_on_path, segment_arrays, tool_motion
 from kinergy.trajectory.program_path import ProgramPath
 from kinergy.trajectory.robot_program import Event, Move
 
@@ -233,7 +232,7 @@ def target_states(
 def _phase_nodes(duration: Array, ramp: Array) -> tuple[Array, Array]:
     """Gauss-Legendre nodes (P, 3 _NODES) and weights of trapezoids' three phases."""
     breaks = np.stack([np.zeros_like(duration), ramp, duration - ramp, duration], axis=1)
-    times, weights, _ = quadrature_nodes(breaks, sub=1, order=_NODES)
+    times, weights, _ = piece_nodes(breaks[:, :-1], breaks[:, 1:], sub=1, order=_NODES)
     return times[:, : 3 * _NODES], weights[:, : 3 * _NODES]
 
 
@@ -262,19 +261,18 @@ def _tool_moves(
     assert path.geometry is not None
     tcp = path.tcp[k]
     pose_a = tcp_pose(robot, q_a, tcp)
-    segs = [tool_segment(pa, pb) for pa, pb in zip(pose_a, pose_b, strict=True)]
-    length = np.array([sg.length for sg in segs])
+    shift, turn, length = segment_arrays(pose_a, pose_b)
     duration, ramp, peak = trapezoid_timing(length, path.speed[k], path.accel[k])
     ramp = np.where(length > 0.0, ramp, 0.0)
     times, weights = _phase_nodes(duration, ramp)
     s, sd, sdd = trapezoid(times, duration[:, None], ramp[:, None], peak[:, None], path.accel[k])
     m = times.shape[1]
-    rep = np.repeat(np.arange(len(segs)), m)
-    shape = (len(segs), m, q_a.shape[1])
+    rep = np.repeat(np.arange(length.size), m)
+    shape = (length.size, m, q_a.shape[1])
     pose, twist, acc = tool_motion(
         pose_a[rep],
-        np.array([sg.shift for sg in segs])[rep, None],
-        np.array([sg.turn for sg in segs])[rep, None],
+        shift[rep, None],
+        turn[rep, None],
         length[rep, None],
         s.reshape(-1, 1),
         sd.reshape(-1, 1),
@@ -304,7 +302,7 @@ def _energy(
     bad = np.any(np.isnan(q.reshape(p, -1)), axis=1)
     q, qd, qdd = (np.nan_to_num(x).reshape(-1, n) for x in (q, qd, qdd))
     load = np.full(p * m, path.move_payload[k], dtype=np.intp)
-    drive = drive_by_payload(robot, path.payloads, load, q, qd, qdd)
+    drive = drive_by_payload(path.robots, load, q, qd, qdd)
     bus = np.maximum(drive.power.sum(axis=1), 0.0).reshape(p, m)
     e = np.sum(bus * weights, axis=1) + standby * duration
     return np.where(bad, np.inf, e)
@@ -320,7 +318,7 @@ def _hold_power(robot: Robot, path: ProgramPath, k: int, q: Array) -> Array:
         if path.event_time[e] <= 0.0:
             continue
         load = np.full(q.shape[0], path.event_payload[e], dtype=np.intp)
-        drive = drive_by_payload(robot, path.payloads, load, q, zero, zero)
+        drive = drive_by_payload(path.robots, load, q, zero, zero)
         total += np.maximum(drive.power.sum(axis=1), 0.0) * path.event_time[e]
     return total
 

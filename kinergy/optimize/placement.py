@@ -24,7 +24,10 @@ from __future__ import annotations
 
 import enum
 import math
+import multiprocessing
+import os
 from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -32,6 +35,7 @@ import numpy as np
 
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
+from kinergy.optimize.levers import CYCLE_TOLERANCE
 from kinergy.optimize.options import ProgramOptions
 from kinergy.optimize.programs import ProgramOptimization, optimize_program
 from kinergy.trajectory.program_path import program_path
@@ -53,6 +57,8 @@ __all__ = [
 MAX_CANDIDATES = 400
 #: the largest shift of the base taken, m (beyond it no arm reaches today's cell)
 MAX_SHIFT = 5.0
+#: decimals a placement's coordinates are rounded to (m and rad: a nanometre, a nanoradian)
+RESOLUTION = 9
 
 
 @dataclass(frozen=True)
@@ -64,8 +70,10 @@ class Range:
     high: float
 
     def values(self, step: float) -> np.ndarray:
-        """``low, low + step, ...`` up to ``high`` (within a millionth of a step), shape (N,)."""
-        return self.low + step * np.arange(self.count(step))
+        """``low, low + step, ...`` up to ``high`` (within a millionth of a step), shape (N,),
+        each rounded to :data:`RESOLUTION`: a placement is the same number whatever grid it
+        is part of (``-0.4 + 3 * 0.2`` is 0.2 as ``0 + 0.2`` is)."""
+        return np.round(self.low + step * np.arange(self.count(step)), RESOLUTION)
 
     def count(self, step: float) -> int:
         """How many values :meth:`values` gives (capped at 10^9 for absurd steps)."""
@@ -182,7 +190,10 @@ class Candidate:
     why : str
         The details ('' when reachable): the line out of reach, the limit broken, ...
     e_supply : float or None
-        The optimised program's supply energy per cycle, J (None when not reachable).
+        The optimised program's supply energy per cycle (the motors and the arm's standing draw
+        over the cycle), J (None when not reachable).
+    e_motors : float or None
+        Its motors' part (on the DC bus, braking lost in the shunt), J.
     cycle_time : float or None
         Its cycle time, s (None when the program cannot run there).
     result : ProgramOptimization or None
@@ -196,6 +207,7 @@ class Candidate:
     e_supply: float | None = None
     cycle_time: float | None = None
     result: ProgramOptimization | None = None
+    e_motors: float | None = None
 
     @property
     def reachable(self) -> bool:
@@ -214,6 +226,7 @@ class Candidate:
             "yaw": p.yaw,
             "reachable": self.reachable,
             "e_supply": self.e_supply,
+            "e_motors": self.e_motors,
             "cycle_time": self.cycle_time,
             "reason": None if self.reachable else self.reason.value,
             "why": self.why or None,
@@ -243,24 +256,34 @@ class PlacementSearch:
 
     @property
     def saving(self) -> float | None:
-        """The best placement's saving on today's optimised program, 0-1 (None when today's
-        optimum does not hold every limit)."""
+        """The best placement's saving on today's optimised program, of what the arm draws from
+        its supply, 0-1 (None when today's optimum does not hold every limit)."""
         if self.best.e_supply is None or self.today.e_supply is None:
             return None
         return 1.0 - self.best.e_supply / self.today.e_supply
+
+    @property
+    def saving_motors(self) -> float | None:
+        """The same, of the motors' energy alone, 0-1."""
+        if self.best.e_motors is None or self.today.e_motors is None:
+            return None
+        return 1.0 - self.best.e_motors / self.today.e_motors
 
 
 def _judged(placement: BasePlacement, result: ProgramOptimization) -> Candidate:
     """A placement's optimisation: reachable if it holds every limit and meets every target."""
     opt = result.optimized.result
     cycle = opt.cycle_time
+    if cycle > result.settings.cycle_time + CYCLE_TOLERANCE:
+        why = f"within the limits only at {cycle:.3f} s"
+        return Candidate(placement, Reason.CANNOT_RUN, why, None, cycle, result)
     if not opt.ok:
         why = "; ".join(opt.check.violations())
         return Candidate(placement, Reason.OVER_LIMIT, why, None, cycle, result)
     if not result.targets_met:
         why = "not within 1 mm and 0.5 deg, or not at rest"
         return Candidate(placement, Reason.TARGET_MISSED, why, None, cycle, result)
-    return Candidate(placement, Reason.NONE, "", opt.score, cycle, result)
+    return Candidate(placement, Reason.NONE, "", opt.e_supply, cycle, result, opt.e_elec)
 
 
 def _reach(
@@ -308,6 +331,7 @@ def place_program(
     options: ProgramOptions | None = None,
     *,
     progress: Callable[[str], None] | None = None,
+    workers: int | None = None,
 ) -> PlacementSearch:
     """Every placement of ``grid`` and today's, each checked and optimised (module docstring).
 
@@ -321,7 +345,11 @@ def place_program(
         The levers (as :func:`kinergy.optimize.programs.optimize_program`); the cycle time and
         caps default to today's program's own and hold for every candidate.
     progress : callable, optional
-        Called with a line before each candidate.
+        Called with a line as each candidate is done.
+    workers : int, optional
+        Processes the candidates are optimised on (default: one per core). Each candidate's
+        optimisation is independent of the others and of the order they run in: the same
+        result on any host and with any number of processes.
 
     Raises
     ------
@@ -346,22 +374,66 @@ def place_program(
         a_max=settings.caps.acceleration,
     )
     today = _judged(BasePlacement(), today_result)
-    best = today if today.reachable else None
-    candidates: list[Candidate] = []
-    for i, (placement, moved) in enumerate(zip(placements, reached, strict=True)):
-        if isinstance(moved, Candidate):
-            candidates.append(moved)
-            continue
-        say(f"placement {i + 1}/{len(placements)}: {placement.label()}")
-        found = today if placement.today else _optimised(robot, moved, placement, fixed)
-        if found.reachable and (best is None or _better(found, best)):
-            best = found  # the only one whose optimisation is kept, besides today's
-        candidates.append(found if found is best or found is today else found.summary())
+    todo = [
+        (i, placement, moved)
+        for i, (placement, moved) in enumerate(zip(placements, reached, strict=True))
+        if not isinstance(moved, Candidate) and not placement.today
+    ]
+    found = _optimise_all(robot, todo, fixed, say, workers)
+    candidates = [
+        r if isinstance(r, Candidate) else today if p.today else found[i]
+        for i, (p, r) in enumerate(zip(placements, reached, strict=True))
+    ]
     if not any(c.reachable for c in candidates):
         raise _refusal(candidates)
+    best = today if today.reachable else None
+    for c in candidates:
+        if c.reachable and (best is None or _better(c, best)):
+            best = c  # the only one whose optimisation is kept, besides today's
     assert best is not None
     kept = tuple(c if c is best or c is today else c.summary() for c in candidates)
     return PlacementSearch(today, kept, best, fixed)
+
+
+def _workers(count: int) -> int:
+    """Processes for ``count`` candidates: one per core this process may use, at most one per
+    candidate (each candidate's result does not depend on which process computes it)."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except AttributeError:  # (not on every platform)
+        cores = os.cpu_count() or 1
+    return max(1, min(cores, count))
+
+
+def _optimise_all(
+    robot: Robot,
+    todo: list[tuple[int, BasePlacement, RobotProgram]],
+    options: ProgramOptions,
+    say: Callable[[str], None],
+    workers: int | None,
+) -> dict[int, Candidate]:
+    """Every reachable candidate optimised (:func:`_optimised`), on ``workers`` processes (None:
+    one per core); by index."""
+    count = len(todo)
+    n = _workers(count) if workers is None else max(1, min(workers, count))
+    out: dict[int, Candidate] = {}
+    if n <= 1:
+        for done, (i, placement, moved) in enumerate(todo):
+            say(f"placement {done + 1}/{count}: {placement.label()}")
+            out[i] = _optimised(robot, moved, placement, options)
+        return out
+    say(f"optimising {count} placements on {n} processes")
+    context = multiprocessing.get_context("spawn")  # no thread of this process is copied
+    with ProcessPoolExecutor(max_workers=n, mp_context=context) as pool:
+        futures = {
+            pool.submit(_optimised, robot, moved, placement, options): i
+            for i, placement, moved in todo
+        }
+        for done, future in enumerate(as_completed(futures)):
+            i = futures[future]
+            out[i] = future.result()
+            say(f"placement {done + 1}/{count} done: {out[i].placement.label()}")
+    return out
 
 
 def _better(a: Candidate, b: Candidate) -> bool:

@@ -1,14 +1,22 @@
-"""The timing problem of a movej program: arrays and callables the solver works on.
+"""The timing problem of a robot program: arrays and callables the solver works on.
 
-A task is fixed by its waypoints (the path in joint space); what a UR program is free to choose is
-how fast each move runs: URScript's ``movej(q, a=..., v=...)`` per move. :func:`timing_problem`
-turns a robot, the waypoints and the caps into a :class:`TimingProblem`: each move's leading-joint
-travel, the largest speed and acceleration the joints' limits allow (:func:`joint_caps`), the
-torque-limited acceleration at full speed (each move's fastest feasible setting), and two
-callables over batches of programs given by their move durations and ramp fractions
-(:mod:`kinergy.optimize.program`): ``evaluate`` (the objective, :mod:`kinergy.optimize.objectives`,
-and each move's torque ratio, :func:`kinergy.optimize.constraints.torque_ratio`) and ``cycle``
-(the program's total time). The solver (:mod:`kinergy.optimize.solve`) sees only these.
+The path of a program is fixed by its targets; what its moves are free to choose is how fast each
+runs: URScript's ``v`` and ``a`` (movej: of the leading joint, rad/s and rad/s^2; movel/movep:
+along the tool's path, m/s and m/s^2), the events' times fixed. :func:`path_problem` states it
+as a :class:`TimingProblem` over the samples of :mod:`kinergy.optimize.samples`:
+
+- caps per move (:func:`path_caps`): every joint's speed and acceleration limit and the
+  optimiser's caps (:class:`Caps`: by default the program's own peak joint speed and
+  acceleration), turned into the move's own unit by the most any joint moves per unit of its path
+  (a movej's leading joint; along a tool line, ``max_s |dq_j/ds|``); the torque-limited
+  acceleration at full speed by a scan (:func:`fastest_acceleration`);
+- the objective (:mod:`kinergy.optimize.objectives`) with each move's part, and each move's torque
+  ratio (:func:`kinergy.optimize.constraints.torque_ratio`), of batches of programs given by their
+  move durations and ramp fractions; the cycle time: the moves' durations (less the blends'
+  overlaps) plus the events' fixed times.
+
+The solver (:mod:`kinergy.optimize.solve`) sees only these. :class:`PathChecks` re-simulates
+programs on the path at 500 Hz (:func:`kinergy.optimize.verify.simulate_path`).
 """
 
 from __future__ import annotations
@@ -17,32 +25,48 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import torque_ratio
-from kinergy.optimize.objectives import ElectricalEnergy, Objective
-from kinergy.optimize.program import durations, sample_programs, serial, settings
-from kinergy.trajectory.movej import blend_starts, check_waypoints, per_move
+from kinergy.optimize.objectives import Objective
+from kinergy.optimize.samples import durations, path_schedule, sample_path_programs
+from kinergy.optimize.verify import PathRun, ProgramResult, simulate_path
+from kinergy.trajectory.program_motion import LineTables, line_tables
+from kinergy.trajectory.program_path import ProgramPath, line_joints
 
 __all__ = [
+    "SLACK",
+    "Caps",
     "CycleTime",
     "Evaluator",
+    "PathChecks",
     "TimingProblem",
     "fastest_acceleration",
-    "joint_caps",
-    "program_settings",
-    "timing_problem",
+    "path_caps",
+    "path_checks",
     "uniform_scaling",
 ]
+
+
+@dataclass(frozen=True)
+class Caps:
+    """The joint speed (rad/s) and acceleration (rad/s^2) caps every program is held to, besides
+    the robot's own limits: by default the program's own peaks (the speeds its programmer
+    chose)."""
+
+    speed: float
+    acceleration: float
 
 
 #: ``(t, f) -> (objective, torque_ratio)`` of B programs, see :class:`TimingProblem`
 Evaluator = Callable[[Array, Array], tuple[Array, Array]]
 #: ``(t, f) -> cycle time`` of B programs, s
 CycleTime = Callable[[Array, Array], Array]
+#: ``(t, f) -> (objective (B,), its per-move parts (B, K), torque_ratio (B, K))`` of B programs
+Parts = Callable[[Array, Array], tuple[Array, Array, Array]]
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,12 +75,11 @@ class TimingProblem:
 
     Attributes
     ----------
-    waypoints : ndarray, shape (K + 1, n)
-        rad.
     travel : ndarray, shape (K,)
-        Leading-joint travel of each move, rad.
+        What each move's profile runs over (a movej's leading-joint travel, rad; a tool move's
+        path length, m or rad).
     blends : ndarray, shape (K,)
-        Joint-space blend radii, rad.
+        Each move's blend radius in the same unit (0 where it does not blend).
     v_cap, a_cap : ndarray, shape (K,)
         Largest leading-joint speed (rad/s) and acceleration (rad/s^2) of each move that keeps
         every joint within its speed and acceleration limits and the caps (``inf``: none).
@@ -74,9 +97,15 @@ class TimingProblem:
         What ``evaluate`` returns (:mod:`kinergy.optimize.objectives`), to score re-simulations.
     v_limit, a_limit : tuple of str, shape (K,)
         What sets each move's ``v_cap`` and ``a_cap`` (for the report).
+    parts : callable
+        ``parts(t, f) -> (objective, parts, torque_ratio)``: ``evaluate`` with the objective's
+        part of each move (B, K), which depends on the timing of that move and of the moves
+        blended into it (``linked``) only: the solver's differences perturb many moves in one
+        program.
+    linked : ndarray of bool, shape (K,)
+        Whether move k blends into move k + 1.
     """
 
-    waypoints: Array
     travel: Array
     blends: Array
     v_cap: Array
@@ -84,7 +113,9 @@ class TimingProblem:
     a_fast: Array
     evaluate: Evaluator = field(repr=False)
     cycle: CycleTime = field(repr=False)
-    objective: Objective = field(default_factory=ElectricalEnergy, repr=False)
+    objective: Objective = field(repr=False)
+    parts: Parts = field(repr=False)
+    linked: NDArray[np.bool_]
     v_limit: tuple[str, ...] = ()
     a_limit: tuple[str, ...] = ()
 
@@ -109,64 +140,6 @@ class TimingProblem:
         """Total time of the program at per-move settings ``v`` and ``a`` (K,), s."""
         t, f = durations(self.travel, v, a)
         return float(self.cycle(t[None, :], f[None, :])[0])
-
-
-def _callables(
-    robot: Robot, waypoints: Array, blends: Array, objective: Objective
-) -> tuple[Evaluator, CycleTime]:
-    """The batched objective/torque evaluator and the cycle-time function of a movej program."""
-    travel = np.max(np.abs(np.diff(waypoints, axis=0)), axis=1)
-
-    def cycle(t: Array, f: Array) -> Array:
-        t = np.atleast_2d(t)
-        _, a, ramp = settings(travel, t, np.atleast_2d(f))
-        start = blend_starts(travel, blends, t, a, ramp)
-        return np.asarray(np.max(start + t, axis=1))
-
-    def evaluate(t: Array, f: Array) -> tuple[Array, Array]:
-        t = np.atleast_2d(np.asarray(t, dtype=float))
-        f = np.atleast_2d(np.asarray(f, dtype=float))
-        samples = sample_programs(robot, waypoints, blends, t, f)
-        value, _ = objective(samples)
-        return value, torque_ratio(robot, samples)
-
-    return evaluate, cycle
-
-
-def joint_caps(
-    robot: Robot, waypoints: Array, v_max: float | None, a_max: float | None
-) -> tuple[Array, Array, list[str], list[str]]:
-    """Per move the largest leading-joint speed (rad/s) and acceleration (rad/s^2) within every
-    joint's limits and the caps, shape (K,) (``inf``: none), and what sets each (for the report).
-
-    A joint that travels ``s_j`` times the leading joint's distance runs at ``s_j`` times its
-    speed and acceleration, so its limit allows the leading joint ``limit_j / s_j``.
-    """
-    delta = np.abs(np.diff(waypoints, axis=0))
-    travel = delta.max(axis=1)
-    speed = np.array([j.limits.speed for j in robot.joints])
-    acc = np.array(
-        [np.inf if j.limits.acceleration is None else j.limits.acceleration for j in robot.joints]
-    )
-    with np.errstate(divide="ignore", invalid="ignore"):
-        share = np.where(travel[:, None] > 0.0, delta / travel[:, None], 0.0)  # (K, n)
-        v_joint = np.where(share > 0.0, speed / share, np.inf)
-        a_joint = np.where(share > 0.0, acc / share, np.inf)
-    names = robot.joint_names
-    v_cap, a_cap, v_why, a_why = [], [], [], []
-    for k in range(travel.size):
-        jv, ja = int(np.argmin(v_joint[k])), int(np.argmin(a_joint[k]))
-        v, a = float(v_joint[k, jv]), float(a_joint[k, ja])
-        vw, aw = f"{names[jv]} speed limit", f"{names[ja]} acceleration limit"
-        if v_max is not None and v_max <= v:
-            v, vw = float(v_max), "v_max"
-        if a_max is not None and a_max <= a:
-            a, aw = float(a_max), "a_max"
-        v_cap.append(v)
-        a_cap.append(a)
-        v_why.append(vw)
-        a_why.append(aw if np.isfinite(a) else "torque limits")
-    return np.array(v_cap), np.array(a_cap), v_why, a_why
 
 
 def fastest_acceleration(
@@ -212,116 +185,153 @@ def fastest_acceleration(
     return np.where(moving, np.minimum(best, a_cap), 0.0)
 
 
-def _checked_inputs(
-    robot: Robot,
-    waypoints: ArrayLike,
-    blends: ArrayLike | None,
-    v_max: float | None,
-    a_max: float | None,
-) -> tuple[Array, Array]:
-    """The waypoints (K + 1, n) within the joints' position limits and the blends (K,)."""
-    w = check_waypoints(waypoints)
-    if w.shape[1] != robot.n:
-        raise KinergyError(f"waypoints have {w.shape[1]} joints but {robot.name} has {robot.n}")
-    for name, cap in (("v_max", v_max), ("a_max", a_max)):
-        if cap is not None and not (np.isfinite(cap) and cap > 0.0):
-            raise KinergyError(f"{name}: must be > 0, got {cap}")
-    for j, joint in enumerate(robot.joints):
-        lo, hi = joint.limits.position
-        bad = np.flatnonzero((w[:, j] < lo) | (w[:, j] > hi))
-        if bad.size:
-            i = int(bad[0])
-            raise KinergyError(
-                f"waypoint {i} ({'start' if i == 0 else f'move {i}'}): {joint.name} at "
-                f"{w[i, j]:.4g} rad is outside its limits [{lo:.4g}, {hi:.4g}] rad"
-            )
-    moves = w.shape[0] - 1
-    r = np.zeros(moves) if blends is None else np.asarray(blends, dtype=float)
-    r = np.broadcast_to(r, (moves,)).copy() if r.ndim == 0 else r
-    if r.shape != (moves,) or np.any(r < 0.0) or not np.all(np.isfinite(r)):
-        raise KinergyError(f"blends: expected {moves} finite values >= 0, got {np.shape(r)}")
-    if not np.any(np.abs(np.diff(w, axis=0)) > 0.0):
-        raise KinergyError("the task does not move: every target equals the start pose")
-    return w, r
-
-
-@serial
-def timing_problem(
-    robot: Robot,
-    waypoints: ArrayLike,
-    *,
-    blends: ArrayLike | None = None,
-    v_max: float | None = None,
-    a_max: float | None = None,
-    recovery: bool = True,
-    objective: Objective | None = None,
-) -> TimingProblem:
-    """Build the timing problem of a movej program through ``waypoints`` on ``robot``.
-
-    Parameters
-    ----------
-    robot : Robot
-    waypoints : array_like, shape (K + 1, n)
-        Start pose and the K targets, rad; each within the joints' position limits.
-    blends : float or array_like, shape (K,), optional
-        Joint-space blend radii, rad (default 0: every move stops at its target).
-    v_max, a_max : float, optional
-        Caps on the leading joint's speed (rad/s) and acceleration (rad/s^2) besides the joint
-        limits; without ``a_max`` a robot without acceleration limits (UR arms) is bounded by its
-        torque limits alone.
-    recovery : bool
-        Braking energy returns to the bus (default, as the seed): for the default objective.
-    objective : Objective, optional
-        What to minimise (:mod:`kinergy.optimize.objectives`); default
-        ``ElectricalEnergy(recovery)``.
-
-    Returns
-    -------
-    TimingProblem
-    """
-    w, r = _checked_inputs(robot, waypoints, blends, v_max, a_max)
-    travel = np.max(np.abs(np.diff(w, axis=0)), axis=1)
-    objective = ElectricalEnergy(recovery) if objective is None else objective
-    v_cap, a_cap, v_why, a_why = joint_caps(robot, w, v_max, a_max)
-    evaluate, cycle = _callables(robot, w, r, objective)
-    return TimingProblem(
-        waypoints=w,
-        travel=travel,
-        blends=r,
-        v_cap=v_cap,
-        a_cap=a_cap,
-        a_fast=fastest_acceleration(evaluate, travel, v_cap, a_cap),
-        evaluate=evaluate,
-        cycle=cycle,
-        objective=objective,
-        v_limit=tuple(v_why),
-        a_limit=tuple(a_why),
-    )
-
-
-def _given(value: ArrayLike | None, moves: int, name: str) -> Array:
-    """A per-move setting as written (NaN: not given), shape (K,)."""
-    if value is None:
-        return np.full(moves, np.nan)
-    arr = per_move(value, moves, name)
-    if np.any(arr[~np.isnan(arr)] <= 0.0) or np.any(np.isinf(arr)):
-        raise KinergyError(f"{name}: must be finite and > 0, got {arr.tolist()}")
-    return arr
-
-
-def program_settings(
-    problem: TimingProblem, speeds: ArrayLike | None, accels: ArrayLike | None
-) -> tuple[Array, Array]:
-    """The program as written: the given per-move ``v`` and ``a`` and, where not given (None or
-    NaN), the fastest feasible (``v_cap`` and the torque-limited ``a_fast``)."""
-    v = _given(speeds, problem.moves, "speeds")
-    a = _given(accels, problem.moves, "accels")
-    fast_v = np.where(np.isfinite(problem.v_cap), problem.v_cap, 1.0)
-    fast_a = np.where(problem.a_fast > 0.0, problem.a_fast, 1.0)
-    return np.where(np.isnan(v), fast_v, v), np.where(np.isnan(a), fast_a, a)
-
-
-def uniform_scaling(speeds: ArrayLike, accels: ArrayLike, factor: float) -> tuple[Array, Array]:
+def uniform_scaling(speeds: Array, accels: Array, factor: float) -> tuple[Array, Array]:
     """Speeds times ``factor`` and accelerations times ``factor^2``: the same movej program run
     ``factor`` times faster (every duration, ramp and blend overlap divided by ``factor``)."""
     return np.asarray(speeds, dtype=float) * factor, np.asarray(accels, dtype=float) * factor**2
+
+
+def path_caps(
+    robot: Robot, path: ProgramPath, v_max: float | None, a_max: float | None
+) -> tuple[Array, Array, list[str], list[str]]:
+    """Per move the largest ``v`` and ``a`` (the move's own units) that keep every joint within
+    its speed and acceleration limit and the caps (``inf``: none), and what sets each.
+
+    A joint that moves ``g_j = max |dq_j / ds|`` per unit of the move's path runs at ``g_j``
+    times its speed and acceleration (the path's curvature term ``q'' sd^2`` is left to the
+    500 Hz verification)."""
+    speed = np.array([j.limits.speed for j in robot.joints])
+    acc = np.array(
+        [np.inf if j.limits.acceleration is None else j.limits.acceleration for j in robot.joints]
+    )
+    if v_max is not None:
+        speed = np.minimum(speed, v_max)
+    if a_max is not None:
+        acc = np.minimum(acc, a_max)
+    names = robot.joint_names
+    v_cap, a_cap, v_why, a_why = [], [], [], []
+    for k in range(path.moves):
+        if path.tool[k] is None:
+            gain = np.abs(path.q_end[k] - path.q_start[k]) / max(path.travel[k], 1e-300)
+        else:
+            q = line_joints(robot, path, k)
+            step = path.travel[k] / (q.shape[0] - 1)
+            gain = np.max(np.abs(np.diff(q, axis=0)), axis=0) / max(step, 1e-300)
+        with np.errstate(divide="ignore", invalid="ignore"):  # a joint that does not move
+            v_joint = np.where(gain > 0.0, speed / gain, np.inf)
+            a_joint = np.where(gain > 0.0, acc / gain, np.inf)
+        jv, ja = int(np.argmin(v_joint)), int(np.argmin(a_joint))
+        v_cap.append(float(v_joint[jv]))
+        a_cap.append(float(a_joint[ja]))
+        v_why.append(f"{names[jv]} speed" + (" (v_max)" if v_max is not None else " limit"))
+        a_why.append(
+            f"{names[ja]} acceleration" + (" (a_max)" if a_max is not None else " limit")
+            if np.isfinite(a_joint[ja])
+            else "torque limits"
+        )
+    return np.array(v_cap), np.array(a_cap), v_why, a_why
+
+
+@dataclass(frozen=True, eq=False)
+class _PathModel:
+    """A resolved program's objective at the quadrature nodes of B timings: the total and each
+    move's part (the move and the events after it), and each move's torque ratio."""
+
+    robot: Robot
+    path: ProgramPath
+    objective: Objective
+    tables: LineTables
+
+    def parts(self, t: Array, f: Array) -> tuple[Array, Array, Array]:
+        """Objective (B,), its per-move parts (B, K) and torque ratios (B, K) of B timings
+        ``t, f`` (B, K)."""
+        samples = sample_path_programs(
+            self.robot, self.path, np.atleast_2d(t), np.atleast_2d(f), tables=self.tables
+        )
+        value, parts = self.objective(samples)
+        return value, parts, torque_ratio(self.robot, samples)
+
+    def evaluate(self, t: Array, f: Array) -> tuple[Array, Array]:
+        value, _, ratio = self.parts(t, f)
+        return value, ratio
+
+    def cycle(self, t: Array, f: Array) -> Array:
+        return path_schedule(self.path, np.atleast_2d(t), np.atleast_2d(f)).total
+
+
+def _problem(model: _PathModel, v_max: float | None, a_max: float | None) -> TimingProblem:
+    robot, path = model.robot, model.path
+    v_cap, a_cap, v_why, a_why = path_caps(robot, path, v_max, a_max)
+    program = path.program
+    a_fast = fastest_acceleration(
+        model.evaluate,
+        path.travel,
+        v_cap,
+        a_cap,
+        where=lambda k: program.where(program.moves[k].line),
+    )
+    return TimingProblem(
+        travel=path.travel,
+        blends=np.where(path.linked, path.blend, 0.0),
+        v_cap=v_cap,
+        a_cap=a_cap,
+        a_fast=a_fast,
+        evaluate=model.evaluate,
+        cycle=model.cycle,
+        objective=model.objective,
+        v_limit=tuple(v_why),
+        a_limit=tuple(a_why),
+        parts=model.parts,
+        linked=path.linked,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class PathChecks:
+    """A program's path, its timing problem (and per-move objective, :func:`kinergy.optimize.
+    timing.allocated`) and its re-simulation at 500 Hz against the caps."""
+
+    robot: Robot
+    path: ProgramPath
+    problem: TimingProblem
+    caps: Caps
+    model: _PathModel
+    standby: float = 0.0
+
+    def simulate(self, v: Array, a: Array, label: str, predicted: float | None = None) -> PathRun:
+        return simulate_path(
+            self.robot,
+            self.path.with_timing(v, a),
+            standby=self.standby,
+            objective=self.problem.objective,
+            speed_cap=self.caps.speed,
+            acceleration_cap=self.caps.acceleration,
+            label=label,
+            predicted=predicted,
+        )
+
+    def run(self, v: Array, a: Array, label: str, predicted: float | None = None) -> ProgramResult:
+        return self.simulate(v, a, label, predicted).result
+
+
+#: the timing solver's caps are this share below the program's: its iterations end a few ms off
+#: the cycle time, and the uniform rescaling to it must stay within the caps
+SLACK = 0.005
+
+
+def path_checks(
+    robot: Robot, path: ProgramPath, objective: Objective, caps: Caps, standby: float = 0.0
+) -> PathChecks:
+    """The timing problem of ``path`` with the caps :data:`SLACK` below ``caps`` (speed, and its
+    square for acceleration: what a uniform rescaling by ``1 + SLACK`` needs), and its checks
+    (``standby``: the arm's standing draw, W, for the supply figures).
+
+    Raises
+    ------
+    KinergyError
+        A move whose torques exceed the limits at any acceleration (naming its line).
+    """
+    slack = Caps(caps.speed * (1.0 - SLACK), caps.acceleration * (1.0 - SLACK) ** 2)
+    model = _PathModel(robot, path, objective, line_tables(robot, path))
+    problem = _problem(model, slack.speed, slack.acceleration)
+    return PathChecks(robot, path, problem, slack, model, standby)

@@ -1,12 +1,14 @@
-"""Energy-optimal robot programs: the path levers and the timing of a URScript program.
+"""The optimiser: a robot program doing the same job with less energy, at a cycle time.
 
-:func:`optimize_program` takes a :class:`~kinergy.trajectory.robot_program.RobotProgram` and
-returns the same program (same moves, events and line order) with changed targets, blend radii,
-speeds and accelerations that does the same job with less supply energy
-(:data:`kinergy.optimize.objectives.PROGRAM_OBJECTIVE`) at the same cycle time. The levers, in
-order (:mod:`kinergy.optimize.program_levers`), each judged at the cycle time, repaired first
-should it break a limit there (:mod:`kinergy.optimize.program_repair`), and kept only if its
-re-simulation scores better than the program before it:
+:func:`optimize_program` takes a :class:`~kinergy.trajectory.robot_program.RobotProgram` (read
+from a URScript file, or a task file's movej program, :mod:`kinergy.io.task`) and returns the
+same program (same moves, events and line order) with changed targets, blend radii, speeds and
+accelerations that does the same job with less supply energy
+(:class:`kinergy.optimize.objectives.SupplyEnergy`: the motors on the DC bus, braking surplus
+lost, plus the arm's standing draw over the cycle) at the same cycle time. The levers, in order
+(:mod:`kinergy.optimize.levers`), each judged at the cycle time, repaired first should it break a
+limit there (:mod:`kinergy.optimize.repair`), and kept only if its re-simulation scores better
+than the program before it:
 
 1. ``2 pi``: every joint target takes the ``2 pi`` turn nearest the joints it comes from, within
    the joint limits (it changes no pose: always on);
@@ -17,68 +19,68 @@ re-simulation scores better than the program before it:
    may be left out of the route (``keep``, the default: the route may avoid something);
 5. ``blends``: via points (a move followed by a move, no event between) get a blend radius of
    40 % of the shorter tool distance of the two moves, at most 10 cm;
-6. ``timing``: every move's ``v`` and ``a`` (:func:`kinergy.optimize.program_timing.retime`).
+6. ``timing``: every move's ``v`` and ``a`` (:func:`kinergy.optimize.timing.retime`).
 
-Levers 1-4 are one search (:mod:`kinergy.optimize.program_search`: dynamic programming over the
-targets' states with a cheap energy estimate of every move, :mod:`kinergy.optimize.path_costs`),
-restricted per lever. Every figure is a 500 Hz re-simulation
-(:func:`kinergy.optimize.program_verify.simulate_path`) at the program's cycle time, with every
-joint limit checked at every sample and, by default, no joint faster or harder than the program
-itself moves. Every step stops on iteration limits and tolerances, never on a clock: the same
-program on every host. :func:`target_errors` checks the optimised program against every target
-of the original.
+Levers 1-4 are one search (:mod:`kinergy.optimize.search`: dynamic programming over the targets'
+states with a cheap energy estimate of every move, :mod:`kinergy.optimize.path_costs`), restricted
+per lever. Every figure is a 500 Hz re-simulation (:func:`kinergy.optimize.verify.simulate_path`)
+at the cycle time, with every joint limit checked at every sample and, by default, no joint
+faster or harder than the program itself moves (:class:`kinergy.optimize.problem.Caps`). Every
+step stops on iteration limits and tolerances, never on a clock: the same program on every host.
+:func:`pareto_front` re-times the optimised path at other cycle times.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
-from kinergy.optimize.objectives import PROGRAM_OBJECTIVE, Objective
-from kinergy.optimize.options import ProgramOptions, ViaPoints
-from kinergy.optimize.program import serial
-from kinergy.optimize.program_levers import (
+from kinergy.optimize.levers import (
     Lever,
     LeverSearch,
     LeverStatus,
     PathLevers,
     path_levers,
-    supply,
     timed,
     via_blends,
     with_timing,
 )
-from kinergy.optimize.program_repair import NO_ROOM, Caps, timing_checks
-from kinergy.optimize.program_timing import retime
-from kinergy.optimize.program_verify import PathRun, TargetCheck, simulate_path, target_errors
+from kinergy.optimize.objectives import Objective, SupplyEnergy
+from kinergy.optimize.options import ProgramOptions, ViaPoints
+from kinergy.optimize.problem import Caps
+from kinergy.optimize.repair import Context, at_cycle
+from kinergy.optimize.samples import serial
+from kinergy.optimize.timing import NO_ROOM, Verified, check_cycle_time, retime
+from kinergy.optimize.verify import PathRun, TargetCheck, target_errors
 from kinergy.trajectory.program_path import ProgramPath, program_path
 from kinergy.trajectory.robot_program import RobotProgram
 
 __all__ = [
+    "MAX_MOVES",
     "TARGET_TOL",
-    "Lever",
-    "LeverStatus",
+    "ParetoPoint",
     "ProgramOptimization",
     "ProgramSettings",
     "optimize_program",
-    "supply",
-    "via_blends",
+    "pareto_front",
 ]
 
 
 #: targets are met within these (m, rad) and the arm is at rest below this joint speed (rad/s)
 TARGET_TOL = (1e-3, np.deg2rad(0.5), 1e-3)
+#: the most moves a program may have (a 30-move program takes under a minute on two cores)
+MAX_MOVES = 100
 
 
 @dataclass(frozen=True)
 class ProgramSettings:
-    """The options an optimisation ran with, resolved: the robot file's standby where none was
-    given, the program's own peaks as caps, its own cycle time.
+    """The options an optimisation ran with, resolved: the robot file's standing draw where none
+    was given, the program's own peaks as caps, its own cycle time.
 
     Attributes
     ----------
@@ -103,10 +105,33 @@ class ProgramSettings:
             "tool_symmetry": self.options.tool_symmetry.value,
             "via_points": self.options.via.value,
             "blends": self.options.blends,
+            "fixed_shares": self.options.fixed_shares,
             "standby": self.standby,
             "v_max": self.caps.speed,
             "a_max": self.caps.acceleration,
             "cycle_time": self.cycle_time,
+        }
+
+
+@dataclass(frozen=True)
+class ParetoPoint:
+    """The supply energy at one cycle time: the optimised path re-timed and the program as
+    written uniformly scaled, re-simulated at 500 Hz (J), and whether each keeps every limit at
+    every sample (None: the program cannot run at that cycle time)."""
+
+    cycle_time: float
+    optimized: float | None
+    uniform: float
+    optimized_ok: bool
+    uniform_ok: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "cycle_time": self.cycle_time,
+            "optimized": self.optimized,
+            "uniform": self.uniform,
+            "optimized_within_limits": self.optimized_ok,
+            "uniform_within_limits": self.uniform_ok,
         }
 
 
@@ -125,6 +150,10 @@ class ProgramOptimization:
         The optimised program at every target of the original.
     settings : ProgramSettings
         The options used.
+    timing : Verified or None
+        How the timing lever's solution came about (None when it could not run).
+    pareto : tuple of ParetoPoint
+        Energy against cycle time (:func:`pareto_front`), empty unless asked for.
     """
 
     program: PathRun
@@ -132,6 +161,8 @@ class ProgramOptimization:
     levers: tuple[Lever, ...]
     targets: list[TargetCheck]
     settings: ProgramSettings
+    timing: Verified | None = None
+    pareto: tuple[ParetoPoint, ...] = ()
 
     @property
     def written(self) -> RobotProgram:
@@ -140,8 +171,19 @@ class ProgramOptimization:
 
     @property
     def saving(self) -> float:
-        """Share of the supply energy saved, 0-1."""
-        return 1.0 - supply(self.optimized.result) / supply(self.program.result)
+        """Share of the supply energy saved (the objective), 0-1."""
+        return self.saving_supply
+
+    @property
+    def saving_supply(self) -> float:
+        """Share of what the arm draws from its supply per cycle saved, 0-1: the motors and the
+        standing draw over the cycle."""
+        return 1.0 - self.optimized.result.e_supply / self.program.result.e_supply
+
+    @property
+    def saving_motors(self) -> float:
+        """Share of the motors' energy saved (on the DC bus, braking surplus lost), 0-1."""
+        return 1.0 - self.optimized.result.e_elec / self.program.result.e_elec
 
     @property
     def targets_met(self) -> bool:
@@ -154,43 +196,51 @@ class ProgramOptimization:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        out: dict[str, Any] = {}
-        for key, run in (("program", self.program), ("optimized", self.optimized)):
-            d = run.result.to_dict()
-            d["e_supply"] = run.result.score
-            out[key] = d
-        out["saving"] = self.saving
-        out["levers"] = [lever.to_dict() for lever in self.levers]
-        out["targets"] = [c.to_dict() for c in self.targets]
-        out["targets_met"] = self.targets_met
-        out["settings"] = self.settings.to_dict()
-        return out
+        return {
+            "program": self.program.result.to_dict(),
+            "optimized": self.optimized.result.to_dict(),
+            "saving": self.saving,
+            "saving_supply": self.saving_supply,
+            "saving_motors": self.saving_motors,
+            "levers": [lever.to_dict() for lever in self.levers],
+            "timing": None if self.timing is None else self.timing.to_dict(),
+            "targets": [c.to_dict() for c in self.targets],
+            "targets_met": self.targets_met,
+            "settings": self.settings.to_dict(),
+            "pareto": [p.to_dict() for p in self.pareto],
+        }
 
 
 def _as_written(
-    robot: Robot, path: ProgramPath, objective: Objective, options: ProgramOptions
+    robot: Robot, path: ProgramPath, objective: Objective, options: ProgramOptions, standby: float
 ) -> tuple[PathRun, Caps]:
-    """The program re-simulated, and the joint speed and acceleration caps: ``v_max`` and
-    ``a_max``, or the program's own peaks."""
-    own = simulate_path(robot, path, objective=objective)
+    """The program re-simulated against the caps, and the caps: ``v_max`` and ``a_max``, or the
+    program's own peak joint speed and acceleration."""
+    own = Context(robot, 1.0, objective, Caps(np.inf, np.inf), standby).run(path, "program")
     caps = Caps(
         float(np.max(np.abs(own.motion.qd))) if options.v_max is None else options.v_max,
         float(np.max(np.abs(own.motion.qdd))) if options.a_max is None else options.a_max,
     )
-    checked = simulate_path(
-        robot, path, objective=objective, speed_cap=caps.speed, acceleration_cap=caps.acceleration
-    )
+    checked = Context(robot, 1.0, objective, caps, standby).run(path, "program")
     return checked, caps
 
 
 def _timing_only(search: LeverSearch, path: ProgramPath, say: Callable[[str], None]) -> None:
     """The program as written, only re-timed, judged against the levers' best: kept when it
     beats them (a lever chain whose own re-timing stopped short of it), recorded either way
-    (what re-timing alone saves)."""
+    (what re-timing alone saves). When no path lever was kept the timing lever re-timed this
+    very path: its figure is recorded again."""
+    timing = next((lv for lv in search.levers if lv.name == "timing"), None)
+    if timing is not None and search.best.path.program.moves == path.program.moves:
+        note = "the program as written, re-timed: as the timing lever (no path lever was kept)"
+        status = LeverStatus.NOT_BETTER if timing.kept else timing.status
+        search.record(Lever("timing only", timing.result, status, 0.0, note, timing.repaired))
+        return
     say("timing only: re-timing the program as written")
-    checks = timing_checks(search.robot, path, search.objective, search.caps)
     try:
-        result, verified = retime(checks, search.budget)
+        result, verified = retime(
+            search.ctx.checks(path), search.budget, share_budget=search.ctx.share_budget, starts=1
+        )
     except KinergyError as exc:  # the timing model's fastest is above the budget
         note = f"the program as written, re-timed: no room: the solver keeps {NO_ROOM}; {exc}"
         search.record(Lever("timing only", search.best.result, LeverStatus.NOT_POSSIBLE, note=note))
@@ -204,12 +254,42 @@ def _timing_only(search: LeverSearch, path: ProgramPath, say: Callable[[str], No
     )
 
 
+def _context(
+    robot: Robot,
+    program: RobotProgram,
+    options: ProgramOptions,
+    objective: Objective | None,
+) -> tuple[ProgramPath, PathRun, Context]:
+    """The program resolved and run as written, and the context every lever is judged in (the
+    cycle time checked against the fastest possible once, here)."""
+    if len(program.moves) > MAX_MOVES:
+        raise KinergyError(
+            f"{program.path or program.name}: {len(program.moves)} moves; the optimiser takes "
+            f"at most {MAX_MOVES} (split the program)"
+        )
+    standby = robot.standby_power if options.standby is None else options.standby
+    objective = SupplyEnergy(standby) if objective is None else objective
+    path = program_path(robot, program)
+    if not np.any(path.travel > 0.0):
+        raise KinergyError(
+            f"{program.path or program.name}: no move changes the arm's position; nothing to "
+            "optimise"
+        )
+    own, caps = _as_written(robot, path, objective, options, standby)
+    budget = own.result.cycle_time if options.cycle_time is None else options.cycle_time
+    ctx = Context(robot, budget, objective, caps, standby, share_budget=not options.fixed_shares)
+    if options.cycle_time is not None:
+        check_cycle_time(ctx.checks(path).problem, path, budget)
+    return path, own, ctx
+
+
 @serial
 def optimize_program(
     robot: Robot,
     program: RobotProgram,
     options: ProgramOptions | None = None,
     *,
+    objective: Objective | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> ProgramOptimization:
     """The energy-optimal program doing the same job at a cycle time (module docstring).
@@ -221,6 +301,8 @@ def optimize_program(
     options : ProgramOptions, optional
         The levers and limits (default :class:`ProgramOptions`: configurations and via points
         kept, no tool symmetry, blends, the program's own cycle time and peaks).
+    objective : Objective, optional
+        What to minimise (default :class:`SupplyEnergy` with the standing draw).
     progress : callable, optional
         Called with a line before each long step.
 
@@ -228,32 +310,21 @@ def optimize_program(
     ------
     KinergyError
         A target out of reach or outside the joint limits, a cycle time shorter than the fastest
-        possible (naming the program line).
+        possible (naming the program line), more than :data:`MAX_MOVES` moves.
     """
     options = ProgramOptions() if options is None else options
     say = progress if progress is not None else (lambda _: None)
-    standby = robot.standby_power if options.standby is None else options.standby
-    objective = PROGRAM_OBJECTIVE(standby)
-    path = program_path(robot, program)
-    if not np.any(path.travel > 0.0):
-        raise KinergyError(
-            f"{program.path or program.name}: no move changes the arm's position; nothing to "
-            "optimise"
-        )
     say(f"{program.name}: simulating the program at 500 Hz")
-    own, caps = _as_written(robot, path, objective, options)
-    budget = own.result.cycle_time if options.cycle_time is None else options.cycle_time
-    search = LeverSearch(robot, budget, objective, caps, own)
-    if options.cycle_time is not None:
-        _check_cycle_time(robot, path, objective, caps, budget)
-        if abs(budget - own.result.cycle_time) > 1e-9:
-            say("uniform scaling to the cycle time")
-            search.rescale()
+    path, own, ctx = _context(robot, program, options, objective)
+    search = LeverSearch(ctx, own)
+    if abs(ctx.budget - own.result.cycle_time) > 1e-9:
+        say("uniform scaling to the cycle time")
+        search.rescale()
     levers = PathLevers(
         free=options.configurations.value == "free",
         symmetry=options.tool_symmetry,
         via=options.via is ViaPoints.FREE,
-        standby=standby,
+        standby=ctx.standby,
     )
     path_levers(search, path, levers, say)
     if options.blends:
@@ -263,31 +334,69 @@ def optimize_program(
     timed(search, say)
     _timing_only(search, path, say)
     optimized = search.best
-    found = tuple(search.levers)
     say("checking the targets")
     targets = target_errors(
-        robot,
-        path,
-        optimized,
-        symmetry=options.tool_symmetry,
-        left_out=search.left_out,
+        robot, path, optimized, symmetry=options.tool_symmetry, left_out=search.left_out
     )
-    settings = ProgramSettings(options, standby, caps, budget)
-    return ProgramOptimization(own, optimized, found, targets, settings)
+    settings = ProgramSettings(options, ctx.standby, ctx.caps, ctx.budget)
+    return ProgramOptimization(
+        own, optimized, tuple(search.levers), targets, settings, search.timing
+    )
 
 
-def _check_cycle_time(
-    robot: Robot, path: ProgramPath, objective: Objective, caps: Caps, budget: float
-) -> None:
-    """Refuse a cycle time below the program's fastest within the caps (naming the longest
-    move's line), before any lever is tried."""
-    checks = timing_checks(robot, path, objective, caps)
-    fastest = checks.problem.fastest_cycle_time
-    if budget < fastest * (1.0 - 1e-9):
-        t_fast, _ = checks.problem.fastest
-        k = int(np.argmax(t_fast))
-        line = path.program.where(path.program.moves[k].line)
-        raise KinergyError(
-            f"cycle time {budget:.4g} s is shorter than the fastest possible {fastest:.4g} s "
-            f"(every move at its speed, acceleration and torque limits; the longest move: {line})"
-        )
+def _cycle_times(points: int, fastest: float, own: float) -> list[float]:
+    """``points`` cycle times from the fastest possible to twice the program's own, and its own,
+    s, increasing."""
+    return [float(t) for t in np.unique(np.append(np.linspace(fastest, 2.0 * own, points), own))]
+
+
+@serial
+def pareto_front(
+    robot: Robot,
+    result: ProgramOptimization,
+    *,
+    points: int = 8,
+    cycle_times: Sequence[float] | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> tuple[ParetoPoint, ...]:
+    """Energy against cycle time: the optimised path re-timed (:func:`kinergy.optimize.timing.
+    retime`, within the same caps) and the program as written uniformly scaled, at each cycle
+    time: ``cycle_times`` (s), or ``points`` (>= 2) from the fastest possible on the optimised
+    path to twice the program's own, plus its own.
+
+    Returns
+    -------
+    tuple of ParetoPoint
+        By increasing cycle time.
+    """
+    say = progress if progress is not None else (lambda _: None)
+    settings = result.settings
+    ctx = Context(
+        robot,
+        settings.cycle_time,
+        SupplyEnergy(settings.standby),
+        settings.caps,
+        settings.standby,
+        share_budget=not settings.options.fixed_shares,
+    )
+    best = result.optimized.path
+    checks = ctx.checks(best)
+    own = result.program.result.cycle_time
+    if cycle_times is None:
+        if points < 2:
+            raise KinergyError(f"points: need at least 2 cycle times, got {points}")
+        times = _cycle_times(points, checks.problem.fastest_cycle_time, own)
+    else:
+        times = sorted(float(t) for t in cycle_times)
+    out = []
+    written = result.program.path
+    for i, budget in enumerate(times):
+        say(f"Pareto front: cycle time {budget:.3f} s ({i + 1}/{len(times)})")
+        uniform = at_cycle(replace(ctx, budget=budget), written, "uniform").result
+        try:
+            timed_run, _ = retime(checks, budget, share_budget=ctx.share_budget)
+            optimized, ok = timed_run.e_supply, timed_run.ok
+        except KinergyError:
+            optimized, ok = None, False
+        out.append(ParetoPoint(budget, optimized, uniform.e_supply, ok, uniform.ok))
+    return tuple(out)

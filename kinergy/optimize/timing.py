@@ -1,12 +1,11 @@
-"""Energy-optimal timing of a movej program: per-move speeds and accelerations for a cycle time.
+"""Energy-optimal timing of a robot program: per-move speeds and accelerations for a cycle time.
 
-A task is fixed by its waypoints (the path in joint space); what a UR program is free to choose is
-how fast each move runs: URScript's ``movej(q, a=..., v=...)`` per move. For a cycle-time budget
-``T`` this module finds the per-move ``v_k, a_k`` (and, optionally, how ``T`` is shared among the
-moves) that minimise the electrical energy the model predicts (UR5e eq 26, summed over the
-motors), within the joints' speed, acceleration, torque and position limits, and verifies every
-result by re-simulating the movej at the controller's 500 Hz with
-:func:`kinergy.accounting.energy.energy` and :func:`limit_violations`.
+The timing lever of a program: each move's ``v`` and ``a``, its path and its events' times fixed.
+For a cycle-time budget ``T`` :func:`retime` finds the per-move ``v_k, a_k`` (and, optionally,
+how ``T`` is shared among the moves) that minimise the objective (the supply energy the model
+predicts, :mod:`kinergy.optimize.objectives`) within the joints' speed, acceleration, torque and
+position limits and the caps, and verifies every result by re-simulating the program at the
+controller's 500 Hz (:func:`kinergy.optimize.verify.simulate_path`).
 
 Physics: what the timing can and cannot change
 ----------------------------------------------
@@ -37,220 +36,79 @@ cycle time) the viscous energy falls like ``1 / T`` while gravity copper grows l
 UR5e the viscous term dominates for cycle times around the programs' own, so the front falls
 over the range kinergy scans (fastest feasible to twice the program's time).
 
-What this gives on the seed UR5e model, test A at its own 13.1 s (3 rad/s, 6 rad/s^2): of
-1015 J, friction is 959 J (Coulomb 407 J, viscous 552 J) and copper 56 J; the optimum (about
-8 %) comes from the viscous part, which even a rectangular speed profile with the best budget
-shares could only bring to about 454 J: the Coulomb floor and the budget bound the saving.
-
 How it is solved
 ----------------
-:func:`kinergy.optimize.timing_problem` builds the problem (arrays and callables),
-:func:`kinergy.optimize.solve.solve_timing` solves it with SLSQP on the quadrature of
-:mod:`kinergy.optimize.program`, and :func:`kinergy.optimize.verify.simulate_program` re-simulates
-every result at 500 Hz (``dt = 0.002``): the energy reported is that re-simulation's (the
-quadrature agrees within about 0.1 %), and the limits are checked at every one of its samples.
-Should a sample exceed a limit the quadrature nodes missed, the caps are tightened by the excess
-and the problem solved again. The objective is pluggable (:mod:`kinergy.optimize.objectives`);
-the default is the electrical energy.
+:func:`kinergy.optimize.problem.path_checks` builds the problem (arrays and callables),
+:func:`allocated` shares the budget among the moves as if each ran alone (a grid per move and
+dynamic programming over the time used), :func:`kinergy.optimize.solve.solve_timing` polishes the
+better of that start and uniform time scaling with SLSQP on the quadrature of
+:mod:`kinergy.optimize.samples`, and every result is re-simulated at 500 Hz: the energy reported
+is that re-simulation's, and the limits are checked at every one of its samples. Should a sample
+exceed a limit the quadrature nodes missed, the caps are tightened by the excess and the problem
+solved again. Every step stops on iterations and tolerances, never on a clock: the same answer on
+every host. :func:`check_cycle_time` is the one refusal of a budget below the fastest possible.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import time
-from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import NDArray
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import LIMIT_TOL
-from kinergy.optimize.objectives import Objective
-from kinergy.optimize.problem import (
-    TimingProblem,
-    program_settings,
-    timing_problem,
-    uniform_scaling,
-)
-from kinergy.optimize.program import durations, serial
+from kinergy.optimize.problem import SLACK, PathChecks, TimingProblem, uniform_scaling
+from kinergy.optimize.samples import durations, settings
 from kinergy.optimize.solve import Outcome, Solution, solve_timing
-from kinergy.optimize.verify import ProgramResult, simulate_program
+from kinergy.optimize.verify import ProgramResult
+from kinergy.trajectory.program_path import ProgramPath
 
 __all__ = [
-    "Checks",
-    "ParetoPoint",
-    "TimingResult",
+    "NO_ROOM",
     "Verified",
-    "best_verified",
-    "optimize_timing",
-    "pareto_front",
-    "uniform_wins",
+    "allocated",
+    "check_cycle_time",
+    "retime",
+    "scaled_to",
 ]
 
 
-@dataclass(frozen=True, eq=False)
-class TimingResult:
-    """The program as written, uniform time scaling and the energy-optimal timing at one cycle
-    time, each re-simulated at 500 Hz.
+#: why the timing solver may find no timing for a program that runs within its caps as written
+NO_ROOM = f"{100 * SLACK:g} % below the speed caps (its iterations end a few ms off the cycle time)"
+#: SLSQP iterations per attempt of the timing solver
+_MAXITER = 25
+#: the allocation's grid: durations per move, ramp fractions, programs evaluated at once, and
+#: the steps of the budget its dynamic programme counts in
+_DURATIONS = 24
+_RAMPS = 8
+_CHUNK = 24
+_UNITS = 2000
 
-    Attributes
-    ----------
-    cycle_time : float
-        The budget, s.
-    program, uniform, optimized : ProgramResult
-    fastest_cycle_time : float
-        Shortest cycle time within the limits (every move at its fastest feasible setting), s.
-    v_cap, a_cap : ndarray, shape (K,)
-        The optimiser's bounds on each move's ``v`` and ``a`` (``inf``: none but torque).
-    active : list of str
-        The limits the optimum runs into (one line each).
-    iterations : int
-        SLSQP iterations (all attempts).
-    seconds : float
-        Wall time of the optimisation and its verification, s (measured, never a budget).
-    solver : Verified
-        Why the solver stopped and whether uniform scaling was kept instead.
+
+def check_cycle_time(problem: TimingProblem, path: ProgramPath, budget: float) -> None:
+    """Refuse a cycle time below the program's fastest within the caps, naming the longest move's
+    line: every move at its speed, acceleration and torque limits.
+
+    Raises
+    ------
+    KinergyError
+        One line.
     """
-
-    cycle_time: float
-    program: ProgramResult
-    uniform: ProgramResult
-    optimized: ProgramResult
-    fastest_cycle_time: float
-    v_cap: Array
-    a_cap: Array
-    active: list[str]
-    iterations: int
-    seconds: float
-    solver: Verified
-
-    @property
-    def message(self) -> str:
-        """What the solver did, in words (:attr:`Verified.words`)."""
-        return self.solver.words
-
-    @property
-    def saving(self) -> float:
-        """``1 - E_optimized / E_program`` (fraction)."""
-        return 1.0 - self.optimized.e_elec / self.program.e_elec
-
-    @property
-    def saving_vs_uniform(self) -> float:
-        """``1 - E_optimized / E_uniform`` (fraction)."""
-        return 1.0 - self.optimized.e_elec / self.uniform.e_elec
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "cycle_time": self.cycle_time,
-            "fastest_cycle_time": self.fastest_cycle_time,
-            "program": self.program.to_dict(),
-            "uniform": self.uniform.to_dict(),
-            "optimized": self.optimized.to_dict(),
-            "saving": self.saving,
-            "saving_vs_uniform": self.saving_vs_uniform,
-            "saving_percent": 100.0 * self.saving,
-            "caps": {
-                "v": [float(x) if np.isfinite(x) else None for x in self.v_cap],
-                "a": [float(x) if np.isfinite(x) else None for x in self.a_cap],
-            },
-            "active_limits": list(self.active),
-            "solver": {
-                "iterations": self.iterations,
-                "seconds": self.seconds,
-                "outcome": None if self.solver.outcome is None else self.solver.outcome.value,
-                "message": self.message,
-            },
-        }
-
-
-class Checks(Protocol):
-    """How every program of one comparison is re-simulated, checked and scored: the problem,
-    and ``run(v, a, label, predicted)`` -> the re-simulated :class:`ProgramResult` (with its
-    ``score``)."""
-
-    @property
-    def problem(self) -> TimingProblem: ...
-
-    def run(
-        self, v: Array, a: Array, label: str, predicted: float | None = None
-    ) -> ProgramResult: ...
-
-
-@dataclass(frozen=True)
-class _Checks:
-    """How every program of one comparison is re-simulated, checked and scored (movej)."""
-
-    robot: Robot
-    problem: TimingProblem
-    v_max: float | None
-    a_max: float | None
-    recovery: bool
-
-    def run(self, v: Array, a: Array, label: str, predicted: float | None = None) -> ProgramResult:
-        return simulate_program(
-            self.robot,
-            self.problem.waypoints,
-            v,
-            a,
-            self.problem.blends,
-            recovery=self.recovery,
-            speed_cap=self.v_max,
-            acceleration_cap=self.a_max,
-            label=label,
-            predicted=predicted,
-            objective=self.problem.objective,
+    fastest = problem.fastest_cycle_time
+    if budget < fastest * (1.0 - 1e-9):
+        t_fast, _ = problem.fastest
+        k = int(np.argmax(t_fast))
+        raise KinergyError(
+            f"cycle time {budget:.4g} s is shorter than the fastest possible {fastest:.4g} s "
+            "(every move at its speed, acceleration and torque limits; the longest move: "
+            f"{path.program.where(path.program.moves[k].line)})"
         )
 
 
-@dataclass(frozen=True)
-class Caps:
-    """The caps of one comparison besides the robot's limits: every joint's speed (rad/s) and
-    acceleration (rad/s^2), None for none; and whether braking energy returns to the bus."""
-
-    v_max: float | None = None
-    a_max: float | None = None
-    recovery: bool = True
-
-
-def _comparison(
-    robot: Robot,
-    waypoints: ArrayLike,
-    problem: TimingProblem | None,
-    written: tuple[ArrayLike | None, ArrayLike | None],
-    blends: ArrayLike | None,
-    caps: Caps,
-    objective: Objective | None,
-) -> tuple[_Checks, Array, Array]:
-    """The checks of one comparison and the program as written (per-move ``v``, ``a`` from the
-    ``written`` speeds and accelerations), building the problem from the blends, the caps and
-    ``objective`` unless given."""
-    if problem is None:
-        problem = timing_problem(
-            robot,
-            waypoints,
-            blends=blends,
-            v_max=caps.v_max,
-            a_max=caps.a_max,
-            recovery=caps.recovery,
-            objective=objective,
-        )
-    checks = _Checks(robot, problem, caps.v_max, caps.a_max, caps.recovery)
-    v_prog, a_prog = program_settings(problem, *written)
-    return checks, v_prog, a_prog
-
-
-def _scaled_to(
-    problem: TimingProblem, v: Array, a: Array, cycle_time: float
-) -> tuple[Array, Array]:
-    """Settings ``(v, a)`` uniformly scaled so that the program takes ``cycle_time``."""
-    return uniform_scaling(v, a, problem.cycle_time(v, a) / cycle_time)
-
-
-def uniform_wins(uniform: ProgramResult, optimized: ProgramResult) -> bool:
+def _uniform_wins(uniform: ProgramResult, optimized: ProgramResult) -> bool:
     """Whether uniform scaling keeps the limits and the optimum does not, or scores better."""
     assert uniform.score is not None and optimized.score is not None
     return uniform.ok and (not optimized.ok or uniform.score < optimized.score)
@@ -270,7 +128,7 @@ def _tightened(problem: TimingProblem, over: dict[str, float]) -> TimingProblem:
 
 
 def _optimum(
-    checks: Checks,
+    checks: PathChecks,
     cycle_time: float,
     v0: Array,
     a0: Array,
@@ -344,13 +202,22 @@ def _active(problem: TimingProblem, result: ProgramResult) -> list[str]:
 class Verified:
     """How a verified timing came about: why the solver stopped (None at the fastest cycle
     time, where nothing is left to choose), whether its start (uniform scaling, or another
-    named one) was kept because the solver ended above it, and the solver's iterations (all
-    attempts)."""
+    named one) was kept because the solver ended above it, the solver's iterations (all
+    attempts) and the limits the result runs into (one line each)."""
 
     outcome: Outcome | None
     start_kept: bool
     iterations: int
     start: str = "uniform scaling"
+    active: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict[str, object]:
+        return {
+            "outcome": None if self.outcome is None else self.outcome.value,
+            "message": self.words,
+            "iterations": self.iterations,
+            "active_limits": list(self.active),
+        }
 
     @property
     def words(self) -> str:
@@ -368,8 +235,8 @@ class Verified:
         return text
 
 
-def best_verified(
-    checks: Checks,
+def _best_verified(
+    checks: PathChecks,
     cycle_time: float,
     v0: Array,
     a0: Array,
@@ -387,193 +254,198 @@ def best_verified(
         checks, cycle_time, v0, a0, share_budget=share_budget, maxiter=maxiter
     )
     # uniform scaling to the budget is the program itself at the program's own cycle time
-    kept = uniform_wins(start, optimized)
+    kept = _uniform_wins(start, optimized)
     if kept:
         optimized = checks.run(start.speeds, start.accels, "optimized")
-    return optimized, Verified(None if sol is None else sol.outcome, kept, iterations, label)
+    outcome = None if sol is None else sol.outcome
+    active = tuple(_active(checks.problem, optimized))
+    return optimized, Verified(outcome, kept, iterations, label, active)
 
 
-def _budget(cycle_time: float | None, program: ProgramResult, fastest: float) -> float:
-    """The cycle-time budget, s: the program's own unless given; at least the fastest."""
-    budget = program.cycle_time if cycle_time is None else float(cycle_time)
-    if not (np.isfinite(budget) and budget > 0.0):
-        raise KinergyError(f"cycle time: must be > 0 s, got {cycle_time}")
-    if budget < fastest * (1.0 - 1e-9):
+def _grid_energy(
+    checks: PathChecks, moving: NDArray[np.intp], grid_t: Array, grid_f: Array
+) -> tuple[Array, Array]:
+    """Each moving move's part of the objective at every grid duration (D, m), with its cheapest
+    ramp fraction of ``grid_f`` (R, m) within its speed and acceleration caps and torque limits:
+    the least part (D, m, inf where none fits) and that ramp fraction (D, m). Program ``(d, r)``
+    of the grid runs every move at its own ``(grid_t[d], grid_f[r])``."""
+    model, problem, path = checks.model, checks.problem, checks.path
+    assert model is not None
+    d_count, r_count = grid_t.shape[0], grid_f.shape[0]
+    dist = path.travel[moving]
+    t_all = np.repeat(grid_t, r_count, axis=0)  # (D R, m)
+    f_all = np.tile(grid_f, (d_count, 1))
+    v_all, a_all, _ = settings(dist, t_all, f_all)
+    t_full = np.zeros((t_all.shape[0], path.moves))
+    f_full = np.ones((t_all.shape[0], path.moves))
+    t_full[:, moving], f_full[:, moving] = t_all, f_all
+    parts, ratio = [], []
+    for lo in range(0, t_full.shape[0], _CHUNK):
+        _, p, r = model.parts(t_full[lo : lo + _CHUNK], f_full[lo : lo + _CHUNK])
+        parts.append(p[:, moving])
+        ratio.append(r[:, moving])
+    ok = (
+        (np.vstack(ratio) <= 1.0 - 1e-3)
+        & (v_all <= problem.v_cap[moving] * (1.0 + 1e-9))
+        & (a_all <= problem.a_fast[moving] * (1.0 + 1e-9))
+    )
+    energy = np.where(ok, np.vstack(parts), np.inf).reshape(d_count, r_count, moving.size)
+    pick = np.argmin(energy, axis=1)  # (D, m)
+    best = np.take_along_axis(energy, pick[:, None, :], axis=1)[:, 0, :]
+    ramp = np.take_along_axis(grid_f, pick, axis=0)  # (D, m)
+    return best, ramp
+
+
+def _share(best: Array, grid_t: Array, total: float) -> NDArray[np.intp] | None:
+    """The grid duration of every move (index per move) whose sum uses ``total`` (to the step;
+    else the most that fits) at the least summed part ``best`` (D, m): dynamic programming over
+    the time used, in steps of ``total / _UNITS`` (each duration rounded up); None when nothing
+    fits. (Using less time is cheaper on some programs, whose holding copper grows with the
+    time, but the cycle time is fixed: the time has to go somewhere.)"""
+    unit = total / _UNITS
+    steps = np.ceil(grid_t / unit - 1e-9).astype(np.intp)  # (D, m)
+    value = np.full(_UNITS + 1, np.inf)
+    value[0] = 0.0
+    back = []
+    for j in range(best.shape[1]):
+        new = np.full(_UNITS + 1, np.inf)
+        arg = np.full(_UNITS + 1, -1, dtype=np.intp)
+        for d in range(best.shape[0]):
+            shift = int(steps[d, j])
+            if not np.isfinite(best[d, j]) or shift > _UNITS:
+                continue
+            cand = np.full(_UNITS + 1, np.inf)
+            cand[shift:] = value[: _UNITS + 1 - shift] + best[d, j]
+            better = cand < new
+            new[better], arg[better] = cand[better], d
+        value = new
+        back.append(arg)
+    fits = np.flatnonzero(np.isfinite(value))
+    if fits.size == 0:
+        return None
+    end = int(fits[-1])
+    chosen = np.zeros(best.shape[1], dtype=np.intp)
+    for j in range(best.shape[1] - 1, -1, -1):
+        chosen[j] = int(back[j][end])
+        end -= int(steps[chosen[j], j])
+    return chosen
+
+
+def allocated(checks: PathChecks, budget: float) -> tuple[Array, Array] | None:
+    """A start for the timing solver: the budget shared among the moves as if each ran alone.
+
+    Every move's part of the objective (the move and the events after it) is evaluated on a grid
+    of its duration (``_DURATIONS`` geometric steps from its fastest within the caps to the
+    longest the budget leaves it) and ramp fraction (``_RAMPS``), all moves at once in each of
+    the grid's programs; per duration the cheapest ramp within the move's speed and acceleration
+    caps and torque limits; then the durations whose sum fits the budget at the least total,
+    exactly on the grid, by dynamic programming over the time used (:func:`_share`). A second
+    pass does the same on a finer grid around each move's choice (between its neighbouring grid
+    durations and ramps). The moves interact only through blends, which this ignores: the solver
+    starts from it, uniformly scaled to the budget. None where no grid point fits.
+    """
+    problem, path = checks.problem, checks.path
+    moving = np.flatnonzero(path.travel > 0.0)
+    if checks.model is None or moving.size == 0:
+        return None
+    dist = path.travel[moving]
+    total = budget - float(path.event_time.sum())
+    fast_t, _ = durations(dist, problem.v_cap[moving], problem.a_fast[moving])
+    spare = total - float(fast_t.sum())
+    if spare <= 0.0:
+        return None
+    grid_t = fast_t * np.geomspace(1.0, (fast_t + spare) / fast_t, _DURATIONS)  # (D, m)
+    grid_f = np.linspace(1.0 / _RAMPS, 1.0, _RAMPS)[:, None] * np.ones(moving.size)
+    best, ramp = _grid_energy(checks, moving, grid_t, grid_f)
+    chosen = _share(best, grid_t, total)
+    if chosen is None:
+        return None
+    cols = np.arange(moving.size)
+    low = grid_t[np.maximum(chosen - 1, 0), cols]
+    high = grid_t[np.minimum(chosen + 1, _DURATIONS - 1), cols]
+    f = ramp[chosen, cols]
+    fine_t = low + np.linspace(0.0, 1.0, _DURATIONS)[:, None] * (high - low)
+    step = 1.0 / _RAMPS
+    fine_f = np.clip(f + np.linspace(-step, step, _RAMPS)[:, None], 0.25 * step, 1.0)
+    fine, fine_ramp = _grid_energy(checks, moving, fine_t, fine_f)
+    again = _share(fine, fine_t, total)
+    t = grid_t[chosen, cols]
+    if again is not None and fine[again, cols].sum() < best[chosen, cols].sum():
+        t, f = fine_t[again, cols], fine_ramp[again, cols]
+    v, a, _ = settings(dist, t, f)
+    v_out, a_out = path.speed.copy(), path.accel.copy()
+    v_out[moving], a_out[moving] = v, a
+    return scaled_to(problem, path, v_out, a_out, budget)
+
+
+def scaled_to(
+    problem: TimingProblem, path: ProgramPath, v: Array, a: Array, budget: float
+) -> tuple[Array, Array]:
+    """``(v, a)`` uniformly scaled (``v k``, ``a k^2``) so that the program lasts ``budget`` s,
+    its events keeping their time: ``k = (T - T_events) / (budget - T_events)``."""
+    fixed = float(path.event_time.sum())
+    own = problem.cycle_time(v, a)
+    if budget <= fixed:
         raise KinergyError(
-            f"cycle time {budget:.4g} s is shorter than the fastest feasible {fastest:.4g} s "
-            "(every move at its speed, acceleration and torque limits)"
+            f"cycle time {budget:.4g} s: the program's events alone take {fixed:.4g} s"
         )
-    return budget
+    return uniform_scaling(v, a, (own - fixed) / (budget - fixed))
 
 
-@serial
-def optimize_timing(
-    robot: Robot,
-    waypoints: ArrayLike,
+def _starts(checks: PathChecks, budget: float) -> list[tuple[Array, Array, str]]:
+    """The solver's starts at ``budget``, the more promising first: the program uniformly scaled
+    to it and the budget shared per move (:func:`allocated`), ordered by their quadrature
+    objective (a start over a torque limit last)."""
+    problem, path = checks.problem, checks.path
+    starts = [(*scaled_to(problem, path, path.speed, path.accel, budget), "uniform scaling")]
+    shared = allocated(checks, budget)
+    if shared is None:
+        return starts
+    starts.append((*shared, "the budget shared per move"))
+    timings = [durations(path.travel, v, a) for v, a, _ in starts]
+    t = np.array([x[0] for x in timings])
+    f = np.array([x[1] for x in timings])
+    value, ratio = problem.evaluate(t, f)
+    over = np.max(ratio, axis=1) > 1.0
+    order = np.lexsort((value, over))
+    return [starts[int(i)] for i in order]
+
+
+def retime(
+    checks: PathChecks,
+    budget: float,
     *,
-    cycle_time: float | None = None,
-    speeds: ArrayLike | None = None,
-    accels: ArrayLike | None = None,
-    blends: ArrayLike | None = None,
-    v_max: float | None = None,
-    a_max: float | None = None,
     share_budget: bool = True,
-    recovery: bool = True,
-    objective: Objective | None = None,
-    problem: TimingProblem | None = None,
-) -> TimingResult:
-    """Energy-optimal per-move ``v`` and ``a`` of a movej program for a cycle time.
-
-    Parameters
-    ----------
-    robot : Robot
-    waypoints : array_like, shape (K + 1, n)
-        Start pose and the K targets, rad.
-    cycle_time : float, optional
-        The budget, s; default the program's own cycle time (``--cycle-time same``).
-    speeds, accels : float or array_like, shape (K,), optional
-        The program as written (rad/s, rad/s^2); NaN or None: the fastest feasible.
-    blends : float or array_like, shape (K,), optional
-        Joint-space blend radii, rad (kept as given).
-    v_max, a_max : float, optional
-        Caps on every joint's speed and acceleration besides the robot's limits (the leading
-        joint's ``v`` and ``a``). Without ``a_max`` a model without acceleration limits (UR arms)
-        is bounded by its torque limits alone.
-    share_budget : bool
-        Let the optimiser share the budget among the moves (default); otherwise each move keeps
-        its share of the program's time.
-    recovery : bool
-        Braking energy returns to the bus (default, as the seed).
-    objective : Objective, optional
-        What to minimise (:mod:`kinergy.optimize.objectives`); default the electrical energy.
-    problem : TimingProblem, optional
-        Built by :func:`timing_problem` with the same arguments and objective, to reuse it.
-
-    Returns
-    -------
-    TimingResult
-        The program, uniform scaling to ``cycle_time`` (speeds times ``k``, accelerations times
-        ``k^2``) and the optimum, each re-simulated at 500 Hz (energy, and every limit at every
-        sample). The optimum never scores worse than uniform scaling when that keeps the limits:
-        should the solver end above it, uniform scaling is returned (and ``solver`` says so).
+    maxiter: int = _MAXITER,
+    starts: int = 2,
+) -> tuple[ProgramResult, Verified]:
+    """The verified energy-optimal timing at ``budget`` s, and how it came about: the solver runs
+    from the program uniformly scaled to the budget and from the budget shared among the moves
+    (:func:`_starts`, the more promising first; ``starts=1``: that one only, or the other should
+    it not hold the limits), at most ``maxiter`` SLSQP iterations per attempt (it stops on
+    iterations and tolerances, never on a clock: the same answer on every host), each keeping
+    its start should it end above it; the best within the limits. (The energy is not convex in
+    the timing: the two starts can end in different optima.)
 
     Raises
     ------
     KinergyError
-        Bad inputs, or a cycle time shorter than the fastest feasible.
+        A budget below the fastest feasible cycle time (naming the slowest move's line).
     """
-    started = time.perf_counter()
-    checks, v_prog, a_prog = _comparison(
-        robot, waypoints, problem, (speeds, accels), blends, Caps(v_max, a_max, recovery), objective
-    )
-    problem = checks.problem
-    program = checks.run(v_prog, a_prog, "program")
-    budget = _budget(cycle_time, program, problem.fastest_cycle_time)
-    uniform = checks.run(*uniform_scaling(v_prog, a_prog, program.cycle_time / budget), "uniform")
-    v0, a0 = _scaled_to(problem, v_prog, a_prog, budget)
-    optimized, verified = best_verified(checks, budget, v0, a0, uniform, share_budget)
-    return TimingResult(
-        cycle_time=budget,
-        program=program,
-        uniform=uniform,
-        optimized=optimized,
-        fastest_cycle_time=problem.fastest_cycle_time,
-        v_cap=problem.v_cap,
-        a_cap=problem.a_cap,
-        active=_active(problem, optimized),
-        iterations=verified.iterations,
-        seconds=time.perf_counter() - started,
-        solver=verified,
-    )
+    check_cycle_time(checks.problem, checks.path, budget)
+    best: tuple[ProgramResult, Verified] | None = None
+    for i, (v0, a0, label) in enumerate(_starts(checks, budget)):
+        if i >= starts and best is not None and best[0].ok:
+            break
+        start = checks.run(v0, a0, "uniform" if label == "uniform scaling" else "allocated")
+        found = _best_verified(checks, budget, v0, a0, start, share_budget, maxiter, label)
+        if best is None or _better(found[0], best[0]):
+            best = found
+    assert best is not None
+    return best
 
 
-@dataclass(frozen=True)
-class ParetoPoint:
-    """Energy at one cycle time: the optimum and uniform scaling of the program, re-simulated at
-    500 Hz (J), and whether each keeps every limit at every sample."""
-
-    cycle_time: float
-    optimized: float
-    uniform: float
-    optimized_ok: bool
-    uniform_ok: bool
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "cycle_time": self.cycle_time,
-            "optimized": self.optimized,
-            "uniform": self.uniform,
-            "optimized_within_limits": self.optimized_ok,
-            "uniform_within_limits": self.uniform_ok,
-        }
-
-
-def _cycle_times(
-    cycle_times: Sequence[float] | None, points: int, fastest: float, own: float
-) -> Array:
-    """The front's cycle times, s, increasing: given, or ``points`` from the fastest feasible to
-    twice the program's own, plus its own."""
-    if cycle_times is None:
-        if points < 2:
-            raise KinergyError(f"points: need at least 2, got {points}")
-        return np.unique(np.append(np.linspace(fastest, max(2.0 * own, fastest), points), own))
-    times = np.sort(np.asarray(cycle_times, dtype=float))
-    if times.size == 0 or not np.all(np.isfinite(times)) or times[0] < fastest * (1 - 1e-9):
-        raise KinergyError(
-            f"cycle_times: each must be at least the fastest feasible {fastest:.4g} s"
-        )
-    return times
-
-
-@serial
-def pareto_front(
-    robot: Robot,
-    waypoints: ArrayLike,
-    *,
-    speeds: ArrayLike | None = None,
-    accels: ArrayLike | None = None,
-    blends: ArrayLike | None = None,
-    v_max: float | None = None,
-    a_max: float | None = None,
-    cycle_times: Sequence[float] | None = None,
-    points: int = 8,
-    share_budget: bool = True,
-    recovery: bool = True,
-    objective: Objective | None = None,
-    problem: TimingProblem | None = None,
-) -> list[ParetoPoint]:
-    """Energy against cycle time: the optimum and uniform scaling of the program at each.
-
-    Parameters are those of :func:`optimize_timing`; ``cycle_times`` (s) default to ``points``
-    evenly spaced from the fastest feasible to twice the program's, plus the program's own.
-    Each optimum starts from the previous one stretched to the next budget.
-
-    Returns
-    -------
-    list of ParetoPoint
-        By increasing cycle time.
-    """
-    checks, v_prog, a_prog = _comparison(
-        robot, waypoints, problem, (speeds, accels), blends, Caps(v_max, a_max, recovery), objective
-    )
-    problem = checks.problem
-    own = problem.cycle_time(v_prog, a_prog)
-    out = []
-    v0, a0 = v_prog, a_prog
-    for budget in _cycle_times(cycle_times, points, problem.fastest_cycle_time, own):
-        uniform = checks.run(*uniform_scaling(v_prog, a_prog, own / budget), "uniform")
-        v0, a0 = _scaled_to(problem, v0, a0, float(budget))
-        best, _, _ = _optimum(checks, float(budget), v0, a0, share_budget=share_budget)
-        if uniform_wins(uniform, best):
-            best = uniform
-        out.append(
-            ParetoPoint(
-                cycle_time=float(budget),
-                optimized=best.e_elec,
-                uniform=uniform.e_elec,
-                optimized_ok=best.ok,
-                uniform_ok=uniform.ok,
-            )
-        )
-        v0, a0 = best.speeds, best.accels
-    return out
+def _better(a: ProgramResult, b: ProgramResult) -> bool:
+    """Within the limits where the other is not, or as much so and a lower objective."""
+    assert a.score is not None and b.score is not None
+    return (not a.ok, a.score) < (not b.ok, b.score)

@@ -1,11 +1,19 @@
-"""Verification: a movej program re-simulated at the controller's 500 Hz.
+"""Verification: a robot program re-simulated at the controller's 500 Hz, and its targets.
 
-Every program the optimiser compares (as written, uniformly scaled, optimised) is re-simulated
-with :func:`kinergy.trajectory.movej.movej` every :data:`VERIFY_DT` and accounted with
-:func:`kinergy.accounting.energy.energy` (the one forward path, UR5e eqs 23-26): the energy
-reported is this re-simulation's, not the optimiser's quadrature (which agrees within about
-0.1 %), and every limit is checked at every one of its samples
-(:func:`kinergy.optimize.constraints.limit_violations`).
+:func:`simulate_path` re-simulates a resolved program (:mod:`kinergy.trajectory.program_motion`)
+every :data:`VERIFY_DT` and reports it as a :class:`ProgramResult`: the objective (the supply
+energy, :mod:`kinergy.optimize.objectives`) at the 500 Hz samples and per move, the motors'
+electrical energy on the bus (clipped at 0: what the supply delivers to them, without the
+standing draw) with its breakdown (:func:`kinergy.accounting.energy.energy`, each sample with the
+load the program sets there, as ``kinergy energy`` accounts a program), and every joint limit at
+every sample (:func:`kinergy.optimize.constraints.limit_violations`). Every figure the optimiser
+reports is such a re-simulation, not its quadrature (which agrees within about 0.1 %).
+
+:func:`target_errors` checks a changed program against the one it came from: the tool at every
+stop (a move that ends at rest: before an event, at the end, or without a blend) within a
+distance and an angle of the original target, up to a declared tool symmetry about the tool's z
+axis; the arm at rest at those stops and during every event; how far blended via points are
+passed.
 """
 
 from __future__ import annotations
@@ -14,83 +22,64 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
-from scipy.integrate import cumulative_trapezoid
+from numpy.typing import NDArray
 
 from kinergy.accounting.energy import energy
 from kinergy.arrays import Array
+from kinergy.dynamics.poses import tcp_pose
 from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import LimitCheck, limit_violations
-from kinergy.optimize.objectives import Objective
-from kinergy.optimize.program import motion_samples, serial
-from kinergy.trajectory.motion import CONTROLLER_DT
-from kinergy.trajectory.movej import movej, plan_movej
+from kinergy.optimize.objectives import Objective, SupplyEnergy
+from kinergy.optimize.options import ToolSymmetry
+from kinergy.optimize.samples import drive_by_payload, grid_weights, samples_at
+from kinergy.trajectory.motion import CONTROLLER_DT, Motion
+from kinergy.trajectory.program_motion import Schedule, payload_index, program_motion, sample_path
+from kinergy.trajectory.program_path import ProgramPath
 
-__all__ = ["VERIFY_DT", "ProgramResult", "program_energy", "simulate_program"]
+__all__ = [
+    "VERIFY_DT",
+    "PathRun",
+    "ProgramResult",
+    "TargetCheck",
+    "simulate_path",
+    "target_errors",
+]
 
 
 #: sample period of every verification: the UR controller's 500 Hz
 VERIFY_DT = CONTROLLER_DT
 
 
-@serial
-def program_energy(
-    robot: Robot,
-    waypoints: ArrayLike,
-    speeds: ArrayLike,
-    accels: ArrayLike,
-    blends: ArrayLike = 0.0,
-    dt: float = VERIFY_DT,
-    *,
-    recovery: bool = True,
-) -> float:
-    """Total electrical energy of a movej program, re-simulated every ``dt`` s, J (UR5e eq 26).
-
-    Parameters
-    ----------
-    robot : Robot
-    waypoints : array_like, shape (K + 1, n)
-        Start pose and targets, rad.
-    speeds, accels : float or array_like, shape (K,)
-        Leading-joint ``v`` (rad/s) and ``a`` (rad/s^2) per move.
-    blends : float or array_like, shape (K,)
-        Joint-space blend radii, rad (:func:`kinergy.trajectory.movej.plan_movej`).
-    dt : float
-        Sample period, s (0.002: the controller's 500 Hz).
-    recovery : bool
-        Braking energy returns to the bus (default, as the seed).
-    """
-    motion = movej(waypoints, speed=speeds, acceleration=accels, blend=blends, dt=dt)
-    return energy(robot, motion, recovery=recovery).total_e_elec
-
-
 @dataclass(frozen=True, eq=False)
 class ProgramResult:
-    """A movej program's settings and its re-simulated energy and limits.
+    """A program's timing and its re-simulated energy and limits.
 
     Attributes
     ----------
     label : str
-        ``program``, ``uniform`` or ``optimized``.
+        ``program``, ``optimized``, a lever's name, ...
     speeds, accels, blends : ndarray, shape (K,)
-        rad/s, rad/s^2, rad (joint-space blend).
+        Each move's ``v``, ``a`` and blend radius, in the move's own units.
     starts, durations : ndarray, shape (K,)
         When each move starts and how long it lasts on its own, s.
     cycle_time : float
         s.
     e_elec : float
-        Total electrical energy of the motors, re-simulated at 500 Hz, J.
+        The motors' electrical energy on the DC bus, braking surplus lost in the shunt,
+        re-simulated at 500 Hz, J: the motors' part of the supply energy.
     e_moves : ndarray, shape (K,)
-        Its share per move (the bus energy between one move's start and the next's), J.
+        The objective's share per move (the move and the events after it), J.
     breakdown : dict of str to float
-        ``inertial``, ``gravity``, ``friction``, ``copper`` parts of ``e_elec``, J.
+        ``inertial``, ``gravity``, ``friction``, ``copper`` parts of the motors' energy, J.
     check : LimitCheck
         The limits at every 500 Hz sample.
     predicted : float or None
-        The optimiser's own (quadrature) estimate of its objective (``e_elec`` by default).
+        The optimiser's own (quadrature) estimate of its objective.
     score : float or None
-        The objective (:mod:`kinergy.optimize.objectives`) at the 500 Hz samples, when scored;
-        what the comparison of programs uses (``e_elec`` up to rounding, by default).
+        The objective (:mod:`kinergy.optimize.objectives`) at the 500 Hz samples: what the
+        comparison of programs uses (the supply energy, J, by default).
+    standby : float
+        The arm's standing draw, W: the supply energy is ``e_elec + standby * cycle_time``.
     """
 
     label: str
@@ -106,11 +95,22 @@ class ProgramResult:
     check: LimitCheck = field(repr=False)
     predicted: float | None = None
     score: float | None = None
+    standby: float = 0.0
 
     @property
     def ok(self) -> bool:
         """Whether every 500 Hz sample is within every limit."""
         return self.check.ok
+
+    @property
+    def e_standby(self) -> float:
+        """The standing draw over the cycle, J."""
+        return self.standby * self.cycle_time
+
+    @property
+    def e_supply(self) -> float:
+        """What the arm draws from its supply per cycle, J: the motors plus the standing draw."""
+        return self.e_elec + self.e_standby
 
     def to_dict(self) -> dict[str, Any]:
         worst = self.check.worst()
@@ -118,7 +118,10 @@ class ProgramResult:
             "label": self.label,
             "cycle_time": self.cycle_time,
             "e_elec": self.e_elec,
-            "predicted_e_elec": self.predicted,
+            "e_standby": self.e_standby,
+            "e_supply": self.e_supply,
+            "score": self.score,
+            "predicted": self.predicted,
             "breakdown": dict(self.breakdown),
             "moves": [
                 {
@@ -127,7 +130,7 @@ class ProgramResult:
                     "blend": float(self.blends[k]),
                     "start": float(self.starts[k]),
                     "duration": float(self.durations[k]),
-                    "e_elec": float(self.e_moves[k]),
+                    "energy": float(self.e_moves[k]),
                 }
                 for k in range(self.speeds.size)
             ],
@@ -140,58 +143,196 @@ class ProgramResult:
         }
 
 
-@serial
-def simulate_program(
+@dataclass(frozen=True, eq=False)
+class PathRun:
+    """A program re-simulated at 500 Hz: the result, the motion and its schedule."""
+
+    result: ProgramResult
+    motion: Motion
+    schedule: Schedule
+    path: ProgramPath
+
+
+def simulate_path(
     robot: Robot,
-    waypoints: ArrayLike,
-    speeds: ArrayLike,
-    accels: ArrayLike,
-    blends: ArrayLike = 0.0,
+    path: ProgramPath,
     *,
-    dt: float = VERIFY_DT,
-    recovery: bool = True,
+    standby: float = 0.0,
+    objective: Objective | None = None,
     speed_cap: float | None = None,
     acceleration_cap: float | None = None,
     label: str = "program",
     predicted: float | None = None,
-    objective: Objective | None = None,
-) -> ProgramResult:
-    """Re-simulate a movej program at ``dt``: its energy (total, per move, breakdown) and limits.
+) -> PathRun:
+    """Re-simulate a program at 500 Hz at its moves' ``path.speed`` and ``path.accel``.
 
-    Parameters are those of :func:`program_energy` and
-    :func:`kinergy.optimize.constraints.limit_violations`; ``label`` and ``predicted`` are
-    passed on to the result, and ``objective`` (optional) scores the re-simulation
-    (:attr:`ProgramResult.score`).
+    Parameters
+    ----------
+    robot : Robot
+    path : ProgramPath
+    standby : float
+        The arm's standing draw, W (>= 0).
+    objective : Objective, optional
+        Scores the run (``score``, ``e_moves``); default :class:`SupplyEnergy` with ``standby``.
+    speed_cap, acceleration_cap : float, optional
+        Caps on every joint's speed (rad/s) and acceleration (rad/s^2) besides the robot's limits.
+    label : str
+    predicted : float, optional
+        The optimiser's estimate of the objective.
+
+    Returns
+    -------
+    PathRun
+        ``result.e_elec``: the motors' electrical energy on the bus, clipped at 0, J;
+        ``result.e_supply``: plus the standing draw; ``result.score``: the objective;
+        ``result.e_moves``: its share per move (a move's events count to it);
+        ``result.blends``: each move's blend radius in its own unit.
     """
-    w = np.asarray(waypoints, dtype=float)
-    plan = plan_movej(w, speed=speeds, acceleration=accels, blend=blends)
-    motion = movej(w, speed=speeds, acceleration=accels, blend=blends, dt=dt)
-    report = energy(robot, motion, recovery=recovery)
-    bus = report.p_elec.sum(axis=1)
-    if not recovery:
-        bus = np.maximum(bus, 0.0)
-    cumulative = cumulative_trapezoid(bus, motion.t, initial=0.0)
-    bounds = np.concatenate([[motion.t[0]], plan.start[1:], [motion.t[-1]]])
-    e_moves = np.diff(np.interp(bounds, motion.t, cumulative))
-    check = limit_violations(
-        robot, motion, report.drive, speed_cap=speed_cap, acceleration_cap=acceleration_cap
+    objective = SupplyEnergy(standby) if objective is None else objective
+    motion, sched = program_motion(robot, path)
+    load = payload_index(path, sched, motion.t)[0]
+    drive = drive_by_payload(path.robots, load, motion.q, motion.qd, motion.qdd)
+    report = energy(robot, motion, recovery=False, state=drive)
+    samples = samples_at(
+        motion.t[None, :],
+        grid_weights(motion.t)[None, :],
+        sched.start,
+        sched.start + sched.duration,
+        drive,
     )
-    moves = plan.start.size
-    score = None
-    if objective is not None:
-        score = float(objective(motion_samples(motion.t, plan, report.drive))[0][0])
-    return ProgramResult(
+    score, parts = objective(samples)
+    check = limit_violations(
+        robot, motion, drive, speed_cap=speed_cap, acceleration_cap=acceleration_cap
+    )
+    result = ProgramResult(
         label=label,
-        speeds=np.broadcast_to(np.asarray(speeds, dtype=float), (moves,)).copy(),
-        accels=np.broadcast_to(np.asarray(accels, dtype=float), (moves,)).copy(),
-        blends=np.broadcast_to(np.asarray(blends, dtype=float), (moves,)).copy(),
-        starts=plan.start,
-        durations=plan.duration,
-        cycle_time=plan.total_time,
+        speeds=path.speed.copy(),
+        accels=path.accel.copy(),
+        blends=np.where(path.linked, path.blend, 0.0),
+        starts=sched.start[0],
+        durations=sched.duration[0],
+        cycle_time=float(sched.total[0]),
         e_elec=report.total_e_elec,
-        e_moves=e_moves,
+        e_moves=parts[0],
         breakdown={k: float(v.sum()) for k, v in report.breakdown.items()},
         check=check,
         predicted=predicted,
-        score=score,
+        score=float(score[0]),
+        standby=standby,
     )
+    return PathRun(result, motion, sched, path)
+
+
+@dataclass(frozen=True)
+class TargetCheck:
+    """How a changed program meets one of the original program's targets.
+
+    Attributes
+    ----------
+    line : int
+        The move's line in the program.
+    stop : bool
+        Whether the move ends at rest (else it is a via point the program blends through).
+    left_out : bool
+        A joint-space via point the route leaves out (free via points): not a target of the
+        job, its figures are those of the move's new end.
+    distance : float
+        Stops: the tool's distance from the target at the stop, m. Via points: the closest the
+        tool passes, m.
+    angle : float
+        Stops: the tool's rotation from the target's (up to the tool symmetry), rad; NaN at via
+        points.
+    speed : float
+        Stops: the largest joint speed at the stop, rad/s; NaN at via points.
+
+    A stop is checked at the instant its move ends (the planned motion there, not the next
+    500 Hz sample, which may already lie in the following move).
+    """
+
+    line: int
+    stop: bool
+    distance: float
+    angle: float
+    speed: float
+    left_out: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "line": self.line,
+            "stop": self.stop,
+            "left_out": self.left_out,
+            "distance": self.distance,
+            "angle": None if np.isnan(self.angle) else self.angle,
+            "speed": None if np.isnan(self.speed) else self.speed,
+        }
+
+
+def _angle(want: Array, got: Array, symmetry: ToolSymmetry) -> float:
+    """Rotation angle between two orientations (3, 3), rad, up to turns about the tool z axis."""
+    if symmetry.any_angle:
+        return float(np.arccos(np.clip(want[:, 2] @ got[:, 2], -1.0, 1.0)))
+    best = np.inf
+    for a in symmetry.equivalent():
+        rz = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+        rel = (want @ rz).T @ got
+        best = min(best, float(np.arccos(np.clip(0.5 * (np.trace(rel) - 1.0), -1.0, 1.0))))
+    return best
+
+
+def target_errors(
+    robot: Robot,
+    original: ProgramPath,
+    run: PathRun,
+    *,
+    symmetry: ToolSymmetry = ToolSymmetry.NONE,
+    left_out: NDArray[np.bool_] | None = None,
+) -> list[TargetCheck]:
+    """Check every target of ``original`` in a re-simulated changed program (same moves).
+
+    Parameters
+    ----------
+    robot : Robot
+    original : ProgramPath
+        The program as written.
+    run : PathRun
+        The changed program at 500 Hz.
+    symmetry : ToolSymmetry
+        Turns about the tool axis that meet a target.
+    left_out : ndarray of bool, shape (K,), optional
+        Via points the changed route leaves out (checked where the move now ends instead).
+
+    Returns
+    -------
+    list of TargetCheck
+        One per move, in order.
+    """
+    path, motion, sched = run.path, run.motion, run.schedule
+    skipped = np.zeros(path.moves, dtype=bool) if left_out is None else left_out
+    want = np.array(
+        [
+            tcp_pose(robot, (path if skipped[k] else original).q_end[k], original.tcp[k])
+            for k in range(original.moves)
+        ]
+    )
+    out = []
+    for k in range(path.moves):
+        end = sched.start[0, k] + sched.duration[0, k]
+        line = original.program.moves[k].line
+        if path.linked[k]:
+            tips = tcp_pose(robot, motion.q, path.tcp[k])[:, :3, 3]
+            gap = float(np.min(np.linalg.norm(tips - want[k, :3, 3], axis=1)))
+            out.append(TargetCheck(line, False, gap, np.nan, np.nan, bool(skipped[k])))
+            continue
+        q, qd, _ = sample_path(robot, path, sched, np.array([[end]]))
+        got = tcp_pose(robot, q[0, 0], path.tcp[k])
+        out.append(
+            TargetCheck(
+                line=line,
+                stop=True,
+                distance=float(np.linalg.norm(got[:3, 3] - want[k, :3, 3])),
+                angle=_angle(want[k, :3, :3], got[:3, :3], symmetry),
+                speed=float(np.max(np.abs(qd[0, 0]))),
+                left_out=bool(skipped[k]),
+            )
+        )
+    return out

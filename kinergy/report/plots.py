@@ -558,34 +558,36 @@ def pareto(
 # -- output -------------------------------------------------------------------------------------
 
 
-def timing_pareto(result: Any, front: Sequence[Any]) -> Figure:
-    """The Pareto plot: optimised energy against cycle time, uniform scaling, and the program,
-    its uniform scaling and the optimum marked."""
+def timing_pareto(result: Any) -> Figure:
+    """The Pareto plot of an optimisation (:class:`kinergy.optimize.ProgramOptimization` with its
+    front): the supply energy of the optimised path re-timed against the cycle time, the program
+    as written uniformly scaled, and the program as written and the optimum marked."""
+    front = [p for p in result.pareto if p.optimized is not None]
     x = np.array([p.cycle_time for p in front])
-    marked = {"program as written": (result.program.cycle_time, result.program.e_elec)}
-    if abs(result.cycle_time - result.program.cycle_time) > 1e-6:
-        marked["uniform scaling"] = (result.uniform.cycle_time, result.uniform.e_elec)
-    marked["optimized"] = (result.optimized.cycle_time, result.optimized.e_elec)
+    own, opt = result.program.result, result.optimized.result
+    marked = {"program as written": (own.cycle_time, own.e_supply)}
+    marked["optimized"] = (opt.cycle_time, opt.e_supply)
     fig = pareto(x, np.array([p.optimized for p in front]), marked=marked)
     ax = fig.axes[0]
     for points in ax.collections:
         if points.get_label() == "candidates":
-            points.set_label("optimised timing")
-    ok = np.array([p.uniform_ok for p in front])
-    if np.any(ok):
+            points.set_label("optimised path, re-timed")
+    ok = [p for p in result.pareto if p.uniform_ok]
+    if ok:
         ax.plot(
-            x[ok],
-            np.array([p.uniform for p in front])[ok],
+            np.array([p.cycle_time for p in ok]),
+            np.array([p.uniform for p in ok]),
             color="0.4",
             linestyle="--",
             linewidth=1.2,
             marker="o",
             markersize=3,
-            label="uniform time scaling",
+            label="program as written, uniform time scaling",
             zorder=2,
         )
+    ax.set_ylabel("Supply energy per cycle [J]")
     ax.legend(loc="upper right", fontsize=9, framealpha=0.9)
-    ax.set_title("Energy against cycle time: optimised timing and uniform scaling")
+    ax.set_title("Energy against cycle time: the optimised program and uniform scaling")
     return fig
 
 

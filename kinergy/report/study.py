@@ -8,7 +8,7 @@ figures written under ``folder / "figures"``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -61,11 +61,11 @@ class Comparison:
 
 @dataclass(frozen=True, eq=False)
 class Timing:
-    """An energy-optimal timing (:class:`kinergy.optimize.TimingResult`) and its Pareto front."""
+    """An energy-optimal timing (:class:`kinergy.optimize.ProgramOptimization`, with its Pareto
+    front)."""
 
     task: str
     result: Any
-    front: Sequence[Any]
 
 
 @dataclass(frozen=True, eq=False)
@@ -247,15 +247,17 @@ def _energy_section(study: Study, figdir: Path) -> tuple[Section, list[Table], l
 def _timing_section(timing: Timing, figdir: Path) -> tuple[Section, Table]:
     table = timing_table(timing.result, timing.task)
     figure = _figure(
-        timing_pareto(timing.result, timing.front),
+        timing_pareto(timing.result),
         figdir,
         "pareto.png",
-        "Energy against cycle time: optimised timing, uniform time scaling, the program as written.",
+        "Supply energy against cycle time: the optimised timing, uniform time scaling, the "
+        "program as written.",
     )
     text = (
         f"Per-move speeds and accelerations of the movej program {timing.task} that minimise the "
-        "model's electrical energy at the program's own cycle time (kinergy optimize), and the "
-        "energy against cycle time."
+        "energy the arm draws from its supply (motors on the DC bus, braking lost in the shunt, "
+        "plus its standing draw) at the program's own cycle time (kinergy optimize --no-blends), "
+        "and the energy against cycle time."
     )
     return Section("Cutting the energy: optimal timing", text, [table], [figure]), table
 

@@ -33,7 +33,13 @@ from kinergy.dynamics.kinematics import axes_jacobian, axes_jacobian_rate, tool_
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 
-__all__ = ["ToolSegment", "joints_on_path", "tool_motion", "tool_segment"]
+__all__ = [
+    "ToolSegment",
+    "joints_on_path",
+    "segment_arrays",
+    "tool_motion",
+    "tool_segment",
+]
 
 
 #: the largest 1-norm condition number of the TCP Jacobian on a straight line; above it the line
@@ -65,10 +71,19 @@ class ToolSegment:
 
 def tool_segment(start: Array, end: Array) -> ToolSegment:
     """The straight tool move between two TCP poses (4, 4)."""
-    shift = end[:3, 3] - start[:3, 3]
-    turn = Rotation.from_matrix(start[:3, :3].T @ end[:3, :3]).as_rotvec()
-    length = float(max(np.linalg.norm(shift), np.linalg.norm(turn)))
-    return ToolSegment(start, end, shift, turn, length)
+    shift, turn, length = segment_arrays(start[None], end[None])
+    return ToolSegment(start, end, shift[0], turn[0], float(length[0]))
+
+
+def segment_arrays(start: Array, end: Array) -> tuple[Array, Array, Array]:
+    """Straight tool moves between TCP poses ``start`` and ``end`` (P, 4, 4), batched: their
+    position changes (P, 3), rotation vectors in the start's frame (P, 3) and path lengths (P,)
+    (:class:`ToolSegment`)."""
+    shift = end[:, :3, 3] - start[:, :3, 3]
+    relative = np.swapaxes(start[:, :3, :3], 1, 2) @ end[:, :3, :3]
+    turn = Rotation.from_matrix(relative).as_rotvec()
+    length = np.maximum(np.linalg.norm(shift, axis=1), np.linalg.norm(turn, axis=1))
+    return shift, turn, length
 
 
 def _rotations(rotvec: Array) -> Array:

@@ -26,7 +26,7 @@ from kinergy.trajectory.movel import ToolSegment, joints_on_path, tool_motion
 from kinergy.trajectory.program_path import ProgramPath
 
 __all__ = [
-    "LineTable",
+    "LineTables",
     "Schedule",
     "line_tables",
     "payload_index",
@@ -116,37 +116,34 @@ def tool_runs(path: ProgramPath) -> list[list[int]]:
     return runs
 
 
-def _profiles(sched: Schedule, t: Array, k: int) -> tuple[Array, Array, Array]:
-    """Move k's distance, speed and acceleration at times ``t`` (B, M)."""
+def _profiles(
+    sched: Schedule, rows: NDArray[np.intp], t: Array, k: int
+) -> tuple[Array, Array, Array]:
+    """Move k's distance, speed and acceleration at times ``t`` (S,) of programs ``rows`` (S,)."""
     return trapezoid(
-        t - sched.start[:, k : k + 1],
-        sched.duration[:, k : k + 1],
-        sched.ramp[:, k : k + 1],
-        sched.peak[:, k : k + 1],
-        sched.accel[:, k : k + 1],
+        t - sched.start[rows, k],
+        sched.duration[rows, k],
+        sched.ramp[rows, k],
+        sched.peak[rows, k],
+        sched.accel[rows, k],
     )
 
 
 def _tool_run(
-    robot: Robot, path: ProgramPath, sched: Schedule, t: Array, run: list[int]
+    robot: Robot,
+    path: ProgramPath,
+    sched: Schedule,
+    rows: NDArray[np.intp],
+    t: Array,
+    run: list[int],
 ) -> tuple[Array, Array, Array]:
-    """The joint displacement, speed and acceleration a run of tool moves adds, (B, M, n)."""
-    first, last = run[0], run[-1]
+    """The joint displacement, speed and acceleration a run of tool moves adds at times ``t``
+    (S,) of programs ``rows`` (S,) inside the run, (S, n): the tool on its lines, the joints by
+    inverse kinematics at every sample."""
+    first = run[0]
     q_a = path.q_start[first]
-    shape = (*t.shape, q_a.size)
-    dq, dqd, dqdd = np.zeros(shape), np.zeros(shape), np.zeros(shape)
-    dq[:] = np.where(
-        (t >= sched.start[:, last : last + 1] + sched.duration[:, last : last + 1])[..., None],
-        path.q_end[last] - q_a,
-        0.0,
-    )
-    active = (t > sched.start[:, first : first + 1]) & (
-        t < sched.start[:, last : last + 1] + sched.duration[:, last : last + 1]
-    )
-    if not np.any(active):
-        return dq, dqd, dqdd
-    profiles = [_profiles(sched, t, k) for k in run]
-    s, sd, sdd = (np.stack([p[i][active] for p in profiles], axis=1) for i in range(3))
+    profiles = [_profiles(sched, rows, t, k) for k in run]
+    s, sd, sdd = (np.stack([p[i] for p in profiles], axis=1) for i in range(3))
     segments: list[ToolSegment] = [seg for k in run if (seg := path.tool[k]) is not None]
     pose, twist, acc = tool_motion(
         segments[0].start,
@@ -165,62 +162,79 @@ def _tool_run(
     q, qd, qdd = joints_on_path(
         robot, path.geometry, path.tcp[first], int(path.branch[first]), pose, twist, acc, ref
     )
-    dq[active] = q - q_a
-    dqd[active] = qd
-    dqdd[active] = qdd
-    return dq, dqd, dqdd
+    return q - q_a, qd, qdd
+
+
+#: the quintic Hermite basis (rows: q0, h q0', h^2 q0'', q1, h q1', h^2 q1'') in powers of the
+#: local coordinate t in [0, 1] (columns: t^0 .. t^5)
+_HERMITE = np.array(
+    [
+        [1.0, 0.0, 0.0, -10.0, 15.0, -6.0],
+        [0.0, 1.0, 0.0, -6.0, 8.0, -3.0],
+        [0.0, 0.0, 0.5, -1.5, 1.5, -0.5],
+        [0.0, 0.0, 0.0, 10.0, -15.0, 6.0],
+        [0.0, 0.0, 0.0, -4.0, 7.0, -3.0],
+        [0.0, 0.0, 0.0, 0.5, -1.0, 0.5],
+    ]
+)
 
 
 @dataclass(frozen=True, eq=False)
-class LineTable:
-    """The joints along one straight tool line as a function of the distance along it, for
-    sampling the line at many timings (the optimiser's quadrature): at ``s`` (0 to the line's
-    length, m or rad) the joints ``q(s)``, ``q'(s) = dq/ds`` and ``q''(s)`` from the inverse
-    kinematics and the TCP Jacobian (:func:`kinergy.trajectory.movel.joints_on_path` at unit
-    path speed), interpolated between the points by quintic Hermite polynomials (error of order
-    ``h^6``). Then ``qd = q' sd`` and ``qdd = q' sdd + q'' sd^2`` for any profile ``s(t)``.
+class LineTables:
+    """The joints along straight tool lines as functions of the distance along each, for
+    sampling the lines at many timings (the optimiser's quadrature): at ``_TABLE_POINTS`` points
+    from 0 to each line's length (m or rad) the joints ``q(s)``, ``q'(s) = dq/ds`` and ``q''(s)``
+    from the inverse kinematics and the TCP Jacobian (:func:`kinergy.trajectory.movel.
+    joints_on_path` at unit path speed), interpolated between the points by quintic Hermite
+    polynomials (error of order ``h^6``), kept as each interval's polynomial coefficients. Then
+    ``qd = q' sd`` and ``qdd = q' sdd + q'' sd^2`` for any profile ``s(t)``.
 
     Attributes
     ----------
-    s : ndarray, shape (P,)
-    q, d1, d2 : ndarray, shape (P, n)
+    index : dict of int to int
+        The table of each tabled move.
+    step : ndarray, shape (T,)
+        Each table's point spacing.
+    coefficients : ndarray, shape (T, P - 1, 6, n)
+        Per table and interval, ``q`` as a polynomial of the interval's local coordinate.
     """
 
-    s: Array
-    q: Array
-    d1: Array
-    d2: Array
+    index: dict[int, int]
+    step: Array
+    coefficients: Array
 
-    def at(self, s: Array) -> tuple[Array, Array, Array]:
-        """``q``, ``q'`` and ``q''`` at distances ``s`` (S,): each (S, n)."""
-        h = float(self.s[1] - self.s[0])
-        x = np.clip(np.asarray(s, dtype=float), self.s[0], self.s[-1])
-        i = np.minimum(((x - self.s[0]) / h).astype(np.intp), self.s.size - 2)
-        t = ((x - self.s[i]) / h)[:, None]
-        t2, t3, t4, t5 = t * t, t**3, t**4, t**5
-        q0, q1 = self.q[i], self.q[i + 1]
-        a0, a1 = self.d1[i] * h, self.d1[i + 1] * h
-        b0, b1 = self.d2[i] * h * h, self.d2[i + 1] * h * h
-        basis = (
-            (1 - 10 * t3 + 15 * t4 - 6 * t5, -30 * t2 + 60 * t3 - 30 * t4, -60 * t + 180 * t2 - 120 * t3),
-            (t - 6 * t3 + 8 * t4 - 3 * t5, 1 - 18 * t2 + 32 * t3 - 15 * t4, -36 * t + 96 * t2 - 60 * t3),
-            (0.5 * t2 - 1.5 * t3 + 1.5 * t4 - 0.5 * t5, t - 4.5 * t2 + 6 * t3 - 2.5 * t4,
-             1 - 9 * t + 18 * t2 - 10 * t3),
-            (10 * t3 - 15 * t4 + 6 * t5, 30 * t2 - 60 * t3 + 30 * t4, 60 * t - 180 * t2 + 120 * t3),
-            (-4 * t3 + 7 * t4 - 3 * t5, -12 * t2 + 28 * t3 - 15 * t4, -24 * t + 84 * t2 - 60 * t3),
-            (0.5 * t3 - t4 + 0.5 * t5, 1.5 * t2 - 4 * t3 + 2.5 * t4, 3 * t - 12 * t2 + 10 * t3),
-        )  # fmt: skip
-        values = (q0, a0, b0, q1, a1, b1)
-        q = sum(b[0] * v for b, v in zip(basis, values, strict=True))
-        d1 = sum(b[1] * v for b, v in zip(basis, values, strict=True)) / h
-        d2 = sum(b[2] * v for b, v in zip(basis, values, strict=True)) / (h * h)
-        return np.asarray(q), np.asarray(d1), np.asarray(d2)
+    def __len__(self) -> int:
+        return len(self.index)
+
+    def __contains__(self, move: object) -> bool:
+        return move in self.index
+
+    def at(self, table: NDArray[np.intp], s: Array) -> tuple[Array, Array, Array]:
+        """``q``, ``q'`` and ``q''`` of tables ``table`` (S,) at distances ``s`` (S,): (S, n)."""
+        h = self.step[table]
+        pieces = self.coefficients.shape[1]
+        x = np.clip(s / h, 0.0, float(pieces))
+        i = np.minimum(x.astype(np.intp), pieces - 1)
+        t = (x - i)[:, None]
+        c = self.coefficients[table, i]  # (S, 6, n)
+        q = c[:, 5]
+        d1 = 5.0 * c[:, 5]
+        d2 = 20.0 * c[:, 5]
+        for j in (4, 3, 2, 1, 0):
+            q = q * t + c[:, j]
+            if j >= 1:
+                d1 = d1 * t + j * c[:, j]
+            if j >= 2:
+                d2 = d2 * t + j * (j - 1) * c[:, j]
+        return q, d1 / h[:, None], d2 / (h * h)[:, None]
 
 
-def line_tables(robot: Robot, path: ProgramPath) -> dict[int, LineTable]:
-    """A :class:`LineTable` of every tool move that runs alone (not blended into another tool
-    move), by move index."""
-    out = {}
+def line_tables(robot: Robot, path: ProgramPath) -> LineTables:
+    """A table (:class:`LineTables`) of every tool move that runs alone (not blended into
+    another tool move)."""
+    index: dict[int, int] = {}
+    steps: list[float] = []
+    coefficients: list[Array] = []
     for run in tool_runs(path):
         if len(run) != 1:
             continue
@@ -238,28 +252,69 @@ def line_tables(robot: Robot, path: ProgramPath) -> dict[int, LineTable]:
         q, d1, d2 = joints_on_path(
             robot, path.geometry, path.tcp[k], int(path.branch[k]), pose, twist, acc, ref
         )
-        out[k] = LineTable(s, q, d1, d2)
-    return out
+        h = float(s[1] - s[0])
+        values = np.stack(
+            [q[:-1], h * d1[:-1], h * h * d2[:-1], q[1:], h * d1[1:], h * h * d2[1:]], axis=1
+        )  # (P - 1, 6, n)
+        index[k] = len(steps)
+        steps.append(h)
+        coefficients.append(np.einsum("vp,ivn->ipn", _HERMITE, values))
+    n = path.q0.size
+    return LineTables(
+        index,
+        np.array(steps, dtype=float),
+        np.array(coefficients) if coefficients else np.zeros((0, _TABLE_POINTS - 1, 6, n)),
+    )
 
 
-def _tabled_run(
-    table: LineTable, path: ProgramPath, sched: Schedule, t: Array, k: int
+def _units(path: ProgramPath) -> list[list[int]]:
+    """The program's moves as units whose displacements add up: each joint move that moves,
+    each run of tool moves blended into one another (a lone tool move a run of one), in order."""
+    units: list[list[int]] = []
+    runs = {run[0]: run for run in tool_runs(path)}
+    k = 0
+    while k < path.moves:
+        if k in runs:
+            units.append(runs[k])
+            k = runs[k][-1] + 1
+            continue
+        if path.travel[k] > 0.0:
+            units.append([k])
+        k += 1
+    return units
+
+
+def _profiled(
+    path: ProgramPath,
+    sched: Schedule,
+    rows: NDArray[np.intp],
+    t: Array,
+    moves: NDArray[np.intp],
+    tables: LineTables | None,
 ) -> tuple[Array, Array, Array]:
-    """The joint displacement, speed and acceleration a lone tool move adds, (B, M, n), from
-    its table."""
-    q_a = path.q_start[k]
-    shape = (*t.shape, q_a.size)
-    dq, dqd, dqdd = np.zeros(shape), np.zeros(shape), np.zeros(shape)
-    end = sched.start[:, k : k + 1] + sched.duration[:, k : k + 1]
-    dq[:] = np.where((t >= end)[..., None], path.q_end[k] - q_a, 0.0)
-    active = (t > sched.start[:, k : k + 1]) & (t < end)
-    if not np.any(active):
-        return dq, dqd, dqdd
-    s, sd, sdd = (x[active] for x in _profiles(sched, t, k))
-    q, d1, d2 = table.at(s)
-    dq[active] = q - q_a
-    dqd[active] = d1 * sd[:, None]
-    dqdd[active] = d1 * sdd[:, None] + d2 * (sd * sd)[:, None]
+    """The displacement, speed and acceleration that joint moves and tabled tool moves
+    ``moves`` (S,) add at times ``t`` (S,) of programs ``rows`` (S,), each inside its move."""
+    s, sd, sdd = trapezoid(
+        t - sched.start[rows, moves],
+        sched.duration[rows, moves],
+        sched.ramp[rows, moves],
+        sched.peak[rows, moves],
+        sched.accel[rows, moves],
+    )
+    tool = np.array([path.tool[k] is not None for k in range(path.moves)])[moves]
+    travel = np.where(path.travel > 0.0, path.travel, 1.0)
+    direction = (path.q_end - path.q_start) / travel[:, None]  # (K, n)
+    dq = s[:, None] * direction[moves]
+    dqd = sd[:, None] * direction[moves]
+    dqdd = sdd[:, None] * direction[moves]
+    if np.any(tool):
+        assert tables is not None
+        pick = np.flatnonzero(tool)
+        which = np.array([tables.index.get(int(k), -1) for k in range(path.moves)])[moves[pick]]
+        q, d1, d2 = tables.at(which, s[pick])
+        dq[pick] = q - path.q_start[moves[pick]]
+        dqd[pick] = d1 * sd[pick, None]
+        dqdd[pick] = d1 * sdd[pick, None] + d2 * (sd[pick] * sd[pick])[:, None]
     return dq, dqd, dqdd
 
 
@@ -269,20 +324,27 @@ def sample_path(
     sched: Schedule,
     t: ArrayLike,
     *,
-    tables: dict[int, LineTable] | None = None,
+    tables: LineTables | None = None,
 ) -> tuple[Array, Array, Array]:
     """Joint angles, speeds and accelerations of B scheduled programs at times ``t``.
+
+    Every move (a run of tool moves blended into one another counts as one) adds its
+    displacement to the joints: all of it once it has ended, none before it starts, its profile
+    in between. The moves that have ended and those that have started are prefixes (neither
+    their starts nor their ends fall), so each sample takes the summed displacement of the
+    first and the profiles of the (at most two, blended) moves between the two, each evaluated
+    at its own samples only.
 
     Parameters
     ----------
     robot : Robot
     path : ProgramPath
     sched : Schedule
-        B programs on ``path`` (:func:`schedule`).
+        B programs on ``path`` (:func:`schedule`), or one for every row of ``t``.
     t : array_like, shape (B, M)
         Times from each program's start, s.
-    tables : dict of int to LineTable, optional
-        Tool moves sampled from their tables (:func:`line_tables`) rather than by inverse
+    tables : LineTables, optional
+        Lone tool moves sampled from their tables (:func:`line_tables`) rather than by inverse
         kinematics at every sample: the optimiser's quadrature; the 500 Hz verification does
         without.
 
@@ -291,27 +353,48 @@ def sample_path(
     q, qd, qdd : ndarray, shape (B, M, n)
         rad, rad/s, rad/s^2.
     """
-    times = np.asarray(t, dtype=float)
+    times = np.atleast_2d(np.asarray(t, dtype=float))
+    if sched.start.shape[0] == 1 and times.shape[0] > 1:  # one program at several rows of times
+        sched = Schedule(*(np.repeat(x, times.shape[0], axis=0) for x in vars(sched).values()))
     n = path.q0.size
-    q = np.broadcast_to(path.q0, (*times.shape, n)).copy()
+    units = _units(path)
+    first = np.array([u[0] for u in units], dtype=np.intp)
+    last = np.array([u[-1] for u in units], dtype=np.intp)
+    delta = (path.q_end[last] - path.q_start[first]).reshape(-1, n)
+    cum = np.vstack([path.q0, path.q0 + np.cumsum(delta, axis=0)])  # (U + 1, n)
+    u_start = sched.start[:, first]  # (B, U), neither falling
+    u_end = (sched.start + sched.duration)[:, last]
+    finished = np.sum(times[:, :, None] >= u_end[:, None, :], axis=2)
+    started = np.sum(times[:, :, None] > u_start[:, None, :], axis=2)
+    q = cum[finished]
     qd = np.zeros_like(q)
     qdd = np.zeros_like(q)
-    for k in range(path.moves):
-        if path.tool[k] is not None or path.travel[k] <= 0.0:
+    simple = np.array(
+        [path.tool[u[0]] is None or (tables is not None and len(u) == 1 and u[0] in tables)
+         for u in units],
+        dtype=bool,
+    )  # fmt: skip
+    for lag in (1, 2):
+        unit = started - lag  # (B, M)
+        rows, cols = np.nonzero((unit >= finished) & (unit >= 0))
+        if rows.size == 0:
             continue
-        s, sd, sdd = _profiles(sched, times, k)
-        unit = (path.q_end[k] - path.q_start[k]) / path.travel[k]
-        q += s[..., None] * unit
-        qd += sd[..., None] * unit
-        qdd += sdd[..., None] * unit
-    for run in tool_runs(path):
-        if tables is not None and len(run) == 1 and run[0] in tables:
-            dq, dqd, dqdd = _tabled_run(tables[run[0]], path, sched, times, run[0])
-        else:
-            dq, dqd, dqdd = _tool_run(robot, path, sched, times, run)
-        q += dq
-        qd += dqd
-        qdd += dqdd
+        which = unit[rows, cols]
+        at = times[rows, cols]
+        easy = simple[which]
+        if np.any(easy):
+            r, c = rows[easy], cols[easy]
+            dq, dqd, dqdd = _profiled(path, sched, r, at[easy], first[which[easy]], tables)
+            q[r, c] += dq
+            qd[r, c] += dqd
+            qdd[r, c] += dqdd
+        for u in np.unique(which[~easy]):
+            pick = np.flatnonzero(which == u)
+            r, c = rows[pick], cols[pick]
+            dq, dqd, dqdd = _tool_run(robot, path, sched, r, at[pick], units[int(u)])
+            q[r, c] += dq
+            qd[r, c] += dqd
+            qdd[r, c] += dqdd
     return q, qd, qdd
 
 

@@ -43,6 +43,7 @@ from kinergy.dynamics.kinematics import flange_pose
 from kinergy.dynamics.poses import pose_matrix
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Payload, Robot
+from kinergy.trajectory.movej import trapezoid_timing
 from kinergy.trajectory.movel import ToolSegment, tool_motion, tool_segment
 from kinergy.trajectory.programs import UR_HOME
 from kinergy.trajectory.robot_program import Event, Move, RobotProgram
@@ -59,6 +60,8 @@ __all__ = [
 
 #: points a straight tool line is followed at to find its end joints
 _LINE_POINTS = 64
+#: the longest a move may take, s (longer is a slip in the units, and overflows the plan)
+_LONGEST_MOVE = 3600.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -92,7 +95,10 @@ class ProgramPath:
     event_after : ndarray of int, shape (E,)
         The move each event follows (-1: before the first move).
     payloads : tuple of Payload or None
-        Every load the program sets; index 0 is the robot's own.
+        Every load the program sets, each once; index 0 is the robot's own.
+    robots : tuple of Robot
+        The robot carrying each of ``payloads`` (built once: the drive model of every sample
+        uses the one of its load).
     move_payload, event_payload : ndarray of int, shapes (K,), (E,)
         The load during each move and event.
     geometry : URGeometry or None
@@ -113,6 +119,7 @@ class ProgramPath:
     event_time: Array
     event_after: NDArray[np.intp]
     payloads: tuple[Payload | None, ...]
+    robots: tuple[Robot, ...]
     move_payload: NDArray[np.intp]
     event_payload: NDArray[np.intp]
     geometry: URGeometry | None
@@ -238,6 +245,7 @@ class _Walk:
         self.q = q0.copy()
         self.tcp = np.eye(4)
         self.payloads: list[Payload | None] = [robot.payload]
+        self.load = 0  # index into payloads of the load set from here on
         self.rows: list[tuple[Array, ToolSegment | None, int, Array, float, float, float]] = []
         self.events: list[tuple[float, int, int]] = []
         self.move_payload: list[int] = []
@@ -246,8 +254,11 @@ class _Walk:
         if event.tcp is not None:
             self.tcp = pose_matrix(event.tcp)
         if event.kind == "payload":
-            self.payloads.append(event.payload)
-        self.events.append((event.duration, len(self.rows) - 1, len(self.payloads) - 1))
+            same = [i for i, p in enumerate(self.payloads) if _same_payload(p, event.payload)]
+            self.load = same[0] if same else len(self.payloads)
+            if not same:
+                self.payloads.append(event.payload)
+        self.events.append((event.duration, len(self.rows) - 1, self.load))
 
     def move(self, move: Move) -> None:
         q_a = self.q
@@ -265,8 +276,14 @@ class _Walk:
             travel = float(np.max(np.abs(q_b - q_a)))
         _check_limits(self.robot, q_b)
         v, a = move_settings(travel, move.a, move.v, move.t)
+        duration = float(trapezoid_timing(travel, v, a)[0])
+        if duration > _LONGEST_MOVE:
+            raise KinergyError(
+                f"at v={v:g} and a={a:g} the move takes {duration:.3g} s, more than an hour "
+                "(a speed or acceleration in the wrong unit?)"
+            )
         self.rows.append((q_b, segment, branch, self.tcp.copy(), travel, v, a))
-        self.move_payload.append(len(self.payloads) - 1)
+        self.move_payload.append(self.load)
         self.q = q_b
 
     def _target_pose(self, move: Move) -> Array:
@@ -289,6 +306,15 @@ class _Walk:
         return nearest_solution(self.robot, self.g, flange, near)
 
 
+def _same_payload(a: Payload | None, b: Payload | None) -> bool:
+    """Whether two loads are the same (``set_payload`` of the same values: one drive model)."""
+    if a is None or b is None:
+        return a is b
+    return (
+        a.mass == b.mass and np.array_equal(a.com, b.com) and np.array_equal(a.inertia, b.inertia)
+    )
+
+
 def _optional_geometry(robot: Robot) -> URGeometry | None:
     try:
         return ur_geometry(robot)
@@ -305,7 +331,7 @@ def _links(program: RobotProgram) -> NDArray[np.bool_]:
     for k, i in enumerate(index[:-1]):
         move = steps[i]
         assert isinstance(move, Move)
-        out[k] = move.r > 0.0 and isinstance(steps[i + 1], Move)
+        out[k] = move.blends and isinstance(steps[i + 1], Move)
     return out
 
 
@@ -342,7 +368,8 @@ def program_path(
     robot : Robot
     program : RobotProgram
     start : array_like, shape (n,), optional
-        Joints at the start, rad; default where the program ends (it runs in cycles).
+        Joints at the start, rad; default the program's own (:attr:`RobotProgram.start`), else
+        where it ends (it runs in cycles).
 
     Returns
     -------
@@ -354,9 +381,16 @@ def program_path(
         ``FILE:LINE: statement: what`` for a target out of reach or outside the joint limits.
     """
     for move in program.moves:
-        if not move.pose and robot.n != 6:
+        if not move.pose and move.target.size != robot.n:
             raise KinergyError(
-                f"{program.where(move.line)}: URScript joint targets have 6 joints, "
+                f"{program.where(move.line)}: the joint target has {move.target.size} joints, "
+                f"{robot.name} has {robot.n}"
+            )
+    if start is None and program.start is not None:
+        start = program.start
+        if start.size != robot.n:
+            raise KinergyError(
+                f"{program.path or program.name}: the start has {start.size} joints, "
                 f"{robot.name} has {robot.n}"
             )
     if start is None:
@@ -380,6 +414,8 @@ def _path(robot: Robot, program: RobotProgram, walk: _Walk, q0: Array) -> Progra
             continue
         if row[1] is not None:
             blend[k] = moves[k].r
+        elif moves[k].joint_blend > 0.0:
+            blend[k] = moves[k].joint_blend
         else:
             blend[k] = tool_blend_radius(robot, row[3], q_start[k], q_end[k], moves[k].r)
     events = walk.events
@@ -398,6 +434,7 @@ def _path(robot: Robot, program: RobotProgram, walk: _Walk, q0: Array) -> Progra
         event_time=np.array([e[0] for e in events], dtype=float),
         event_after=np.array([e[1] for e in events], dtype=np.intp),
         payloads=tuple(walk.payloads),
+        robots=tuple(robot if p is robot.payload else robot.with_payload(p) for p in walk.payloads),
         move_payload=np.array(walk.move_payload, dtype=np.intp),
         event_payload=np.array([e[2] for e in events], dtype=np.intp),
         geometry=walk.g,

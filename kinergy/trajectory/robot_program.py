@@ -45,8 +45,9 @@ class Move:
     Attributes
     ----------
     kind : {'movej', 'movel', 'movep'}
-    target : ndarray, shape (6,)
-        Joint angles (rad) or, when ``pose``, ``[x, y, z, rx, ry, rz]`` (m, rad).
+    target : ndarray, shape (n,) or (6,)
+        Joint angles (rad; URScript's have 6, a task's as many as its robot's joints) or, when
+        ``pose``, ``[x, y, z, rx, ry, rz]`` (m, rad).
     pose : bool
         Whether ``target`` is a pose (``p[...]``).
     a, v : float
@@ -55,6 +56,9 @@ class Move:
         Duration, s (0: from ``a`` and ``v``).
     r : float
         Blend radius at the tool, m (0: the move stops at its target).
+    joint_blend : float
+        A movej's blend radius on the leading joint, rad (a task's ``r``: kinergy's own); when
+        > 0 the move blends by it instead of by ``r`` (which is then only written out).
     qnear : ndarray, shape (6,), optional
         For a pose target: the joints the solution should be near (``get_inverse_kin(x,
         qnear)``); default the joints where the move starts (the controller's choice).
@@ -71,6 +75,7 @@ class Move:
     v: float
     t: float = 0.0
     r: float = 0.0
+    joint_blend: float = 0.0
     qnear: Array | None = None
     line: int = 0
     text: str = ""
@@ -79,8 +84,14 @@ class Move:
         if self.kind not in MOVE_DEFAULTS:
             raise KinergyError(f"unknown move {self.kind!r}")
         target = np.asarray(self.target, dtype=float)
-        if target.shape != (6,) or not np.all(np.isfinite(target)):
-            raise KinergyError(f"{self.kind}: the target must be 6 finite numbers")
+        if (
+            target.ndim != 1
+            or (self.pose and target.size != 6)
+            or target.size == 0
+            or not np.all(np.isfinite(target))
+        ):
+            what = "a pose of 6" if self.pose else "joint angles as"
+            raise KinergyError(f"{self.kind}: the target must be {what} finite numbers")
         object.__setattr__(self, "target", target)
         for name, low, strict in (("a", 0.0, True), ("v", 0.0, True), ("t", 0.0, False)):
             x = float(getattr(self, name))
@@ -89,9 +100,13 @@ class Move:
                     f"{self.kind}: {name} must be {'>' if strict else '>='} 0, got {x:g}"
                 )
             object.__setattr__(self, name, x)
-        if not (np.isfinite(self.r) and self.r >= 0.0):
-            raise KinergyError(f"{self.kind}: r must be >= 0, got {self.r:g}")
-        object.__setattr__(self, "r", float(self.r))
+        for name in ("r", "joint_blend"):
+            x = float(getattr(self, name))
+            if not (np.isfinite(x) and x >= 0.0):
+                raise KinergyError(f"{self.kind}: {name} must be >= 0, got {x:g}")
+            object.__setattr__(self, name, x)
+        if self.joint_blend > 0.0 and self.kind != "movej":
+            raise KinergyError(f"{self.kind}: a joint-space blend is for a movej only")
         if self.qnear is not None:
             qn = np.asarray(self.qnear, dtype=float)
             if qn.shape != (6,) or not np.all(np.isfinite(qn)):
@@ -102,6 +117,12 @@ class Move:
     def tool_space(self) -> bool:
         """Whether the tool moves on a straight line (``movel``, ``movep``)."""
         return self.kind != "movej"
+
+    @property
+    def blends(self) -> bool:
+        """Whether the move has a blend radius (it blends into the next move, if one follows
+        with no event between)."""
+        return self.r > 0.0 or self.joint_blend > 0.0
 
     def replaced(self, **changes: object) -> Move:
         """A copy with some fields changed."""
@@ -163,6 +184,8 @@ class RobotProgram:
         The file's lines, to write the program back with changed moves.
     notes : tuple of str
         What reading assumed (statements kept verbatim as events of fixed time).
+    start : ndarray, shape (n,), optional
+        Joints the program starts from, rad; None: where it ends (it runs in cycles).
     """
 
     name: str
@@ -170,9 +193,15 @@ class RobotProgram:
     path: str = ""
     lines: tuple[str, ...] = ()
     notes: tuple[str, ...] = field(default=())
+    start: Array | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "steps", tuple(self.steps))
+        if self.start is not None:
+            start = np.asarray(self.start, dtype=float)
+            if start.ndim != 1 or not np.all(np.isfinite(start)):
+                raise KinergyError(f"{self.path or self.name}: the start must be finite joints")
+            object.__setattr__(self, "start", start)
         if not self.moves:
             raise KinergyError(f"{self.path or self.name}: the program has no move")
 

@@ -17,7 +17,7 @@ from kinergy.io.motion import iter_motion
 from kinergy.io.urscript_reader import read_program
 from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
-from kinergy.optimize.program_samples import drive_by_payload
+from kinergy.optimize.samples import drive_by_payload
 from kinergy.predict import drive_state
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.program_motion import payload_index, program_motion
@@ -145,7 +145,7 @@ def program_energy(
     program = program_path(robot, read_program(path))
     motion, sched = program_motion(robot, program)
     load = payload_index(program, sched, motion.t)[0]
-    state = drive_by_payload(robot, program.payloads, load, motion.q, motion.qd, motion.qdd)
+    state = drive_by_payload(program.robots, load, motion.q, motion.qd, motion.qdd)
     return energy(robot, motion, recovery=recovery, state=state)
 
 

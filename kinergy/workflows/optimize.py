@@ -1,200 +1,178 @@
-"""The ``kinergy optimize`` pipeline: a task's energy-optimal timing, its Pareto front, files.
+"""The ``kinergy optimize ROBOT PROGRAM`` pipeline: a program doing the same job with less energy.
 
-Given a model and a task (the waypoints of a movej program, :mod:`kinergy.io.task`),
-:func:`optimize_task` finds the per-move ``v`` and ``a`` that minimise the model's electrical
-energy at a cycle time (:func:`kinergy.optimize.optimize_timing`), compared with the program as
-written and with uniform time scaling, all re-simulated at 500 Hz, and the Pareto front of energy
-against cycle time (:func:`kinergy.optimize.pareto_front`). :func:`run_optimize` also loads the
-task and writes the optimum as URScript (:func:`timing_script`) and the Pareto plot, all or none.
+:func:`read_any_program` reads a URScript program (``*.script``, :mod:`kinergy.io.urscript_reader`)
+or a task (a task file or a built-in task, :mod:`kinergy.io.task`) into the one program type;
+:func:`run_optimize` optimises it (:func:`kinergy.optimize.programs.optimize_program`), adds the
+Pareto front where asked (:func:`kinergy.optimize.programs.pareto_front`), and writes where asked,
+all or none and never over the program itself: the optimised program as URScript
+(:func:`kinergy.io.urscript.program_script`: every line but the moves kept), the Pareto plot and
+the two motions ``program.csv`` and ``optimized.csv`` (record.py layout, 500 Hz, ``timestamp``,
+``target_q_*``, ``target_qd_*``, ``target_qdd_*``). The URScript written is read back with
+kinergy's own reader and simulated again: :attr:`OptimizeRun.readback` is that energy.
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from kinergy.errors import KinergyError
-from kinergy.files import all_or_none
-from kinergy.io.task import Task, load_task
-from kinergy.io.urscript import movej_program, write_script
+from kinergy.files import all_or_none, atomic_folder, check_outputs
+from kinergy.io.rtde import write_log
+from kinergy.io.task import load_task
+from kinergy.io.urscript import move_statement, program_script, write_script
+from kinergy.io.urscript_reader import parse_program, read_program
 from kinergy.model.robot import Robot
-from kinergy.optimize import (
-    ParetoPoint,
-    TimingResult,
-    optimize_timing,
-    pareto_front,
-    timing_problem,
-)
+from kinergy.optimize.options import ProgramOptions
+from kinergy.optimize.programs import ProgramOptimization, optimize_program, pareto_front
+from kinergy.optimize.verify import simulate_path
 from kinergy.report.plots import save, timing_pareto
+from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.program_path import program_path
+from kinergy.trajectory.robot_program import Move, RobotProgram
 
-__all__ = ["MAX_MOVES", "OptimizeRun", "optimize_task", "run_optimize", "timing_script"]
+__all__ = ["OptimizeRun", "optimized_script", "read_any_program", "run_optimize"]
 
 
 @dataclass(frozen=True, eq=False)
 class OptimizeRun:
-    """What ``kinergy optimize`` computed and wrote.
+    """What ``kinergy optimize`` did with a program.
 
     Attributes
     ----------
     robot : Robot
-    task : Task
-    result : TimingResult
-        The program, uniform scaling and the optimum at the cycle time.
-    front : list of ParetoPoint
-        Energy against cycle time (empty when not asked for).
+    result : ProgramOptimization
+    script : str
+        The optimised program as URScript.
+    readback : float
+        The supply energy of ``script`` read back and simulated again, J.
     written : list of Path
-        The files written (Pareto plot, URScript).
+    notes : tuple of str
+        What reading the program assumed.
     """
 
     robot: Robot
-    task: Task
-    result: TimingResult
-    front: list[ParetoPoint]
+    result: ProgramOptimization
+    script: str
+    readback: float
     written: list[Path]
+    notes: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``optimize --json`` shape: the result, the robot's and task's names, the front."""
         out = self.result.to_dict()
         out["robot"] = self.robot.name
-        out["task"] = self.task.name
-        out["pareto"] = [p.to_dict() for p in self.front]
+        out["task"] = self.result.program.path.program.name
+        out["readback_e_supply"] = self.readback
+        out["notes"] = list(self.notes)
         return out
 
 
-MAX_MOVES = 100
-"""Most moves :func:`optimize_task` takes: a 30-move task costs about 40 s per timing on two
-cores, so a 100-move task with the default Pareto front already runs for tens of minutes."""
-
-
-def optimize_task(
-    robot: Robot,
-    task: Task,
-    *,
-    cycle_time: float | None = None,
-    v_max: float | None = None,
-    a_max: float | None = None,
-    points: int = 8,
-    share_budget: bool = True,
-) -> tuple[TimingResult, list[ParetoPoint]]:
-    """The energy-optimal timing of ``task`` at ``cycle_time`` (s; None: the program's own) and,
-    with ``points`` >= 2, the Pareto front; one timing problem serves both.
+def read_any_program(source: str | os.PathLike[str], robot: Robot) -> RobotProgram:
+    """A URScript program (``*.script``) or a task (a task file or a built-in task) as the
+    program the optimiser takes.
 
     Raises
     ------
     KinergyError
-        Prefixed with the task's name; a task of more than :data:`MAX_MOVES` moves.
+        ``FILE:LINE: ...`` or ``FILE: FIELD: ...``, one line.
     """
-    if task.moves > MAX_MOVES:
-        raise KinergyError(
-            f"{task.name}: {task.moves} moves; the timing optimiser takes at most {MAX_MOVES} "
-            "(each timing costs about 1.4 s per move on two cores; split the program)"
-        )
-    try:
-        problem = timing_problem(
-            robot, task.waypoints, blends=task.blends, v_max=v_max, a_max=a_max
-        )
-        result = optimize_timing(
-            robot,
-            task.waypoints,
-            cycle_time=cycle_time,
-            speeds=task.speeds,
-            accels=task.accels,
-            blends=task.blends,
-            v_max=v_max,
-            a_max=a_max,
-            share_budget=share_budget,
-            problem=problem,
-        )
-        front = []
-        if points:
-            front = pareto_front(
-                robot,
-                task.waypoints,
-                points=points,
-                speeds=task.speeds,
-                accels=task.accels,
-                blends=task.blends,
-                v_max=v_max,
-                a_max=a_max,
-                share_budget=share_budget,
-                problem=problem,
-            )
-    except KinergyError as exc:
-        raise exc.prefixed(f"{task.name}") from None
-    return result, front
+    if os.fspath(source).endswith(".script"):
+        return read_program(source)
+    return load_task(source, robot=robot)
 
 
-def timing_script(robot: Robot, task: Task, result: TimingResult) -> str:
-    """The optimum as a URScript movej program (the task's UR blend radii, if any)."""
-    opt = result.optimized
-    return movej_program(
-        task.waypoints,
-        opt.speeds,
-        opt.accels,
-        task.ur_blends if np.any(task.ur_blends > 0.0) else None,
-        name="kinergy_" + "".join(c if c.isalnum() else "_" for c in task.name),
-        cycle_time=opt.cycle_time,
-        energy=opt.e_elec,
-        comments=[
-            f"{robot.name}, task {task.name}: {100 * result.saving:.1f} % less energy than "
-            f"the program as written ({result.program.e_elec:.1f} J) at the same cycle time"
-        ],
-    )
+def optimized_script(result: ProgramOptimization) -> str:
+    """The optimised program as URScript, with a header saying what changed and its figures."""
+    own, opt = result.program.result, result.optimized.result
+    kept = [lv.name for lv in result.levers if lv.kept and lv.name not in ("program",)]
+    options = result.settings.options
+    header = [
+        f"kinergy optimize: {100 * result.saving_supply:.1f} % less supply energy "
+        f"(model-predicted; the motors' alone {100 * result.saving_motors:.1f} %) than the "
+        f"program as written: {own.e_supply:.1f} J -> {opt.e_supply:.1f} J per cycle of "
+        f"{opt.cycle_time:.3f} s",
+        f"levers used: {', '.join(kept) or 'none'}; tool symmetry {options.tool_symmetry.value}, "
+        f"configurations {options.configurations.value}, via points {options.via.value}",
+    ]
+    left = [c.line for c in result.targets if c.left_out]
+    if left:
+        header.append(
+            "via points left out of the route (they take the joints of the target before "
+            f"them): line{'s' if len(left) > 1 else ''} {', '.join(map(str, left))}"
+        )
+    written = result.written
+    if written.lines or written.start is None:
+        return program_script(written, header)
+    # a task that starts elsewhere than it ends: to its start first, not part of the cycle
+    first = Move("movej", written.start, pose=False, a=1.4, v=1.05)
+    header.append(f"first to the task's start (not part of the cycle): {move_statement(first)}")
+    return program_script(written, header)
+
+
+def _motion_signals(motion: Motion) -> dict[str, Any]:
+    return {"target_q": motion.q, "target_qd": motion.qd, "target_qdd": motion.qdd}
 
 
 def _write(
-    robot: Robot,
-    task: Task,
-    timing: tuple[TimingResult, list[ParetoPoint]],
+    run: tuple[ProgramOptimization, str],
     urscript: str | os.PathLike[str] | None,
+    motions: str | os.PathLike[str] | None,
     plot: str | os.PathLike[str] | None,
 ) -> list[Path]:
-    """Write the Pareto plot and the URScript where asked: all or none (no file is left behind
-    when one fails). Returns the paths written."""
-    result, front = timing
-    script = None if urscript is None else timing_script(robot, task, result)
-    figure = None if plot is None else timing_pareto(result, front)
+    """Write the URScript, the Pareto plot and the motions folder where asked: all or none."""
+    result, script = run
+    figure = None if plot is None else timing_pareto(result)
     with all_or_none() as written:
         if figure is not None and plot is not None:
             written.append(save(figure, plot))
-        if script is not None and urscript is not None:
+        if urscript is not None:
             written.append(write_script(urscript, script))
+        if motions is not None:
+            with atomic_folder(motions) as folder:
+                for name, run_ in (("program", result.program), ("optimized", result.optimized)):
+                    write_log(folder / f"{name}.csv", run_.motion.t, _motion_signals(run_.motion))
+            written += [Path(motions) / "program.csv", Path(motions) / "optimized.csv"]
     return written
 
 
 def run_optimize(
     robot: Robot,
-    task_name: str | os.PathLike[str],
+    source: str | os.PathLike[str],
     *,
-    cycle_time: float | None = None,
-    v_max: float | None = None,
-    a_max: float | None = None,
-    points: int = 8,
-    share_budget: bool = True,
+    options: ProgramOptions | None = None,
+    points: int = 0,
     urscript: str | os.PathLike[str] | None = None,
+    motions: str | os.PathLike[str] | None = None,
     plot: str | os.PathLike[str] | None = None,
+    progress: Callable[[str], None] | None = None,
 ) -> OptimizeRun:
-    """``kinergy optimize``: load the task, optimise it (:func:`optimize_task`), write the
-    URScript and the Pareto plot (PNG) where asked.
+    """``kinergy optimize ROBOT PROGRAM``: read (:func:`read_any_program`), optimise with
+    ``options`` (:func:`kinergy.optimize.programs.optimize_program`), the Pareto front at
+    ``points`` cycle times (0: none), read the result back, write.
 
     Raises
     ------
     KinergyError
-        A bad task, a cycle time below the fastest feasible, an unwritable file.
+        ``FILE:LINE: ...`` for a line that cannot be handled, a target out of reach or outside
+        the joint limits, a cycle time shorter than the fastest possible; a Pareto plot without
+        a front; an unwritable file.
     """
-    task = load_task(task_name, robot=robot)
-    result, front = optimize_task(
-        robot,
-        task,
-        cycle_time=cycle_time,
-        v_max=v_max,
-        a_max=a_max,
-        points=points,
-        share_budget=share_budget,
-    )
-    written = _write(robot, task, (result, front), urscript, plot)
-    return OptimizeRun(robot, task, result, front, written)
+    inputs = [Path(source)] if Path(source).exists() else []
+    check_outputs([("--urscript", urscript), ("--motions", motions), ("--plot", plot)], inputs)
+    if plot is not None and points < 2:
+        raise KinergyError("--plot: needs a Pareto front (--pareto-points of at least 2)")
+    program = read_any_program(source, robot)
+    result = optimize_program(robot, program, options, progress=progress)
+    if points:
+        result = replace(
+            result, pareto=pareto_front(robot, result, points=points, progress=progress)
+        )
+    script = optimized_script(result)
+    stem = Path(program.path).stem if program.path else program.name
+    back = parse_program(script, path=f"{stem}_optimized.script", name=program.name)
+    again = simulate_path(robot, program_path(robot, back), standby=result.settings.standby)
+    written = _write((result, script), urscript, motions, plot)
+    return OptimizeRun(robot, result, script, again.result.e_supply, written, program.notes)

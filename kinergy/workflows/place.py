@@ -4,7 +4,7 @@
 placements of a grid around today's (:func:`kinergy.optimize.placement.place_program`: each
 checked for reach and optimised with every lever at today's cycle time), writes the best
 placement's optimised program as URScript (its poses in the moved base frame, the user's names
-and comments kept: :func:`kinergy.workflows.optimize_program.optimized_script`) and the energy
+and comments kept: :func:`kinergy.workflows.optimize.optimized_script`) and the energy
 map (PNG, :func:`kinergy.report.placement.placement_map`) where asked, all or none and never over
 the program. The written program is read back with kinergy's own reader and simulated again:
 :attr:`PlaceRun.readback` is that energy, beside today's optimised program read back the same
@@ -24,16 +24,15 @@ from kinergy.files import all_or_none, check_outputs
 from kinergy.io.urscript import write_script
 from kinergy.io.urscript_reader import parse_program, read_program
 from kinergy.model.robot import Robot
-from kinergy.optimize.objectives import PROGRAM_OBJECTIVE
 from kinergy.optimize.options import ProgramOptions
 from kinergy.optimize.placement import Candidate, PlacementGrid, PlacementSearch, place_program
-from kinergy.optimize.program_verify import simulate_path
-from kinergy.optimize.programs import ProgramOptimization, supply
+from kinergy.optimize.programs import ProgramOptimization
+from kinergy.optimize.verify import simulate_path
 from kinergy.report.placement import placement_map
 from kinergy.report.plots import save
 from kinergy.trajectory.program_path import program_path
 from kinergy.trajectory.robot_program import RobotProgram
-from kinergy.workflows.optimize_program import optimized_script
+from kinergy.workflows.optimize import optimized_script
 
 __all__ = ["PlaceRun", "placed_script", "run_place"]
 
@@ -68,7 +67,8 @@ class PlaceRun:
     @property
     def saving(self) -> float:
         """The best placement's written program against today's optimised one, both read back,
-        0-1: what the placement saves beyond the program's levers."""
+        0-1: what the placement saves beyond the program's levers, of what the arm draws from
+        its supply (the motors and its standing draw over the cycle)."""
         return 1.0 - self.readback / self.today_readback
 
     def to_dict(self) -> dict[str, Any]:
@@ -85,6 +85,7 @@ class PlaceRun:
             "today_readback_e_supply": self.today_readback,
             "best_readback_e_supply": self.readback,
             "saving_beyond_levers": self.saving,
+            "saving_beyond_levers_motors": search.saving_motors,
             "candidates": [c.to_dict() for c in search.candidates],
             "written": [str(p) for p in self.written],
         }
@@ -95,8 +96,10 @@ def _summary(candidate: Candidate) -> dict[str, Any]:
     out = candidate.to_dict()
     result = candidate.result
     if result is not None:
-        out["e_program"] = result.program.result.score
-        out["saving_by_levers"] = result.saving
+        out["e_program"] = result.program.result.e_supply
+        out["e_program_motors"] = result.program.result.e_elec
+        out["saving_by_levers"] = result.saving_supply
+        out["saving_by_levers_motors"] = result.saving_motors
         out["levers"] = [lv.to_dict() for lv in result.levers]
         out["within_limits"] = result.optimized.result.ok
         out["targets_met"] = result.targets_met
@@ -130,10 +133,8 @@ def placed_script(search: PlacementSearch) -> str:
 def _read_back(robot: Robot, script: str, name: str, result: ProgramOptimization) -> float:
     """Supply energy of a written program read back by kinergy's reader and simulated again."""
     back = parse_program(script, path=f"{name}.script", name=name)
-    again = simulate_path(
-        robot, program_path(robot, back), objective=PROGRAM_OBJECTIVE(result.settings.standby)
-    )
-    return supply(again.result)
+    again = simulate_path(robot, program_path(robot, back), standby=result.settings.standby)
+    return again.result.e_supply
 
 
 def run_place(

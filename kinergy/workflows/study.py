@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
 
 from kinergy.accounting.energy import EnergyReport, energy
@@ -13,18 +14,19 @@ from kinergy.files import output_folder
 from kinergy.identification.chunks import Segment
 from kinergy.identification.result import IdentificationResult
 from kinergy.identification.validation import PLOT_SAMPLES, validation_report
-from kinergy.io.task import Task
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import LogReading
 from kinergy.messages import Messages
 from kinergy.model.robot import Robot
+from kinergy.optimize.options import ProgramOptions
+from kinergy.optimize.programs import optimize_program, pareto_front
 from kinergy.report.html import Section, Table, write_report
 from kinergy.report.study import Comparison, Study, Timing, study_sections
 from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.robot_program import RobotProgram
 from kinergy.workflows.energy import program_energy
 from kinergy.workflows.identify import identify_logs as identified
 from kinergy.workflows.logs import chunked_logs, read_motion
-from kinergy.workflows.optimize import optimize_task
 
 __all__ = ["optimal_timing", "run_study", "study_report", "write_study"]
 
@@ -49,10 +51,11 @@ def _comparisons(
     return torque, current
 
 
-def optimal_timing(model: Robot, task: Task, *, points: int = 6) -> Timing:
-    """The energy-optimal timing of ``task`` at its own cycle time and the Pareto front."""
-    result, front = optimize_task(model, task, points=points)
-    return Timing(task.name, result, front)
+def optimal_timing(model: Robot, task: RobotProgram, *, points: int = 6) -> Timing:
+    """The energy-optimal timing of ``task`` (a movej program; its path kept: no blends) at its
+    own cycle time and the Pareto front."""
+    result = optimize_program(model, task, ProgramOptions(blends=False))
+    return Timing(task.name, replace(result, pareto=pareto_front(model, result, points=points)))
 
 
 def run_study(
@@ -63,7 +66,7 @@ def run_study(
     result: IdentificationResult | None = None,
     truth: Robot | None = None,
     paper: bool = False,
-    task: Task | None = None,
+    task: RobotProgram | None = None,
     progress: Progress | None = None,
 ) -> Study:
     """Compute everything a study report shows (:class:`kinergy.report.study.Study`).
@@ -79,7 +82,7 @@ def run_study(
         program run with the loads it sets, :func:`~kinergy.workflows.energy.program_energy`).
     result, truth, paper
         See :class:`~kinergy.report.study.Study`.
-    task : Task, optional
+    task : RobotProgram, optional
         A movej program whose energy-optimal timing and Pareto front the report shows.
     """
     say = progress or (lambda _msg: None)

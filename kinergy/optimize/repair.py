@@ -11,7 +11,7 @@ the path, before the lever is judged:
    limits are sped up uniformly (``v c``, ``a c^2``, each at most to its own headroom) to keep the
    cycle time: up to three rounds, each re-simulated at 500 Hz;
 2. **re-timed**: should that not do, the timing solver at the cycle time within the caps
-   (:func:`kinergy.optimize.program_timing.retime`).
+   (:func:`kinergy.optimize.timing.retime`).
 
 Either way the result is a 500 Hz re-simulation; when neither brings it within the limits the
 caller drops the lever and says so.
@@ -29,35 +29,50 @@ from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import LIMIT_TOL
 from kinergy.optimize.objectives import Objective
-from kinergy.optimize.problem import uniform_scaling
-from kinergy.optimize.program_timing import PathChecks, path_checks, retime
-from kinergy.optimize.program_verify import PathRun, simulate_path
+from kinergy.optimize.problem import Caps, PathChecks, path_checks, uniform_scaling
+from kinergy.optimize.timing import retime
+from kinergy.optimize.verify import PathRun, simulate_path
 from kinergy.trajectory.program_motion import schedule
 from kinergy.trajectory.program_path import ProgramPath
 
-__all__ = ["Caps", "Repair", "at_cycle", "repair", "timing_checks"]
+__all__ = ["Context", "Repair", "at_cycle", "repair"]
 
 
 #: rounds of the per-move repair
 _ROUNDS = 3
 #: a move over a limit is slowed this much beyond its excess
 _MARGIN = 1.005
-#: the timing solver's caps are this share below the program's: its iterations end a few ms off
-#: the cycle time, and the uniform rescaling to it must stay within the caps
-_SLACK = 0.005
-#: why the timing solver may find no timing for a program that runs within its caps as written
-NO_ROOM = (
-    f"{100 * _SLACK:g} % below the speed caps (its iterations end a few ms off the cycle time)"
-)
 
 
-@dataclass(frozen=True)
-class Caps:
-    """The joint speed (rad/s) and acceleration (rad/s^2) caps every program is held to, besides
-    the robot's own limits."""
+@dataclass(frozen=True, eq=False)
+class Context:
+    """What every program of one optimisation is run and judged with: the robot, the cycle time
+    (s), the objective, the caps, the arm's standing draw (W) and whether the timing keeps each
+    move's share of the cycle time."""
 
-    speed: float
-    acceleration: float
+    robot: Robot
+    budget: float
+    objective: Objective
+    caps: Caps
+    standby: float
+    share_budget: bool = True
+
+    def run(self, path: ProgramPath, label: str) -> PathRun:
+        """``path`` at its own timing, re-simulated at 500 Hz against the caps."""
+        return simulate_path(
+            self.robot,
+            path,
+            standby=self.standby,
+            objective=self.objective,
+            speed_cap=self.caps.speed,
+            acceleration_cap=self.caps.acceleration,
+            label=label,
+        )
+
+    def checks(self, path: ProgramPath) -> PathChecks:
+        """The timing problem of ``path`` and its checks (:func:`kinergy.optimize.problem.
+        path_checks`)."""
+        return path_checks(self.robot, path, self.objective, self.caps, self.standby)
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,33 +84,14 @@ class Repair:
     how: str
 
 
-def at_cycle(
-    robot: Robot, path: ProgramPath, budget: float, objective: Objective, caps: Caps, label: str
-) -> PathRun:
-    """``path`` uniformly slowed (or sped up) to last ``budget`` s, its events keeping their
+def at_cycle(ctx: Context, path: ProgramPath, label: str) -> PathRun:
+    """``path`` uniformly slowed (or sped up) to last the cycle time, its events keeping their
     time, re-simulated at 500 Hz against the caps."""
     fixed = float(path.event_time.sum())
     own = float(schedule(path, path.speed, path.accel).total[0])
-    v, a = uniform_scaling(path.speed, path.accel, (own - fixed) / max(budget - fixed, 1e-9))
-    return _run(robot, path.with_timing(v, a), objective, caps, label)
-
-
-def _run(robot: Robot, path: ProgramPath, objective: Objective, caps: Caps, label: str) -> PathRun:
-    return simulate_path(
-        robot,
-        path,
-        objective=objective,
-        speed_cap=caps.speed,
-        acceleration_cap=caps.acceleration,
-        label=label,
-    )
-
-
-def timing_checks(robot: Robot, path: ProgramPath, objective: Objective, caps: Caps) -> PathChecks:
-    """The timing problem of ``path`` with the caps ``_SLACK`` below ``caps`` (speed, and its
-    square for acceleration: what a uniform rescaling by ``1 + _SLACK`` needs)."""
-    v_max, a_max = caps.speed * (1.0 - _SLACK), caps.acceleration * (1.0 - _SLACK) ** 2
-    return path_checks(robot, path, objective, v_max, a_max)
+    factor = (own - fixed) / max(ctx.budget - fixed, 1e-9)
+    v, a = uniform_scaling(path.speed, path.accel, factor)
+    return ctx.run(path.with_timing(v, a), label)
 
 
 def _excess(run: PathRun) -> tuple[Array, Array]:
@@ -159,39 +155,25 @@ def _per_move(path: ProgramPath, run: PathRun, budget: float) -> tuple[Array, Ar
     return v * factor, a * factor**2
 
 
-def repair(
-    robot: Robot,
-    run: PathRun,
-    budget: float,
-    objective: Objective,
-    caps: Caps,
-) -> Repair | None:
-    """The program of ``run`` (over a limit at ``budget`` s) within every limit and cap at the
-    same cycle time, by its timing alone (module docstring); None when neither step does it.
-
-    Raises
-    ------
-    KinergyError
-        Not raised for a program the timing cannot repair; only for bad input (a move whose
-        torques exceed the limits at any acceleration names its line).
-    """
-    path, current = run.path, run
+def repair(ctx: Context, run: PathRun) -> Repair | None:
+    """The program of ``run`` (over a limit at the cycle time) within every limit and cap at the
+    same cycle time, by its timing alone (module docstring); None when neither step does it."""
+    path, current, budget = run.path, run, ctx.budget
     for _ in range(_ROUNDS):
         timing = _per_move(path, current, budget)
         if timing is None:
             break
         path = path.with_timing(*timing)
-        current = _run(robot, path, objective, caps, run.result.label)
+        current = ctx.run(path, run.result.label)
         if current.result.ok:
             return Repair(current, "per move")
     try:
-        checks = timing_checks(robot, run.path, objective, caps)
-        result, _ = retime(checks, budget)
+        result, _ = retime(ctx.checks(run.path), budget, share_budget=ctx.share_budget)
     except KinergyError:
         return None  # (the cycle time is too short for this path within the caps)
     if not result.ok:
         return None
-    timed = _run(
-        robot, run.path.with_timing(result.speeds, result.accels), objective, caps, run.result.label
-    )
+    # the solver's iterations end a few ms off the cycle time: uniformly to it (the caps keep
+    # room for that)
+    timed = at_cycle(ctx, run.path.with_timing(result.speeds, result.accels), run.result.label)
     return Repair(timed, "re-timed") if timed.result.ok else None

@@ -1,25 +1,29 @@
-"""A movej program as a batched function of its timing: the samples the optimiser evaluates.
+"""A robot program as a batched function of its moves' timing: the samples the optimiser
+evaluates.
 
 The optimiser's variables are, per move, its duration ``t_k`` and ramp fraction ``f_k`` (the share
 of the move spent accelerating and braking: ``f = 2 tau / t``); :func:`settings` and
-:func:`durations` convert them to and from URScript's ``v`` and ``a``, with the profile of
-:mod:`kinergy.trajectory.movej` (the one movej planner).
-
-:func:`sample_programs` samples B programs at once at quadrature nodes and runs the drive model
-(:func:`kinergy.predict.drive_state`, the one forward path) over all of them in one call. Inside
-the optimiser the energy is a quadrature, not a fixed-step sum: Gauss-Legendre nodes on every
-piece between the profiles' switching times (start, end of ramp, start of braking, end), so it is
-a smooth function of the decision variables (a fixed ``dt`` grid makes it a staircase in them,
-which stalls gradient methods) at a few hundred model evaluations per program.
-:func:`motion_samples` gives a 500 Hz re-simulation the same form (trapezoid weights), so an
-objective (:mod:`kinergy.optimize.objectives`) is written once for both.
+:func:`durations` convert them to and from URScript's ``v`` and ``a`` (the profile of
+:mod:`kinergy.trajectory.movej`, the one trapezoid planner). For a resolved
+:class:`~kinergy.trajectory.program_path.ProgramPath` (movej, movel, movep, blends, events of
+fixed time), :func:`sample_path_programs` plans B programs
+(:func:`kinergy.trajectory.program_motion.schedule_profiles`), samples them at quadrature nodes and
+runs the drive model (:func:`kinergy.predict.drive_state`, the one forward path) over every sample
+with the load the program has set there (:func:`drive_by_payload`). Inside the optimiser the
+energy is a quadrature, not a fixed-step sum: Gauss-Legendre nodes on every piece between the
+moves' switching times (start, end of ramp, start of braking, end) while a move runs, and one node
+per event (the arm at rest, its power constant), so it is a smooth function of the decision
+variables (a fixed ``dt`` grid makes it a staircase in them, which stalls gradient methods) at a
+few hundred model evaluations per program. A 500 Hz re-simulation takes the same form
+(:func:`samples_at` with :func:`grid_weights`), so an objective
+(:mod:`kinergy.optimize.objectives`) is written once for both.
 """
 
 from __future__ import annotations
 
 import functools
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import ParamSpec, TypeVar
 
 import numpy as np
@@ -29,15 +33,24 @@ from kinergy.arrays import Array
 from kinergy.dynamics.threads import kernel_threads
 from kinergy.model.robot import Robot
 from kinergy.predict import DriveState, drive_state
-from kinergy.trajectory.movej import MovejPlan, blend_starts, sample_moves, trapezoid_timing
+from kinergy.trajectory.movej import trapezoid_timing
+from kinergy.trajectory.program_motion import (
+    LineTables,
+    Schedule,
+    payload_index,
+    sample_path,
+    schedule_profiles,
+)
+from kinergy.trajectory.program_path import ProgramPath
 
 __all__ = [
     "ProgramSamples",
+    "drive_by_payload",
     "durations",
     "grid_weights",
-    "motion_samples",
-    "quadrature_nodes",
-    "sample_programs",
+    "path_schedule",
+    "piece_nodes",
+    "sample_path_programs",
     "samples_at",
     "serial",
     "settings",
@@ -45,8 +58,9 @@ __all__ = [
 
 Mask = NDArray[np.bool_]
 
-#: Gauss-Legendre quadrature: sub-intervals per piece and nodes per sub-interval
-_SUB = 4
+#: Gauss-Legendre quadrature: sub-intervals per piece and nodes per sub-interval (the 500 Hz
+#: re-simulation makes the final figures)
+_SUB = 2
 _ORDER = 4
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(_ORDER)
 
@@ -88,23 +102,23 @@ def durations(travel: Array, v: Array, a: Array) -> tuple[Array, Array]:
     return t, f
 
 
-def quadrature_nodes(
-    breaks: Array, *, sub: int = _SUB, order: int = _ORDER
+def piece_nodes(
+    lo: Array, hi: Array, *, sub: int = _SUB, order: int = _ORDER
 ) -> tuple[Array, Array, Mask]:
-    """Gauss-Legendre nodes and weights over the pieces between sorted breakpoints, plus the ends
-    of every piece nudged inside it (weight 0, for the limit checks at the switching times).
+    """Gauss-Legendre nodes and weights over pieces ``[lo, hi]``, plus the ends of every piece
+    nudged inside it (weight 0, for the limit checks at the switching times).
 
     Parameters
     ----------
-    breaks : ndarray, shape (B, P)
-        Sorted switching times of each program, s.
+    lo, hi : ndarray, shape (B, P)
+        Where each piece of each program starts and ends, s.
     sub, order : int
         Sub-intervals per piece and Gauss-Legendre nodes per sub-interval.
 
     Returns
     -------
     times, weights : ndarray, shape (B, M)
-        s; the weights integrate over ``[breaks[:, 0], breaks[:, -1]]``.
+        s; the weights integrate over the pieces.
     valid : ndarray of bool, shape (B, M)
         Whether the node lies in a piece of non-zero width: a node of an empty piece sits on a
         switching time, where rounding can put it in two phases at once (the braking of one move
@@ -113,15 +127,14 @@ def quadrature_nodes(
     gauss_x, gauss_w = (
         (_GAUSS_X, _GAUSS_W) if order == _ORDER else np.polynomial.legendre.leggauss(order)
     )
-    lo, hi = breaks[:, :-1], breaks[:, 1:]  # (B, P - 1)
     width = (hi - lo) / sub
-    centre = lo[..., None] + (np.arange(sub) + 0.5) * width[..., None]  # (B, P-1, SUB)
+    centre = lo[..., None] + (np.arange(sub) + 0.5) * width[..., None]  # (B, P, SUB)
     half = 0.5 * width[..., None, None]
-    t = centre[..., None] + half * gauss_x  # (B, P-1, SUB, ORDER)
+    t = centre[..., None] + half * gauss_x  # (B, P, SUB, ORDER)
     w = np.broadcast_to(half * gauss_w, t.shape)
     eps = 1e-9 * np.maximum(hi - lo, 0.0)
-    ends = np.stack([lo + eps, hi - eps], axis=-1)  # (B, P-1, 2)
-    big_b = breaks.shape[0]
+    ends = np.stack([lo + eps, hi - eps], axis=-1)  # (B, P, 2)
+    big_b = lo.shape[0]
     times = np.concatenate([t.reshape(big_b, -1), ends.reshape(big_b, -1)], axis=1)
     weights = np.concatenate([w.reshape(big_b, -1), np.zeros((big_b, ends[0].size))], axis=1)
     wide = (hi - lo) > 1e-9
@@ -216,38 +229,6 @@ def samples_at(
     return ProgramSamples(times, weights, _move_of(times, start), inside, drive)
 
 
-def sample_programs(
-    robot: Robot, waypoints: Array, blends: Array, t: Array, f: Array
-) -> ProgramSamples:
-    """B movej programs through ``waypoints`` at the quadrature nodes, with the drive model.
-
-    Parameters
-    ----------
-    robot : Robot
-    waypoints : ndarray, shape (K + 1, n)
-        rad.
-    blends : ndarray, shape (K,)
-        Joint-space blend radii, rad.
-    t, f : ndarray, shape (B, K)
-        Each program's move durations (s) and ramp fractions.
-
-    Returns
-    -------
-    ProgramSamples
-        Gauss-Legendre nodes between every program's switching times (:func:`quadrature_nodes`).
-    """
-    travel = np.max(np.abs(np.diff(waypoints, axis=0)), axis=1)
-    v, a, ramp = settings(travel, t, f)
-    start = blend_starts(travel, blends, t, a, ramp)
-    end = start + t
-    breaks = np.sort(np.concatenate([start, start + ramp, end - ramp, end], axis=1), axis=1)
-    times, weights, valid = quadrature_nodes(breaks)  # (B, M)
-    q, qd, qdd = sample_moves(waypoints, times, start, t, ramp, v, a)
-    n = waypoints.shape[1]
-    state = drive_state(robot, q.reshape(-1, n), qd.reshape(-1, n), qdd.reshape(-1, n))
-    return samples_at(times, weights, start, end, state, valid)
-
-
 def grid_weights(t: Array) -> Array:
     """Trapezoid-rule weights of samples at times ``t`` (N,), s: ``sum(w x) = int x dt``."""
     weights = np.zeros_like(t)
@@ -257,17 +238,126 @@ def grid_weights(t: Array) -> Array:
     return weights
 
 
-def motion_samples(t: Array, plan: MovejPlan, drive: DriveState) -> ProgramSamples:
-    """One program sampled on a time grid (a 500 Hz re-simulation) as :class:`ProgramSamples`.
+def drive_by_payload(
+    robots: tuple[Robot, ...],
+    load: NDArray[np.intp],
+    q: Array,
+    qd: Array,
+    qdd: Array,
+) -> DriveState:
+    """The drive model (:func:`kinergy.predict.drive_state`) at samples that carry different
+    loads.
 
     Parameters
     ----------
-    t : ndarray, shape (N,)
-        Sample times, s (trapezoid weights).
-    plan : MovejPlan
-        The program's plan (move starts and durations).
-    drive : DriveState
-        The drive model at the samples, arrays of shape (N, n).
+    robots : tuple of Robot
+        The robot carrying each load (:attr:`kinergy.trajectory.program_path.ProgramPath.robots`).
+    load : ndarray of int, shape (N,)
+        Index into ``robots`` of each sample's load.
+    q, qd, qdd : ndarray, shape (N, n)
+
+    Returns
+    -------
+    DriveState
+        Arrays of shape (N, n), each sample computed with its load.
     """
-    start = plan.start[None, :]
-    return samples_at(t[None, :], grid_weights(t)[None, :], start, start + plan.duration, drive)
+    used = np.unique(load)
+    if used.size == 1:
+        return drive_state(robots[int(used[0])], q, qd, qdd)
+    parts = {
+        int(i): drive_state(robots[int(i)], q[m], qd[m], qdd[m])
+        for i in used
+        if np.any(m := load == i)
+    }
+    out = {}
+    for f in fields(DriveState):
+        arr = np.zeros(q.shape)
+        for i, state in parts.items():
+            arr[load == i] = getattr(state, f.name)
+        out[f.name] = arr
+    return DriveState(**out)
+
+
+def path_schedule(path: ProgramPath, t: Array, f: Array) -> Schedule:
+    """B programs on ``path`` given their moves' durations ``t`` (s) and ramp fractions ``f``,
+    shape (B, K) (:func:`settings`)."""
+    v, a, ramp = settings(path.travel, t, f)
+    return schedule_profiles(path, t, ramp, v, a)
+
+
+def _nodes(path: ProgramPath, sched: Schedule) -> tuple[Array, Array, NDArray[np.bool_]]:
+    """The quadrature of B programs: Gauss-Legendre nodes on every piece between the moves'
+    switching times (start, end of ramp, start of braking, end) where a move runs, and one node
+    per event of non-zero time (the arm at rest there, its load fixed: the power is constant),
+    weighted by its time. Times, weights and valid nodes, shape (B, M) each."""
+    end = sched.start + sched.duration
+    breaks = np.sort(
+        np.concatenate([sched.start, sched.start + sched.ramp, end - sched.ramp, end], axis=1),
+        axis=1,
+    )
+    lo, hi = breaks[:, :-1], breaks[:, 1:]
+    mid = 0.5 * (lo + hi)
+    running = np.any(
+        (mid[:, :, None] > sched.start[:, None, :]) & (mid[:, :, None] < end[:, None, :]), axis=2
+    )
+    keep = np.any(running & (hi - lo > 1e-12), axis=0)  # the same pieces in every program
+    times, weights, valid = piece_nodes(lo[:, keep], hi[:, keep], sub=_SUB)
+    timed = path.event_time > 0.0
+    if np.any(timed):
+        at_rest = sched.event_start[:, timed] + 0.5 * path.event_time[timed]
+        times = np.concatenate([times, at_rest], axis=1)
+        weights = np.concatenate(
+            [weights, np.broadcast_to(path.event_time[timed], at_rest.shape)], axis=1
+        )
+        valid = np.concatenate([valid, np.ones(at_rest.shape, dtype=bool)], axis=1)
+    return times, weights, valid
+
+
+def _samples(
+    robot: Robot,
+    path: ProgramPath,
+    sched: Schedule,
+    times: Array,
+    weights: Array,
+    valid: NDArray[np.bool_] | None,
+    tables: LineTables | None = None,
+) -> ProgramSamples:
+    q, qd, qdd = sample_path(robot, path, sched, times, tables=tables)
+    n = path.q0.size
+    load = payload_index(path, sched, times).reshape(-1)
+    drive = drive_by_payload(
+        path.robots, load, q.reshape(-1, n), qd.reshape(-1, n), qdd.reshape(-1, n)
+    )
+    end = sched.start + sched.duration
+    return samples_at(times, weights, sched.start, end, drive, valid)
+
+
+def sample_path_programs(
+    robot: Robot,
+    path: ProgramPath,
+    t: Array,
+    f: Array,
+    *,
+    tables: LineTables | None = None,
+) -> ProgramSamples:
+    """B programs on ``path`` at the quadrature nodes, with the drive model.
+
+    Parameters
+    ----------
+    robot : Robot
+    path : ProgramPath
+    t, f : ndarray, shape (B, K)
+        Each program's move durations (s) and ramp fractions.
+    tables : LineTables, optional
+        Lone tool moves sampled from their tables
+        (:func:`kinergy.trajectory.program_motion.line_tables`).
+
+    Returns
+    -------
+    ProgramSamples
+        Gauss-Legendre nodes between every program's switching times while a move runs, one
+        node per event (:func:`_nodes`); events count to the move before them.
+    """
+    sched = path_schedule(path, t, f)
+    times, weights, valid = _nodes(path, sched)
+    return _samples(robot, path, sched, times, weights, valid, tables)

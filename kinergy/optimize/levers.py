@@ -2,11 +2,11 @@
 
 :class:`LeverSearch` carries the best program so far. :meth:`LeverSearch.judge` resolves a
 lever's program, runs it at the cycle time (uniformly slowed or sped up), repairs it if it breaks
-a limit (:func:`kinergy.optimize.program_repair.repair`: re-timed per move, then by the timing
+a limit (:func:`kinergy.optimize.repair.repair`: re-timed per move, then by the timing
 solver) and keeps it if its 500 Hz re-simulation beats the best so far; every lever is recorded
 as a :class:`Lever` with what it saved or why it was dropped. :func:`path_levers` runs the ``2 pi``
 wraps and the search over configurations, tool turns and via points (one cost table, a cheapest
-cycle per set of levers, :mod:`kinergy.optimize.program_search`), :func:`via_blends` the blend
+cycle per set of levers, :mod:`kinergy.optimize.search`), :func:`via_blends` the blend
 radii and :func:`timed` the timing solver.
 """
 
@@ -23,20 +23,18 @@ from numpy.typing import NDArray
 from kinergy.dynamics.poses import tcp_pose
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
-from kinergy.optimize.objectives import Objective
 from kinergy.optimize.options import ToolSymmetry
 from kinergy.optimize.path_costs import TargetStates, move_costs, refined_turns, target_states
-from kinergy.optimize.program_repair import NO_ROOM, Caps, at_cycle, repair, timing_checks
-from kinergy.optimize.program_search import (
+from kinergy.optimize.repair import Context, at_cycle, repair
+from kinergy.optimize.search import (
     cheapest_cycle,
     chosen_moves,
     lever_mask,
     masked,
     wrapped_moves,
 )
-from kinergy.optimize.program_timing import retime
-from kinergy.optimize.program_verify import PathRun
-from kinergy.optimize.verify import ProgramResult
+from kinergy.optimize.timing import NO_ROOM, Verified, retime
+from kinergy.optimize.verify import PathRun, ProgramResult
 from kinergy.trajectory.program_path import ProgramPath, program_path
 from kinergy.trajectory.robot_program import Move, RobotProgram
 
@@ -46,7 +44,6 @@ __all__ = [
     "LeverStatus",
     "PathLevers",
     "path_levers",
-    "supply",
     "timed",
     "via_blends",
     "with_timing",
@@ -62,8 +59,8 @@ _BLEND_MAX = 0.10
 _FINER = (np.deg2rad(15.0), np.deg2rad(5.0))
 
 
-def supply(result: ProgramResult) -> float:
-    """The supply energy of a scored program (:attr:`ProgramResult.score`), J."""
+def _score(result: ProgramResult) -> float:
+    """The objective of a scored program (:attr:`ProgramResult.score`: the supply energy, J)."""
     if result.score is None:
         raise KinergyError(f"{result.label}: the program was not scored")
     return result.score
@@ -129,7 +126,7 @@ class Lever:
             "repaired": self.repaired or None,
             "note": self.note,
             "cycle_time": self.result.cycle_time,
-            "e_supply": self.result.score,
+            "e_supply": self.result.e_supply,
             "e_elec": self.result.e_elec,
             "within_limits": self.result.ok,
         }
@@ -159,7 +156,7 @@ def _same_moves(a: RobotProgram, b: RobotProgram) -> bool:
 
     def key(m: Move) -> tuple[object, ...]:
         qnear = None if m.qnear is None else m.qnear.tobytes()
-        return (m.kind, m.target.tobytes(), m.pose, m.a, m.v, m.t, m.r, qnear)
+        return (m.kind, m.target.tobytes(), m.pose, m.a, m.v, m.t, m.r, m.joint_blend, qnear)
 
     return [key(m) for m in a.moves] == [key(m) for m in b.moves]
 
@@ -167,11 +164,12 @@ def _same_moves(a: RobotProgram, b: RobotProgram) -> bool:
 class LeverSearch:
     """The levers' runs, in order, the best so far carried on (module docstring)."""
 
-    def __init__(
-        self, robot: Robot, budget: float, objective: Objective, caps: Caps, best: PathRun
-    ) -> None:
-        self.robot, self.budget, self.objective, self.caps = robot, budget, objective, caps
+    def __init__(self, ctx: Context, best: PathRun) -> None:
+        self.ctx = ctx
+        self.robot, self.budget = ctx.robot, ctx.budget
         self.best = best
+        #: how the timing lever's solution came about (None until it ran)
+        self.timing: Verified | None = None
         self.levers: list[Lever] = [Lever("program", best.result, LeverStatus.AS_WRITTEN)]
         #: which moves' targets the best program leaves out (via points), shape (K,)
         self.left_out = np.zeros(best.path.moves, dtype=bool)
@@ -186,10 +184,10 @@ class LeverSearch:
             The program cannot run (a target out of reach, ...).
         """
         path = program_path(self.robot, program)
-        first = at_cycle(self.robot, path, self.budget, self.objective, self.caps, label)
+        first = at_cycle(self.ctx, path, label)
         if first.result.ok:
             return first, ""
-        fixed = repair(self.robot, first, self.budget, self.objective, self.caps)
+        fixed = repair(self.ctx, first)
         return (first, "") if fixed is None else (fixed.run, fixed.how)
 
     def judge(
@@ -215,7 +213,7 @@ class LeverSearch:
             except KinergyError as exc:
                 lever = Lever(name, before, LeverStatus.NOT_POSSIBLE, note=f"{text}: {exc}")
                 continue
-            saved = supply(before) - supply(run.result)
+            saved = _score(before) - _score(run.result)
             late = run.result.cycle_time - self.budget
             if not run.result.ok:
                 why = "; ".join(run.result.check.violations())
@@ -248,11 +246,14 @@ class LeverSearch:
         the cycle time is not the program's own."""
         before = self.best
         run, how = self.run(before.path.program, "uniform scaling")
-        status = LeverStatus.KEPT if run.result.ok else LeverStatus.OVER_LIMITS
+        late = run.result.cycle_time - self.budget > CYCLE_TOLERANCE
+        status = LeverStatus.KEPT if run.result.ok and not late else LeverStatus.OVER_LIMITS
         note = "the program as written at the cycle time"
         if not run.result.ok:
             note += "; even re-timed: " + "; ".join(run.result.check.violations())
-        saved = supply(before.result) - supply(run.result)
+        elif late:
+            note += f"; within the limits only at {run.result.cycle_time:.3f} s"
+        saved = _score(before.result) - _score(run.result)
         self.levers.append(Lever("uniform scaling", run.result, status, saved, note, how))
         self.best = run
 
@@ -361,7 +362,7 @@ def via_blends(robot: Robot, path: ProgramPath) -> list[Move]:
     for k, move in enumerate(program.moves):
         i = index[k]
         after = steps[i + 1] if k + 1 < path.moves else None
-        via = isinstance(after, Move) and move.kind == after.kind == "movej" and move.r == 0.0
+        via = isinstance(after, Move) and move.kind == after.kind == "movej" and not move.blends
         if via:
             r = min(_BLEND_MAX, _BLEND_SHARE * min(reach[k], reach[k + 1]))
             move = move.replaced(r=round(float(r), 4))
@@ -374,11 +375,13 @@ def timed(search: LeverSearch, say: Callable[[str], None]) -> None:
     at the cycle time within the caps, written back as a program and judged."""
     path = search.best.path
     say("timing: solving every move's v and a")
-    checks = timing_checks(search.robot, path, search.objective, search.caps)
     try:
-        result, verified = retime(checks, search.budget)
+        result, verified = retime(
+            search.ctx.checks(path), search.budget, share_budget=search.ctx.share_budget
+        )
     except KinergyError as exc:  # the timing model's fastest is above the cycle time
         note = f"no room to re-time: the solver keeps {NO_ROOM}; {exc}"
         search.record(Lever("timing", search.best.result, LeverStatus.NOT_POSSIBLE, note=note))
         return
+    search.timing = verified
     search.judge("timing", with_timing(path, result), verified.words)

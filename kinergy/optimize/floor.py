@@ -1,6 +1,6 @@
 """Where a robot program's energy goes, per joint, and the share of it no lever can touch.
 
-:func:`energy_floor` splits a re-simulated program (:class:`~kinergy.optimize.program_verify.
+:func:`energy_floor` splits a re-simulated program (:class:`~kinergy.optimize.verify.
 PathRun`) into the parts of :func:`kinergy.accounting.energy.part_powers` per joint (friction,
 copper, gravity, inertial; framework Fig. 4) and sets beside them two figures that no timing,
 blend or speed lever changes once the joint path is chosen:
@@ -32,8 +32,8 @@ from kinergy.arrays import Array
 from kinergy.drives.electrics import friction_torques
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.model.robot import Robot
-from kinergy.optimize.program_samples import drive_by_payload
-from kinergy.optimize.program_verify import PathRun
+from kinergy.optimize.samples import drive_by_payload
+from kinergy.optimize.verify import PathRun
 from kinergy.trajectory.program_motion import payload_index
 
 __all__ = ["EnergyFloor", "energy_floor"]
@@ -104,7 +104,7 @@ def energy_floor(robot: Robot, run: PathRun) -> EnergyFloor:
     ----------
     robot : Robot
     run : PathRun
-        The program at 500 Hz (:func:`kinergy.optimize.program_verify.simulate_path`).
+        The program at 500 Hz (:func:`kinergy.optimize.verify.simulate_path`).
 
     Returns
     -------
@@ -112,11 +112,11 @@ def energy_floor(robot: Robot, run: PathRun) -> EnergyFloor:
     """
     motion, path = run.motion, run.path
     load = payload_index(path, run.schedule, motion.t)[0]  # (N,)
-    state = drive_by_payload(robot, path.payloads, load, motion.q, motion.qd, motion.qdd)
+    state = drive_by_payload(path.robots, load, motion.q, motion.qd, motion.qdd)
     powers = part_powers(robot, state)
     parts = {k: np.asarray(np.trapezoid(p, motion.t, axis=0)) for k, p in powers.items()}
     still = np.zeros_like(motion.q)
-    holding = drive_by_payload(robot, path.payloads, load, motion.q, still, still).power
+    holding = drive_by_payload(path.robots, load, motion.q, still, still).power
     length = np.sum(np.abs(np.diff(motion.q, axis=0)), axis=0)
     moving = run.result.cycle_time - float(path.event_time.sum())
     return EnergyFloor(
