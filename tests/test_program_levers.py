@@ -362,7 +362,8 @@ def test_blends_go_only_between_joint_moves_so_straight_lines_stay_whole() -> No
 def test_no_lever_buys_its_saving_with_a_longer_cycle() -> None:
     """A program at its own limits leaves no room: a lever whose program holds the limits only
     when it takes longer is not kept, and the timing reports itself not possible (it claimed
-    17.8 % by taking 2.774 s for a 2.390 s cycle)."""
+    17.8 % by taking 2.774 s for a 2.390 s cycle); the blends are refused, whether the re-timing
+    ends past the cycle time or over a limit within it."""
     from kinergy.optimize.levers import CYCLE_TOLERANCE, LeverStatus
 
     robot = load_robot("ur5e")
@@ -374,4 +375,6 @@ def test_no_lever_buys_its_saving_with_a_longer_cycle() -> None:
         if lever.status is LeverStatus.KEPT:
             assert lever.result.cycle_time <= own + CYCLE_TOLERANCE, lever.name
     blends = next(lv for lv in result.levers if lv.name == "blends")
-    assert blends.status is LeverStatus.OVER_LIMITS and "over the cycle time" in blends.note
+    # refused either way: within the limits only past the cycle time, or over a limit re-timed
+    assert blends.status is LeverStatus.OVER_LIMITS
+    assert "over the cycle time" in blends.note or "even re-timed" in blends.note

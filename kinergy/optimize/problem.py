@@ -191,6 +191,16 @@ def uniform_scaling(speeds: Array, accels: Array, factor: float) -> tuple[Array,
     return np.asarray(speeds, dtype=float) * factor, np.asarray(accels, dtype=float) * factor**2
 
 
+def joint_caps(robot: Robot, caps: Caps) -> tuple[Array, Array]:
+    """Every joint's speed (rad/s) and acceleration (rad/s^2) bound: its limit or the cap,
+    the lower, shape (n,) each (``inf``: none)."""
+    speed = np.array([j.limits.speed for j in robot.joints])
+    acc = np.array(
+        [np.inf if j.limits.acceleration is None else j.limits.acceleration for j in robot.joints]
+    )
+    return np.minimum(speed, caps.speed), np.minimum(acc, caps.acceleration)
+
+
 def path_caps(
     robot: Robot, path: ProgramPath, v_max: float | None, a_max: float | None
 ) -> tuple[Array, Array, list[str], list[str]]:
@@ -241,15 +251,26 @@ class _PathModel:
     path: ProgramPath
     objective: Objective
     tables: LineTables
+    caps: Caps
 
     def parts(self, t: Array, f: Array) -> tuple[Array, Array, Array]:
-        """Objective (B,), its per-move parts (B, K) and torque ratios (B, K) of B timings
-        ``t, f`` (B, K)."""
+        """Objective (B,), its per-move parts (B, K) and limit ratios (B, K) of B timings
+        ``t, f`` (B, K): per move the largest joint torque over its limit at the samples and,
+        for a tool move, the largest joint speed or acceleration over its cap (a line's joints
+        move faster and harder where it curves in joint space than its ``v`` and ``a`` tell; a
+        movej's joints follow its leading joint, bounded by ``v_cap`` and ``a_cap``)."""
         samples = sample_path_programs(
             self.robot, self.path, np.atleast_2d(t), np.atleast_2d(f), tables=self.tables
         )
         value, parts = self.objective(samples)
-        return value, parts, torque_ratio(self.robot, samples)
+        ratio = torque_ratio(self.robot, samples)
+        tool = np.array([segment is not None for segment in self.path.tool])
+        if np.any(tool) and samples.qd is not None and samples.qdd is not None:
+            speed, acc = joint_caps(self.robot, self.caps)
+            room = 1.0 + _RATE_ROOM  # a move at its speed cap stays within the torque's margin
+            rates = np.maximum(np.abs(samples.qd) / speed, np.abs(samples.qdd) / acc) / room
+            ratio = np.maximum(ratio, np.where(tool, samples.move_max(rates.max(axis=1)), 0.0))
+        return value, parts, ratio
 
     def evaluate(self, t: Array, f: Array) -> tuple[Array, Array]:
         value, _, ratio = self.parts(t, f)
@@ -317,6 +338,10 @@ class PathChecks:
 #: the timing solver's caps are this share below the program's: its iterations end a few ms off
 #: the cycle time, and the uniform rescaling to it must stay within the caps
 SLACK = 0.005
+#: the joints' speeds and accelerations at the quadrature nodes may pass the solver's caps by
+#: this share (they stay within the program's; the fastest setting of a move keeps the torques
+#: 0.1 % below their limits, and its speed at its cap)
+_RATE_ROOM = 0.002
 
 
 def path_checks(
@@ -332,6 +357,6 @@ def path_checks(
         A move whose torques exceed the limits at any acceleration (naming its line).
     """
     slack = Caps(caps.speed * (1.0 - SLACK), caps.acceleration * (1.0 - SLACK) ** 2)
-    model = _PathModel(robot, path, objective, line_tables(robot, path))
+    model = _PathModel(robot, path, objective, line_tables(robot, path), slack)
     problem = _problem(model, slack.speed, slack.acceleration)
     return PathChecks(robot, path, problem, slack, model, standby)

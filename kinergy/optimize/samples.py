@@ -166,6 +166,8 @@ class ProgramSamples:
         a sample can lie in two).
     drive : DriveState
         The drive model at every sample, arrays of shape (B * M, n), program by program.
+    qd, qdd : ndarray, shape (B * M, n), optional
+        The joint speeds (rad/s) and accelerations (rad/s^2) at every sample.
     """
 
     t: Array
@@ -173,6 +175,8 @@ class ProgramSamples:
     move: NDArray[np.intp]
     inside: Mask
     drive: DriveState = field(repr=False)
+    qd: Array | None = field(default=None, repr=False)
+    qdd: Array | None = field(default=None, repr=False)
 
     @property
     def moves(self) -> int:
@@ -209,6 +213,7 @@ def samples_at(
     end: Array,
     drive: DriveState,
     valid: Mask | None = None,
+    rates: tuple[Array, Array] | None = None,
 ) -> ProgramSamples:
     """:class:`ProgramSamples` of B programs at given times.
 
@@ -222,11 +227,14 @@ def samples_at(
         The drive model at the samples, arrays of shape (B * M, n).
     valid : ndarray of bool, shape (B, M), optional
         Samples that count for the moves' spans (default all).
+    rates : tuple of ndarray, shape (B * M, n) each, optional
+        The joint speeds and accelerations at the samples.
     """
     inside = (times[:, :, None] >= start[:, None, :]) & (times[:, :, None] <= end[:, None, :])
     if valid is not None:
         inside &= valid[:, :, None]
-    return ProgramSamples(times, weights, _move_of(times, start), inside, drive)
+    qd, qdd = (None, None) if rates is None else rates
+    return ProgramSamples(times, weights, _move_of(times, start), inside, drive, qd, qdd)
 
 
 def grid_weights(t: Array) -> Array:
@@ -322,14 +330,13 @@ def _samples(
     valid: NDArray[np.bool_] | None,
     tables: LineTables | None = None,
 ) -> ProgramSamples:
-    q, qd, qdd = sample_path(robot, path, sched, times, tables=tables)
-    n = path.q0.size
-    load = payload_index(path, sched, times).reshape(-1)
-    drive = drive_by_payload(
-        path.robots, load, q.reshape(-1, n), qd.reshape(-1, n), qdd.reshape(-1, n)
+    q, qd, qdd = (
+        x.reshape(-1, path.q0.size) for x in sample_path(robot, path, sched, times, tables=tables)
     )
+    load = payload_index(path, sched, times).reshape(-1)
+    drive = drive_by_payload(path.robots, load, q, qd, qdd)
     end = sched.start + sched.duration
-    return samples_at(times, weights, sched.start, end, drive, valid)
+    return samples_at(times, weights, sched.start, end, drive, valid, (qd, qdd))
 
 
 def sample_path_programs(

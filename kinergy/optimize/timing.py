@@ -79,7 +79,7 @@ __all__ = [
 #: why the timing solver may find no timing for a program that runs within its caps as written
 NO_ROOM = f"{100 * SLACK:g} % below the speed caps (its iterations end a few ms off the cycle time)"
 #: SLSQP iterations per attempt of the timing solver
-_MAXITER = 25
+_MAXITER = 50
 #: the allocation's grid: durations per move, ramp fractions, programs evaluated at once, and
 #: the steps of the budget its dynamic programme counts in
 _DURATIONS = 24
@@ -262,19 +262,30 @@ def _best_verified(
     return optimized, Verified(outcome, kept, iterations, label, active)
 
 
+def _ramps(dist: Array, grid_t: Array, v_cap: Array, a_cap: Array) -> Array:
+    """``_RAMPS`` ramp fractions per grid duration and move, (D, R, m), spanning those within
+    the move's speed and acceleration caps: ``f (1 - f/2) >= 2 D / (a t^2)`` (the acceleration)
+    and ``f <= 2 (1 - D / (v t))`` (the speed), where the two meet near the fastest duration."""
+    c = 2.0 * dist / (a_cap * grid_t**2)
+    low = np.where(c <= 0.5, 1.0 - np.sqrt(np.maximum(1.0 - 2.0 * c, 0.0)), 1.0)
+    high = np.clip(2.0 * (1.0 - dist / (grid_t * v_cap)), 0.0, 1.0)
+    high = np.maximum(high, low)
+    u = np.linspace(0.0, 1.0, _RAMPS)[None, :, None]
+    return np.clip(low[:, None, :] + u * (high - low)[:, None, :], 1e-3, 1.0)
+
+
 def _grid_energy(
     checks: PathChecks, moving: NDArray[np.intp], grid_t: Array, grid_f: Array
 ) -> tuple[Array, Array]:
     """Each moving move's part of the objective at every grid duration (D, m), with its cheapest
-    ramp fraction of ``grid_f`` (R, m) within its speed and acceleration caps and torque limits:
+    ramp fraction of ``grid_f`` (D, R, m) within its speed and acceleration caps and its limits:
     the least part (D, m, inf where none fits) and that ramp fraction (D, m). Program ``(d, r)``
-    of the grid runs every move at its own ``(grid_t[d], grid_f[r])``."""
+    of the grid runs every move at its own ``(grid_t[d], grid_f[d, r])``."""
     model, problem, path = checks.model, checks.problem, checks.path
-    assert model is not None
-    d_count, r_count = grid_t.shape[0], grid_f.shape[0]
+    d_count, r_count = grid_f.shape[0], grid_f.shape[1]
     dist = path.travel[moving]
     t_all = np.repeat(grid_t, r_count, axis=0)  # (D R, m)
-    f_all = np.tile(grid_f, (d_count, 1))
+    f_all = grid_f.reshape(d_count * r_count, moving.size)
     v_all, a_all, _ = settings(dist, t_all, f_all)
     t_full = np.zeros((t_all.shape[0], path.moves))
     f_full = np.ones((t_all.shape[0], path.moves))
@@ -292,7 +303,7 @@ def _grid_energy(
     energy = np.where(ok, np.vstack(parts), np.inf).reshape(d_count, r_count, moving.size)
     pick = np.argmin(energy, axis=1)  # (D, m)
     best = np.take_along_axis(energy, pick[:, None, :], axis=1)[:, 0, :]
-    ramp = np.take_along_axis(grid_f, pick, axis=0)  # (D, m)
+    ramp = np.take_along_axis(grid_f, pick[:, None, :], axis=1)[:, 0, :]  # (D, m)
     return best, ramp
 
 
@@ -336,12 +347,12 @@ def allocated(checks: PathChecks, budget: float) -> tuple[Array, Array] | None:
 
     Every move's part of the objective (the move and the events after it) is evaluated on a grid
     of its duration (``_DURATIONS`` geometric steps from its fastest within the caps to the
-    longest the budget leaves it) and ramp fraction (``_RAMPS``), all moves at once in each of
-    the grid's programs; per duration the cheapest ramp within the move's speed and acceleration
-    caps and torque limits; then the durations whose sum fits the budget at the least total,
-    exactly on the grid, by dynamic programming over the time used (:func:`_share`). A second
-    pass does the same on a finer grid around each move's choice (between its neighbouring grid
-    durations and ramps). The moves interact only through blends, which this ignores: the solver
+    longest the budget leaves it) and ramp fraction (``_RAMPS`` across those within its caps,
+    :func:`_ramps`), all moves at once in each of the grid's programs; per duration the cheapest
+    ramp within the move's caps and limits; then the durations whose sum fits the budget at the
+    least total, exactly on the grid, by dynamic programming over the time used
+    (:func:`_share`). A second pass does the same on a finer grid around each move's choice
+    (between its neighbouring grid durations). The moves interact only through blends, which this ignores: the solver
     starts from it, uniformly scaled to the budget. None where no grid point fits.
     """
     problem, path = checks.problem, checks.path
@@ -349,27 +360,27 @@ def allocated(checks: PathChecks, budget: float) -> tuple[Array, Array] | None:
     if checks.model is None or moving.size == 0:
         return None
     dist = path.travel[moving]
-    total = budget - float(path.event_time.sum())
+    # the moves' durations add up to the budget less the events' time, plus what blends overlap
+    # (as in the program uniformly scaled to the budget)
+    t0, _ = durations(path.travel, *scaled_to(problem, path, path.speed, path.accel, budget))
+    total = max(float(t0.sum()), budget - float(path.event_time.sum()))
     fast_t, _ = durations(dist, problem.v_cap[moving], problem.a_fast[moving])
     spare = total - float(fast_t.sum())
     if spare <= 0.0:
         return None
+    v_cap, a_fast = problem.v_cap[moving], problem.a_fast[moving]
     grid_t = fast_t * np.geomspace(1.0, (fast_t + spare) / fast_t, _DURATIONS)  # (D, m)
-    grid_f = np.linspace(1.0 / _RAMPS, 1.0, _RAMPS)[:, None] * np.ones(moving.size)
-    best, ramp = _grid_energy(checks, moving, grid_t, grid_f)
+    best, ramp = _grid_energy(checks, moving, grid_t, _ramps(dist, grid_t, v_cap, a_fast))
     chosen = _share(best, grid_t, total)
     if chosen is None:
         return None
     cols = np.arange(moving.size)
     low = grid_t[np.maximum(chosen - 1, 0), cols]
     high = grid_t[np.minimum(chosen + 1, _DURATIONS - 1), cols]
-    f = ramp[chosen, cols]
     fine_t = low + np.linspace(0.0, 1.0, _DURATIONS)[:, None] * (high - low)
-    step = 1.0 / _RAMPS
-    fine_f = np.clip(f + np.linspace(-step, step, _RAMPS)[:, None], 0.25 * step, 1.0)
-    fine, fine_ramp = _grid_energy(checks, moving, fine_t, fine_f)
+    fine, fine_ramp = _grid_energy(checks, moving, fine_t, _ramps(dist, fine_t, v_cap, a_fast))
     again = _share(fine, fine_t, total)
-    t = grid_t[chosen, cols]
+    t, f = grid_t[chosen, cols], ramp[chosen, cols]
     if again is not None and fine[again, cols].sum() < best[chosen, cols].sum():
         t, f = fine_t[again, cols], fine_ramp[again, cols]
     v, a, _ = settings(dist, t, f)
