@@ -31,7 +31,7 @@ from kinergy.accounting.energy import EnergyReport
 from kinergy.accounting.energy import energy as _energy_of_motion
 from kinergy.errors import KinergyError
 from kinergy.files import check_replaceable
-from kinergy.identification.options import IdentifyOptions, Method, Solver, Target
+from kinergy.identification.options import IdentifyOptions, Method, Solver, Target, friction_option
 from kinergy.identification.result import IdentificationResult
 from kinergy.identification.validation import ValidationReport
 from kinergy.io.columns import parse_columns
@@ -165,7 +165,7 @@ def identify(
     r = _robot(robot)
     options = IdentifyOptions(
         method=_choice(Method, method, "method"),
-        friction=friction,
+        friction=friction_option(friction, "friction"),
         target=_choice(Target, target, "target"),
         solver=_choice(Solver, solver, "solver"),
         ridge=ridge,

@@ -38,7 +38,7 @@ from scipy.spatial.transform import Rotation
 import kinergy
 from kinergy.cli import main
 from kinergy.drives.transmission import reflected_inertia, transmission_matrix
-from kinergy.friction.registry import friction_torque
+from kinergy.friction.registry import get_model
 from kinergy.model import robot_to_dict
 from kinergy.model.mjcf import robot_to_mjcf
 from kinergy.model.urdf_export import robot_to_urdf
@@ -129,7 +129,11 @@ def _lines(robot: kinergy.Robot) -> tuple[np.ndarray, np.ndarray]:
         )
         w, tau = w.ravel(), tau.ravel()
         friction = joint.drive.friction
-        f = friction_torque(friction.model, friction.params, w[:, None], tau[:, None]).ravel()
+        f = (
+            get_model(friction.model)
+            .friction_torque(friction.params, w[:, None], tau[:, None])
+            .ravel()
+        )
         c[k], b[k] = _nonnegative_line(np.column_stack([np.sign(w), w]), f)
     return c, b
 
@@ -659,7 +663,7 @@ def test_foreign_urdf_gives_its_transmissions_and_dynamics(tmp_path: Path) -> No
     c, b = _lines(robot)
     for joint, ck, bk in zip(back.joints, c, b, strict=True):
         assert joint.drive.gear_ratio == 100.0
-        assert joint.drive.friction.model == "viscous_coulomb"
+        assert joint.drive.friction.name == "viscous_coulomb"
         assert joint.drive.friction.params["coulomb"] == pytest.approx(ck, rel=1e-12)
         assert joint.drive.friction.params["viscous"] == pytest.approx(bk, rel=1e-12)
     q, qd, qdd = random_state(robot, 20, seed=3)

@@ -159,7 +159,7 @@ def _ur5e_dict() -> dict:
             lambda d: d["joints"][3].update(colour="blue"),
             r"joints\[3\] \(wrist_1\): unknown field\(s\) 'colour'",
         ),
-        (lambda d: d.update(convention="euler"), "convention must be one of dh, mdh"),
+        (lambda d: d.update(convention="euler"), "convention: must be one of dh, mdh, got 'euler'"),
         (
             lambda d: d["joints"][5]["limits"].update(position=[1.0, -1.0]),
             r"limits.position must be \[lower, upper\]",

@@ -158,7 +158,7 @@ def _drives(r: Robot) -> str:
                 fmt(d.torque_constant),
                 fmt(d.motor_constant),
                 fmt(d.kt_over_kb),
-                f"{d.friction.model} {friction}",
+                f"{d.friction.name} {friction}",
             ]
         )
     return table(headers, rows)
@@ -229,7 +229,7 @@ def _calibration_text(result: CalibrationImport, out: str, points: bool) -> str:
             [
                 j.name,
                 f"{j.torque_constant:.4f}",
-                f"{j.friction.model} {params}",
+                f"{j.friction.model.name} {params}",
                 f"{100 * np.max(np.abs(model / measured - 1)):.1f}",
                 "yes" if np.all(np.abs(model - measured) <= tol) else "NO",
                 f"{100 * np.max(np.abs(contrast / measured - 1)):.1f}",

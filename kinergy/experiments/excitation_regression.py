@@ -46,7 +46,7 @@ from kinergy.dynamics.regressor import (
     regressor,
     regressor_gradient,
 )
-from kinergy.friction.registry import friction_columns
+from kinergy.friction.viscous_coulomb import MODEL as VISCOUS_COULOMB
 from kinergy.linalg import column_scale, pivoted_rank
 from kinergy.model.robot import Robot
 
@@ -64,8 +64,6 @@ __all__ = [
 CRITERIA = ("cond", "dopt")
 #: joint-side speed (rad/s) of the tanh that stands in for the Coulomb column's sign
 COULOMB_SMOOTHING = 0.05
-#: the friction model whose columns stand for every motor's friction (viscous and Coulomb)
-_FRICTION = "viscous_coulomb"
 #: a drive column whose part independent of the link base columns is below this is dependent
 _DEPENDENT_TOL = 1e-8
 #: central-difference step of the friction columns' derivative in qd, rad/s
@@ -74,9 +72,9 @@ _FD_STEP = 1e-6
 
 def _motor_columns(smoothing: Array, wm: Array, dwm: Array) -> Array:
     """Rotor-inertia, viscous and Coulomb columns of every motor, motor side, (N, 3, n):
-    ``dwm``, then the registry's viscous and Coulomb columns of ``wm`` at ``smoothing[m]``."""
+    ``dwm``, then the ``viscous_coulomb`` model's viscous and Coulomb columns of ``wm`` at ``smoothing[m]``."""
     friction = [
-        friction_columns(_FRICTION, {"viscous": 0.0, "coulomb": 0.0, "smoothing": s}, wm[:, m])
+        VISCOUS_COULOMB.friction_columns({"viscous": 0.0, "coulomb": 0.0, "smoothing": s}, wm[:, m])
         for m, s in enumerate(smoothing)
     ]  # each (N, 2): viscous, Coulomb
     return np.concatenate([dwm[:, None, :], np.stack(friction, axis=2)], axis=1)

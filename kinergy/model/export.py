@@ -147,7 +147,7 @@ def friction_comments(robot: Robot, side: JointSide) -> list[tuple[int, str]]:
         out.append(
             (
                 k,
-                f"motor of joint {joint.name}: friction model {joint.drive.friction.model!r} is "
+                f"motor of joint {joint.name}: friction model {joint.drive.friction.name!r} is "
                 f"not Coulomb + viscous; exported as its best line, Coulomb "
                 f"{_fmt(line.coulomb)} N m and viscous {_fmt(line.viscous)} N m s/rad motor side"
                 f"{joint_part}; RMS error {_fmt(line.rms_error)} N m motor side "

@@ -47,7 +47,6 @@ import numpy as np
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import get_model
 from kinergy.model.robot import Friction, Robot, transmission_matrix
 
 __all__ = [
@@ -163,20 +162,21 @@ def friction_line(friction: Friction, speed: float, load: float) -> FrictionLine
     from scipy.optimize import nnls  # heavy (0.2 s): imported on first use
 
     u, tau_load = _grid(load)
-    spec = get_model(friction.model)
     with np.errstate(all="ignore"):  # a non-finite torque is refused below
-        f = np.asarray(spec.torque(friction.params, u * speed, tau_load, None), dtype=float)
+        f = np.asarray(
+            friction.model.torque(friction.params, u * speed, tau_load, None), dtype=float
+        )
     columns = np.column_stack([np.sign(u), u])  # unknowns c and b w_max: both columns O(1)
     if not np.all(np.isfinite(f)) or float(np.max(np.abs(f))) > MAGNITUDE:
         raise KinergyError(
-            f"friction model {friction.model!r} has no finite Coulomb + viscous line over motor "
+            f"friction model {friction.name!r} has no finite Coulomb + viscous line over motor "
             f"speeds up to {speed:g} rad/s and loads up to {load:g} N m"
         )
     solution, _ = nnls(columns, f)
     coulomb, viscous = float(solution[0]), float(solution[1] / speed)
     if not np.isfinite(viscous):
         raise KinergyError(
-            f"friction model {friction.model!r}: a motor speed range of {speed:g} rad/s is too "
+            f"friction model {friction.name!r}: a motor speed range of {speed:g} rad/s is too "
             "small for a viscous coefficient"
         )
     residual = f - columns @ solution

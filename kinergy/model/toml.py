@@ -409,7 +409,7 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         drive: dict[str, Any] = {key: getattr(j.drive, key) for key in _DRIVE_NUMBERS}
         if j.drive.winding_resistance is not None:
             drive["winding_resistance"] = j.drive.winding_resistance
-        drive["friction"] = {"model": j.drive.friction.model, **j.drive.friction.params}
+        drive["friction"] = j.drive.friction.as_dict()
         if j.drive.thermal is not None:
             drive["thermal"] = {key: getattr(j.drive.thermal, key) for key in _THERMAL_KEYS}
         limits: dict[str, Any] = {

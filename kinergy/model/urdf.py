@@ -51,11 +51,14 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction.model import SMOOTHING
+from kinergy.friction.none import MODEL as NO_FRICTION
+from kinergy.friction.viscous_coulomb import MODEL as VISCOUS_COULOMB
 from kinergy.model.frames import joint_transforms, mdh_transform
 from kinergy.model.friction_line import joint_side, motor_ranges
 from kinergy.model.robot import (
     CONVENTIONS,
     SOURCE_CATEGORIES,
+    Convention,
     Drive,
     Friction,
     Joint,
@@ -567,11 +570,11 @@ def _standard_drive(name: str, standard: Standard) -> Drive:
     damping, coulomb = standard.dynamics.get(name, (0.0, 0.0))
     friction = (
         Friction(
-            "viscous_coulomb",
+            VISCOUS_COULOMB,
             {"viscous": damping / gear**2, "coulomb": coulomb / abs(gear), "smoothing": SMOOTHING},
         )
         if damping > 0.0 or coulomb > 0.0
-        else Friction("none", {})
+        else Friction(NO_FRICTION, {})
     )
     return Drive(
         gear_ratio=gear,
@@ -887,7 +890,7 @@ def _drives_found(robot_joints: Sequence[Joint]) -> str:
             ),
             (
                 "friction from <dynamics>",
-                any(j.drive.friction.model != "none" for j in robot_joints),
+                any(j.drive.friction.model is not NO_FRICTION for j in robot_joints),
             ),
         )
         if present
@@ -988,11 +991,11 @@ def _generic(
     ]
     flange = np.linalg.solve(frames[-1], poses[tip])
     flange[np.abs(flange) < 1e-14] = 0.0
-    friction = any(j.drive.friction.model != "none" for j in joints)
+    friction = any(j.drive.friction.model is not NO_FRICTION for j in joints)
     try:
         robot = Robot(
             name=name or urdf.robot.name or path.stem,
-            convention="mdh",
+            convention=Convention.MDH,
             joints=tuple(joints),
             base=frames[0],
             flange=flange,

@@ -166,7 +166,7 @@ def _kinergy_element(robot: Robot, side: JointSide, names: tuple[str, str, str])
         drive.set("kt_over_kb", number(d.kt_over_kb))
         if d.winding_resistance is not None:
             drive.set("winding_resistance", number(d.winding_resistance))
-        friction = ET.SubElement(element, _tag("friction"), model=d.friction.model)
+        friction = ET.SubElement(element, _tag("friction"), model=d.friction.name)
         for key, value in d.friction.params.items():
             friction.set(key, number(value))
         friction.set("line_speed", number(line.speed))

@@ -95,7 +95,7 @@ def truth_tables(truth: Robot, model: Robot, held_out: IdentData) -> list[Table]
                 mj.name,
                 _pct(m.torque_constant, t.torque_constant),
                 _pct(m.rotor_inertia, t.rotor_inertia),
-                m.friction.model,
+                m.friction.name,
                 f"{r2[j]:.4f}",
             ]
         )

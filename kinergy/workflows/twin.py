@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 from typing import TypeGuard
 
+from kinergy import checks
 from kinergy.io.log import Log
 from kinergy.io.rtde import write_log
 from kinergy.io.urscript_reader import read_program
@@ -14,16 +15,17 @@ from kinergy.model.robot import Robot
 from kinergy.model.toml import save_robot
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import TEST_TRAJECTORIES, paper_trajectory
-from kinergy.twin import TwinSettings, realistic_truth, simulate
+from kinergy.twin import Mismatch, TwinSettings, realistic_truth, simulate
 from kinergy.workflows.logs import read_motion
 
 __all__ = ["builtin_log", "is_builtin", "simulate_to_file", "twin_truth"]
 
 
-def twin_truth(robot: Robot, mismatch: str, seed: int) -> Robot:
+def twin_truth(robot: Robot, mismatch: Mismatch | str, seed: int) -> Robot:
     """The twin's true robot for ``--mismatch``: the model itself (``none``) or
     :func:`kinergy.twin.realistic_truth` of it, seeded (``realistic``)."""
-    return realistic_truth(robot, seed) if mismatch == "realistic" else robot
+    mismatch = checks.choice(mismatch, Mismatch, "mismatch")
+    return realistic_truth(robot, seed) if mismatch == Mismatch.REALISTIC else robot
 
 
 def is_builtin(name: object) -> TypeGuard[str]:
