@@ -33,6 +33,7 @@ from kinergy.model import (
 )
 from kinergy.model.export import Export
 from kinergy.model.mjcf import robot_to_mjcf
+from kinergy.model.urdf import import_urdf
 from kinergy.model.urdf_export import robot_to_urdf
 from kinergy.workflows.calibration import CalibrationImport, import_calibration
 
@@ -348,14 +349,14 @@ def robot_import_urdf(
 ) -> None:
     """Read a URDF serial chain into a robot file (TOML).
 
-    A URDF written by `kinergy robot export` gives back the model it was written from (its
-    <kinergy:model> element holds the drives and what else URDF cannot). Any other URDF gives
-    modified-DH kinematics, the link inertials and limits, gear ratios from ROS
-    SimpleTransmissions and Coulomb + viscous friction from <dynamics>; the rest of the drives
+    A URDF written by `kinergy robot export` gives back the robot file it was written from (its
+    <kinergy:robot> element holds it), after checking the standard elements against it. Any other
+    URDF, as published (meshes and the like are skipped), gives modified-DH kinematics, the link
+    inertials and limits, gear ratios from <transmission> (ROS or ros2_control
+    SimpleTransmission; Drake's drake:gear_ratio), rotor inertias where a transmission gives them
+    (drake:rotor_inertia) and Coulomb + viscous friction from <dynamics>; the rest of the drives
     is nominal: identify it from logs before trusting energy predictions.
     """
-    from kinergy.model.urdf import import_urdf  # needs the urdf extra (yourdfpy)
-
     if Path(out).suffix.lower() == ".urdf":
         raise KinergyError(
             f"--out: {out} would be written as TOML but read back as URDF; name it .toml"
@@ -365,6 +366,8 @@ def robot_import_urdf(
     save_robot(
         r, out, header=f"{r.name}: imported from {Path(urdf).name} by kinergy robot import-urdf"
     )
+    for text in result.notes:
+        note(text)
     if not result.restored:
         note(
             "the drives not in the URDF are nominal (marked so in the robot file): identify them "

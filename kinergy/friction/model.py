@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.errors import Code, KinergyError
 from kinergy.friction.standstill import OPTIONAL_PARAMETERS, OPTIONAL_UNITS, hold
@@ -99,6 +100,10 @@ class FrictionModel:
         Each parameter's unit (motor side), as tables print it: ``{"viscous": "N m s/rad"}``.
     linear_values, with_linear : callable, optional
         How :attr:`linear` maps to and from the parameters, when not one to one by name.
+    line : callable or None
+        For a family that is a Coulomb level plus a viscous term (its Coulomb term smoothed by
+        ``tanh(wm / smoothing)``): ``line(params) -> (coulomb, viscous)`` (N m, N m s/rad),
+        what the URDF and MJCF exports write for it exactly (:mod:`kinergy.model.friction_line`).
     """
 
     name: str
@@ -118,6 +123,7 @@ class FrictionModel:
     with_linear: Callable[[FrictionModel, Mapping[str, float], Array], dict[str, float]] = (
         _replace_by_name
     )
+    line: Callable[[Mapping[str, float]], tuple[float, float]] | None = None
 
     def __post_init__(self) -> None:
         bounds = {name: LEVEL_BOUNDS for name in self.linear}
@@ -163,21 +169,17 @@ class FrictionModel:
                 f"(expected: {', '.join(names)})",
                 Code.UNKNOWN_KEY,
             )
-        out: dict[str, float] = {}
-        for name in names:
-            value = params[name]
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise KinergyError(f"friction parameter {name!r} must be a number, got {value!r}")
-            if not np.isfinite(value):
-                raise KinergyError(f"friction parameter {name!r} must be finite, got {value!r}")
-            if name in self.positive and value <= 0.0:
-                raise KinergyError(f"friction parameter {name!r} must be > 0, got {value!r}")
-            if name in OPTIONAL_PARAMETERS and value < 0.0:
-                raise KinergyError(f"friction parameter {name!r} must be >= 0, got {value!r}")
-            if name == "holding" and value > 1.0:
-                raise KinergyError(f"friction parameter 'holding' must be <= 1, got {value!r}")
-            out[name] = float(value)
-        return out
+        bounds: dict[str, dict[str, float]] = {
+            **{name: {"gt": 0.0} for name in self.positive},
+            **{name: {"ge": 0.0} for name in OPTIONAL_PARAMETERS},
+            "holding": {"ge": 0.0, "le": 1.0},
+        }
+        return {
+            name: checks.number(
+                params[name], f"friction parameter {name!r}", **bounds.get(name, {})
+            )
+            for name in names
+        }
 
     def friction_torque(
         self,
