@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
 from kinergy.drives.electrics import controller_voltage, winding_resistances
@@ -117,9 +118,7 @@ class TwinSettings:
             "voltage_noise",
             "ripple",
         ):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0.0):
-                raise KinergyError(f"{name} must be >= 0, got {value}")
+            object.__setattr__(self, name, checks.number(getattr(self, name), name, ge=0.0))
 
     @classmethod
     def exact(cls) -> TwinSettings:
