@@ -666,6 +666,8 @@ def current_step(
     models = [options.family or j.drive.friction.model for j in staged.joints]
     summary = logs.summary("current")
     edges = _folds(logs) if options.auto else [0, summary.samples]
+    several = options.auto or any(models[m].search for m in active)  # passes: keep the signals
+    passes = _Passes(logs, staged, rotor, edges, several)
     if options.auto:
         asks = [
             _auto_fit(m, staged.joints[m], candidates(summary, m), holdings, summary.samples)
@@ -673,8 +675,6 @@ def current_step(
         ]
     else:
         asks = [_fixed_fit(m, staged.joints[m], models[m], holdings) for m in active]
-    several = options.auto or any(models[m].search for m in active)
-    passes = _Passes(logs, staged, rotor, edges, several)
     fits = dict(zip(active, answer(together(asks), passes), strict=True))
     joints: list[Joint] = []
     stats: list[CurrentStats] = []

@@ -281,16 +281,6 @@ def _parsed(target: Target | str, solver: Solver | str) -> tuple[Target, Solver]
     return checks.choice(target, Target, "target"), checks.choice(solver, Solver, "solver")
 
 
-def _check_options(solver: Solver, ridge: float) -> None:
-    ridge = checks.number(ridge, "ridge", ge=0.0)
-    if solver == Solver.RIDGE and ridge == 0.0:
-        raise KinergyError("solver 'ridge' needs ridge > 0 (the weight of the prior, e.g. 1e-4)")
-    if solver != Solver.RIDGE and ridge != 0.0:
-        raise KinergyError(
-            f"ridge = {ridge:g} is only used by solver 'ridge', not {solver.value!r}"
-        )
-
-
 def _pick_target(logs: LogChunks, target: Target) -> Target:
     """``target``, checked against the logs; ``AUTO``: torque, else moment, else current."""
     if target == Target.AUTO:
@@ -669,7 +659,6 @@ def identify_full(
     if not datas:
         raise KinergyError("no log to identify from")
     parsed_target, parsed_solver = _parsed(target, solver)
-    _check_options(parsed_solver, ridge)
     family = friction_option(friction, "friction")
     options = IdentifyOptions(Method.FULL, family, parsed_target, parsed_solver, ridge)
     return full(robot, LogChunks.of(datas), options, currents=currents)
@@ -689,7 +678,6 @@ def full(
     :func:`identify_full` with its ``target``, ``solver``, ``ridge`` and ``friction`` from
     ``options``."""
     options = options or IdentifyOptions(Method.FULL)
-    _check_options(options.solver, options.ridge)
     target = _pick_target(logs, options.target)
     with_currents = currents and logs.every("current")
     current = CurrentOptions(options.friction)

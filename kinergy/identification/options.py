@@ -181,7 +181,18 @@ class IdentifyOptions:
                 "methods",
                 Code.UNSUPPORTED,
             )
-        object.__setattr__(self, "ridge", checks.number(self.ridge, "--ridge", ge=0.0))
+        ridge = checks.number(self.ridge, "--ridge", ge=0.0)
+        object.__setattr__(self, "ridge", ridge)
+        if self.method != Method.FULL:
+            return
+        if self.solver == Solver.RIDGE and ridge == 0.0:
+            raise KinergyError(
+                "solver 'ridge' needs ridge > 0 (the weight of the prior, e.g. 1e-4)"
+            )
+        if self.solver != Solver.RIDGE and ridge != 0.0:
+            raise KinergyError(
+                f"ridge = {ridge:g} is only used by solver 'ridge', not {self.solver.value!r}"
+            )
 
 
 #: the nursing doc's low-pass cutoff for the motor currents, Hz

@@ -226,7 +226,8 @@ def identify_sequential(
         Logs that cannot identify a parameter (a joint that never moves or never reverses, too few
         samples, a singular regression), naming the joints.
     """
-    return sequential(robot, LogChunks.of(datas), CurrentOptions(friction_option(friction), hold))
+    options = CurrentOptions(friction_option(friction), hold)  # the family resolved, once
+    return sequential(robot, LogChunks.of(datas), options)
 
 
 @one_blas_thread
