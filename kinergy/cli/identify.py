@@ -198,7 +198,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     default=None,
     help="Friction model for every joint (default: the model's own), e.g. power_law, "
     "load_coulomb, thermal_viscous; auto: per joint, the model with the lowest "
-    "cross-validated current RMS (sequential method).",
+    "cross-validated current RMS (sequential and full methods; the logs need actual_current). "
+    "The nursing method fits its own (Makkar) friction and takes none.",
 )
 @click.option(
     "--target",
