@@ -314,8 +314,8 @@ _EXPORTERS: dict[str, Callable[..., Export]] = {"urdf": robot_to_urdf, "mjcf": r
     "format_name",
     type=click.Choice(sorted(_EXPORTERS)),
     required=True,
-    help="urdf: kinematics, link inertials, limits and joint-side friction, with the drives in a "
-    "<kinergy:model> element (robot import-urdf reads it back); mjcf: a MuJoCo model with the "
+    help="urdf: kinematics, link inertials, limits and joint-side friction, with the robot file "
+    "itself in a <kinergy:robot> element (robot import-urdf reads it back); mjcf: a MuJoCo model with the "
     "reflected rotor inertia as armature, the friction as damping and frictionloss, torque "
     "actuators.",
 )

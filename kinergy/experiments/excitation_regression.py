@@ -8,8 +8,8 @@ The regression the full identification solves (:mod:`kinergy.identification.full
 stacked over a grid of samples gives ``W`` (samples x n rows). Its columns are the link base
 columns ``Y_b`` (:func:`kinergy.dynamics.regressor.base_parameters`) and, with the drives, every
 motor's rotor-inertia column (``N[m, j] (N qdd)_m``, UR5e eq 2; ``N`` and ``wm = N qd`` from
-:mod:`kinergy.drives.transmission`) and its friction columns: the registry's
-``viscous_coulomb`` columns (:func:`kinergy.friction.registry.friction_columns`; viscous ``wm``,
+:mod:`kinergy.drives.transmission`) and its friction columns: the
+``viscous_coulomb`` columns (:meth:`kinergy.friction.model.FrictionModel.friction_columns`; viscous ``wm``,
 Coulomb ``tanh(wm / (|i| * 0.05 rad/s))``, a smooth sign), reflected to the joints by ``N^T``.
 A drive column that is a combination of the link base columns for every motion (on a UR arm
 ``J_1`` multiplies the same ``qdd_1`` on joint 1 as the ``Iyy1`` group) is left out: no trajectory

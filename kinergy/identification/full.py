@@ -12,7 +12,7 @@ paper's ridge regression)::
 - ``N^T diag(J) N qdd``: motor plus reducer inertias ``J = J_m + J_r`` (motor side, kg m^2)
   reflected through the transmission ``N`` (UR5e eq 2, ``i^2 (J_m + J_r) qdd`` for a UR joint);
 - ``N^T F(wm) phi``: motor-side friction, ``F`` the columns of each joint's friction model
-  (:func:`kinergy.friction.registry.friction_columns`) at the motor speeds ``wm = N qd`` and ``phi``
+  (:meth:`kinergy.friction.model.FrictionModel.friction_columns`) at the motor speeds ``wm = N qd`` and ``phi``
   its linear parameters; shape parameters (smoothing, Stribeck speed, ...) stay the model's.
 
 ``tau`` is the signal chosen by ``target``:

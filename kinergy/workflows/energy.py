@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from kinergy import checks
 from kinergy.accounting.energy import EnergyAccumulator, EnergyReport, energy
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.arrays import Array
@@ -19,7 +20,7 @@ from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.optimize.program_samples import drive_by_payload
 from kinergy.predict import drive_state
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import Motion, MotionSource
 from kinergy.trajectory.program_motion import payload_index, program_motion
 from kinergy.trajectory.program_path import program_path
 from kinergy.trajectory.programs import paper_trajectory
@@ -84,14 +85,14 @@ def _measured_power(log: Log) -> Array | None:
 _EXTRAS = ("joint_temperatures", "actual_robot_voltage", "actual_robot_current", "segment")
 
 
-def _signals_used(log: CheckedLog, source: str) -> list[str] | None:
+def _signals_used(log: CheckedLog, source: MotionSource) -> list[str] | None:
     """The signals of ``log`` its energy uses (the others are never converted): the motion of
     ``source`` (``auto`` as :func:`kinergy.io.motion.motion_from_log`) and :data:`_EXTRAS`,
     those the log has; None (all) when it has no joint positions, so the error lists what it
     has."""
     names = log.names()
-    if source == "auto":
-        source = "target" if "target_q" in names else "actual"
+    if source == MotionSource.AUTO:
+        source = MotionSource.TARGET if "target_q" in names else MotionSource.ACTUAL
     if f"{source}_q" not in names:
         return None
     wanted = [f"{source}_{x}" for x in ("q", "qd", "qdd")] + list(_EXTRAS)
@@ -171,7 +172,7 @@ def energy_of_log(
     path: str | os.PathLike[str],
     reading: LogReading | None = None,
     *,
-    source: str = "auto",
+    source: MotionSource | str = MotionSource.AUTO,
     recovery: bool = True,
     rows: int = ENERGY_ROWS,
 ) -> LogEnergy:
@@ -202,6 +203,7 @@ def energy_of_log(
     measured = False
     peak = np.zeros(robot.n)
     log = CheckedLog(path, robot, reading or LogReading(), rows=rows, ahead=True)
+    source = checks.choice(source, MotionSource, "source")
     log.select = _signals_used(log, source)
     for part in iter_motion(log.chunks(), n_joints=robot.n, source=source):
         m = part.motion
