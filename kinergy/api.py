@@ -34,7 +34,7 @@ from kinergy.files import check_replaceable
 from kinergy.identification.options import IdentifyOptions, Method, Solver, Target
 from kinergy.identification.result import IdentificationResult
 from kinergy.identification.validation import ValidationReport
-from kinergy.io.columns import parse_columns
+from kinergy.io.columns import ColumnMap, parse_column_spec
 from kinergy.io.formats import read_log as _read_file
 from kinergy.io.log import Log
 from kinergy.io.rosbag import bag_options
@@ -86,7 +86,7 @@ def _choice(kind: type[E], value: str, name: str) -> E:
 
 def _reading(
     robot: Robot,
-    columns: str | Sequence[str] | None,
+    columns: str | ColumnMap | Sequence[str] | None,
     repair: bool,
     cutoff: float | None,
     accept: str | Sequence[str],
@@ -94,9 +94,10 @@ def _reading(
     effort: str | None,
 ) -> LogReading:
     """The reading options of the commands, parsed as the command line parses them."""
-    names = parse_columns(columns, robot.n) if isinstance(columns, str) else columns
+    if isinstance(columns, str):
+        columns = parse_column_spec(columns, robot.n)
     return LogReading(
-        columns=None if names is None else tuple(names),
+        columns=columns if columns is None or isinstance(columns, ColumnMap) else tuple(columns),
         repair=repair,
         cutoff=cutoff,
         accept=parse_accept([accept] if isinstance(accept, str) else accept),

@@ -21,7 +21,7 @@ from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElaps
 from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_outputs, check_replaceable
-from kinergy.io.columns import parse_columns
+from kinergy.io.columns import parse_column_spec
 from kinergy.io.formats import NOT_LOGS
 from kinergy.io.rosbag import bag_options
 from kinergy.jsonable import dumps, to_jsonable
@@ -165,7 +165,7 @@ def log_reading(
 ) -> LogReading:
     """The log-reading options of a command, parsed for ``robot`` (its joint count checks the
     ``--columns`` spec)."""
-    names = None if columns is None else tuple(parse_columns(columns, robot.n))
+    names = None if columns is None else parse_column_spec(columns, robot.n)
     return LogReading(
         columns=names,
         repair=repair,

@@ -533,6 +533,8 @@ class LogCheck:
                 continue
             ran = True
             for j, joint in enumerate(robot.joints):
+                if joint.limits.continuous:  # no end stop: any angle is one (speeds check units)
+                    continue
                 low, high = joint.limits.position
                 x_lo, x_hi = self.lo[name][j], self.hi[name][j]
                 if x_lo < low - POSITION_MARGIN or x_hi > high + POSITION_MARGIN:

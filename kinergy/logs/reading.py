@@ -22,7 +22,7 @@ from typing import TypeVar
 import numpy as np
 
 from kinergy.errors import KinergyError
-from kinergy.io.columns import printable
+from kinergy.io.columns import Columns, printable
 from kinergy.io.fields import closest, is_known
 from kinergy.io.formats import CHUNK_ROWS, iter_log
 from kinergy.io.log import Log
@@ -58,9 +58,11 @@ class LogReading:
 
     Attributes
     ----------
-    columns : tuple of str or None
+    columns : tuple of str, ColumnMap or None
         The columns of a headerless file (:func:`kinergy.io.columns.parse_columns` of the
-        ``--columns`` spec); None: the file names them in a header line (UR's record.py layout).
+        ``--columns`` spec), or a header log's names mapped to RTDE's
+        (:class:`kinergy.io.columns.ColumnMap`); None: the file names them in a header line by
+        RTDE's names (UR's record.py layout).
     repair : bool
         Drop rows that cannot be read (each drop noted) instead of refusing the file.
     cutoff : float or None
@@ -72,7 +74,7 @@ class LogReading:
         log that is not a bag.
     """
 
-    columns: tuple[str, ...] | None = None
+    columns: Columns | None = None
     repair: bool = False
     cutoff: float | None = None
     accept: frozenset[Check] = frozenset()

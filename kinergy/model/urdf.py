@@ -459,12 +459,15 @@ def _limits(joint: Any, where: str) -> Limits:
     for attr in ("effort", "velocity"):
         if getattr(limit, attr) is None:
             raise _fail(jwhere, f"<limit> lacks {attr!r}")
-    if joint.type == "continuous":
+    continuous = joint.type == "continuous"
+    if continuous:
         position = np.array([-_TWO_PI, _TWO_PI])
     else:  # URDF: lower and upper default to 0
         position = np.array([limit.lower or 0.0, limit.upper or 0.0])
     try:
-        return Limits(position=position, speed=limit.velocity, torque=limit.effort)
+        return Limits(
+            position=position, speed=limit.velocity, torque=limit.effort, continuous=continuous
+        )
     except KinergyError as exc:
         raise exc.prefixed(jwhere) from None
 
@@ -807,6 +810,8 @@ def _restored(
         }
         if kin.acceleration is not None:
             limit_table["acceleration"] = kin.acceleration
+        if kin.continuous or limits.continuous:
+            limit_table["continuous"] = True
         joints.append(
             {
                 "name": kin.name,
@@ -932,7 +937,8 @@ def import_urdf(
         convention ``mdh``, one joint per ``revolute``/``continuous`` joint of the chain, named as
         in the URDF, with the same sign of q; link inertials the rigid sums of the links each
         joint moves (``fixed`` joints merged; a subtree hanging off the chain is lumped in at its
-        q = 0 configuration); limits from ``<limit>`` (continuous joints: +-2 pi rad); gear
+        q = 0 configuration); limits from ``<limit>`` (continuous joints: +-2 pi rad for planners, and
+        ``continuous``); gear
         ratios from ROS SimpleTransmissions, Coulomb + viscous friction from ``<dynamics>``, the
         rest of the drives nominal (see the module docstring).
 

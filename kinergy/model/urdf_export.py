@@ -157,6 +157,8 @@ def _kinergy_element(robot: Robot, side: JointSide, names: tuple[str, str, str])
         )
         if joint.limits.acceleration is not None:
             element.set("acceleration", number(joint.limits.acceleration))
+        if joint.limits.continuous:  # URDF's <limit> keeps the planners' range
+            element.set("continuous", "true")
         d = joint.drive
         drive = ET.SubElement(element, _tag("drive"))
         if side.coupled:  # else in the joint's <transmission>

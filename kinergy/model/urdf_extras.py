@@ -56,7 +56,7 @@ _MODEL_KEYS = {
     "flange_xyz",
     "flange_rpy",
 }
-_JOINT_KEYS = {"name", "d", "a", "alpha", "offset", "acceleration"}
+_JOINT_KEYS = {"name", "d", "a", "alpha", "offset", "acceleration", "continuous"}
 _DRIVE_KEYS = {
     "gear_ratio",
     "motor_inertia",
@@ -100,6 +100,8 @@ class KinergyJoint:
         ``d, a, alpha, offset`` in the robot's convention (m, rad).
     acceleration : float or None
         rad/s^2.
+    continuous : bool
+        The joint turns without limit (``Limits.continuous``).
     drive : dict
         The drive's numbers (``gear_ratio`` only for a coupled robot).
     friction : dict or None
@@ -113,6 +115,7 @@ class KinergyJoint:
     name: str
     kinematics: dict[str, float]
     acceleration: float | None
+    continuous: bool
     drive: dict[str, float]
     friction: dict[str, Any] | None
     line: tuple[float, float] | None
@@ -221,6 +224,9 @@ def _joint(element: ET.Element, index: int, where: str) -> KinergyJoint:
         for key in ("d", "a", "alpha", "offset")
     }
     acceleration = element.get("acceleration")
+    continuous = element.get("continuous", "false")
+    if continuous not in ("true", "false"):
+        raise KinergyError(f"{jwhere}: continuous must be true or false, got {continuous!r}")
     drives = element.findall(_tag("drive"))
     if len(drives) != 1:
         raise KinergyError(f"{jwhere}: needs one <kinergy:drive>, found {len(drives)}")
@@ -263,6 +269,7 @@ def _joint(element: ET.Element, index: int, where: str) -> KinergyJoint:
         acceleration=None
         if acceleration is None
         else _number(acceleration, f"{jwhere} acceleration"),
+        continuous=continuous == "true",
         drive=drive,
         friction=friction,
         line=line,

@@ -203,7 +203,11 @@ def identify_logs(
         accepted.append(f"fit: {problem}")
     result = dataclasses.replace(result, inputs=inputs, accepted=tuple(accepted))
     if out is not None:
-        columns = compact_columns(reading.columns) if reading.columns else None
+        columns = None
+        if isinstance(reading.columns, tuple):
+            columns = compact_columns(reading.columns)
+        elif reading.columns is not None:
+            columns = str(reading.columns)
         model = _record(result.robot, inputs, options, columns, accepted)
         what = f"{robot.name} identified ({result.method} method)"
         save_robot(model, out, header=_header(what, [p.path for p in inputs.provenance]))
