@@ -13,6 +13,7 @@ from __future__ import annotations
 import hashlib
 import os
 import queue
+import re
 import threading
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
@@ -23,7 +24,7 @@ import numpy as np
 
 from kinergy.errors import KinergyError
 from kinergy.io.columns import Columns, printable
-from kinergy.io.fields import closest, is_known
+from kinergy.io.fields import closest
 from kinergy.io.formats import CHUNK_ROWS, iter_log
 from kinergy.io.log import Log
 from kinergy.io.panda_layout import is_panda_layout, panda_files
@@ -298,19 +299,25 @@ class CheckedLog:
         return next(chunks, None)
 
     def _check_names(self) -> None:
-        """Refuse a column whose name is not a known field but a misspelling of one the log
-        lacks (``actual_curent`` for ``actual_current``): a command needing it would otherwise
-        find nothing, or quietly do without. Names that resemble nothing known pass (a recorder
-        may log fields kinergy does not read)."""
-        have = self.names()
-        for name in sorted(have):
-            if is_known(name) or name.startswith("_"):
-                continue
-            guess = closest(name)
-            if guess is not None and guess not in have:
+        """Refuse a column the reader ignored (no field kinergy knows) whose name is a
+        misspelling of a field the command needs and the log lacks (``actual_curent_0`` for
+        ``actual_current`` when currents are needed): the command would otherwise find nothing,
+        or quietly do without. Other ignored columns pass (a recorder may log anything)."""
+        head = self._head()
+        if head is None or not head.ignored:
+            return
+        have = set(head.signals)
+        needed = set(CHECKED_SIGNALS) if self.select is None else set(self.select)
+        lacking = sorted(needed - have)
+        for column in head.ignored:
+            base = re.sub(r"_\d+$", "", column)
+            guess = closest(base, lacking) or closest(column, lacking)
+            if guess is not None:
+                mapped = re.sub(r"_\d+$", "_*", column)
                 raise KinergyError(
-                    f"{self.path}: column {printable(name)} is not a field kinergy knows (did you "
-                    f"mean {guess}?): name it as UR's RTDE does"
+                    f"{self.path}: column {printable(column)} is not a field kinergy knows (did you "
+                    f"mean {guess}?): name it as UR's RTDE does, or map it with --columns "
+                    f"{guess}={printable(mapped)}"
                 )
 
     def _wanted(self) -> list[str] | None:
