@@ -1,0 +1,412 @@
+"""The ``robot`` check: does the robot's nominal model explain a log's torques and currents?
+
+The nominal model's torques and currents (:func:`kinergy.predict.drive_state`: the rigid body
+with the log's payload, the reflected rotor inertia and, for currents, the drive's friction and
+torque constant) are set against the logged ``target_moment``, measured torques or currents on
+an evenly thinned sample of rows: per joint a ratio (least-squares slope) and a correlation
+(:func:`robot_match`). A joint whose sign is flipped, two joints swapped, or a log another
+built-in robot explains far better fail, with the ratios seen and, where one fits, the robot
+that would (:func:`explain_mismatch`). A joint whose modelled signal does not stand out of the
+log's noise is not judged; a load the model lacks is named with the payload that would explain
+it (:func:`payload_explains`).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from kinergy.arrays import Array
+from kinergy.drives.transmission import joint_torque, transmission_matrix
+from kinergy.dynamics.regressor import regressor
+from kinergy.logs.signal_checks import CURRENTS, MOVE_SPAN, MOVE_SPEED, TORQUES, rated_current
+from kinergy.logs.sums import Moments
+from kinergy.logs.verdicts import Check, Findings, first, joint_label
+from kinergy.model.library import library_names, load_robot
+from kinergy.model.robot import Payload, Robot
+from kinergy.predict import drive_state
+
+__all__ = [
+    "RobotMatch",
+    "better_robot",
+    "explain_mismatch",
+    "judge_robot",
+    "payload_explains",
+    "robot_match",
+    "without_effort",
+]
+
+#: a joint is informative for the robot check when the model's signal varies by this fraction
+#: of its rating (standard deviation)
+INFORMATIVE = 0.02
+#: the ratio band of a matching robot, per kind of signal (nominal torque constants of a robot
+#: file can be off by 2 while its masses are within 20 %)
+RATIO_BAND = {"torque": (0.5, 2.0), "current": (1 / 3, 3.0)}
+#: a ratio outside this band on any joint is not a model that is a little off
+WIDE_BAND = (0.2, 5.0)
+#: another built-in robot "fits far better" when its score is within this (ratios within about
+#: 10 %) while the given robot's is beyond :data:`POOR_SCORE` (about 25 %)
+CLOSE_SCORE = 0.1
+POOR_SCORE = 0.25
+#: correlations: a flipped sign below -NEGATIVE, a match above MATCH
+NEGATIVE = 0.5
+MATCH = 0.8
+#: two joints look swapped when each follows the other's model with a correlation above this
+SWAP_MATCH = 0.9
+#: a swap of two joints explains a log when, exchanged, both are informative and the median
+#: |log ratio| is within this (ratios within about 25 %)
+SWAP_SCORE = 0.25
+
+
+@dataclass(frozen=True)
+class RobotMatch:
+    """How well a robot's nominal model explains a log's torques and currents
+    (:func:`robot_match`).
+
+    Attributes
+    ----------
+    ratios : dict of str to ndarray
+        Per logged signal, the least-squares ratio logged / model per joint (nan where the joint
+        tells nothing: the model's signal hardly varies).
+    correlations : dict of str to ndarray
+    failures : list of str
+        A flipped sign, swapped joints, a joint that does not follow the model: one text each.
+    off : str
+        Most informative joints' ratios outside the band (the wrong robot, or a scaled signal);
+        "" when not.
+    warnings : list of str
+        A few joints' ratios outside the band.
+    score : float
+        The largest over the signals of the median |log ratio| of the informative joints (0: a
+        perfect scale).
+    skipped : str
+        Why nothing could be judged ("" when something was).
+    """
+
+    ratios: dict[str, Array]
+    correlations: dict[str, Array]
+    failures: list[str] = field(default_factory=list)
+    off: str = ""
+    warnings: list[str] = field(default_factory=list)
+    score: float = math.inf
+    skipped: str = ""
+
+    @property
+    def fits(self) -> bool:
+        """Nothing failed and every signal's scale is in its band."""
+        return not (self.failures or self.off or self.skipped)
+
+
+def _model_signal(
+    robot: Robot, rows: dict[str, Array], name: str
+) -> tuple[Array, Array, Array] | None:
+    """The model's prediction of the logged signal ``name`` on the logged motion (the commanded
+    one for ``target_*`` signals where logged, else the measured one), its rating per joint and
+    which joints move (a joint at rest holds whatever its position loop needs: nothing to
+    compare); None without a motion."""
+    prefix = "target" if name.startswith("target") and "target_q" in rows else "actual"
+    if f"{prefix}_q" not in rows:
+        prefix = "target" if "target_q" in rows else ""
+    if not prefix:
+        return None
+    q, qd, qdd = (rows[f"{prefix}_{k}"] for k in ("q", "qd", "qdd"))
+    state = drive_state(robot, q, qd, qdd)
+    torque = np.array([j.limits.torque for j in robot.joints])
+    moving = (np.ptp(q, axis=0) >= MOVE_SPAN) & (np.sqrt(np.mean(qd**2, axis=0)) >= MOVE_SPEED)
+    if name == "target_moment":
+        return state.tau_sim, torque, moving
+    if name in ("actual_joint_torque", "actual_current_as_torque"):
+        return joint_torque(robot, state.tau_m), torque, moving
+    return state.current, rated_current(robot), moving
+
+
+def robot_match(robot: Robot, rows: dict[str, Array]) -> RobotMatch:
+    """Judge whether the logged torques and currents ``rows`` (name -> (k, n), with the logged
+    motion ``actual_q/qd/qdd`` or ``target_q/qd/qdd``) belong to ``robot`` (module docstring).
+
+    Every signal is checked for flipped signs, swapped joints and joints that do not follow the
+    model; the scale (the ratios against the band of :data:`RATIO_BAND`, and the score) is judged
+    on the first signal of ``target_moment``, measured torques, ``actual_current_as_torque``,
+    currents that the motion informs: a torque does not depend on the drives' torque constants,
+    which a robot file may have off by a factor of 2.
+    """
+    ratios: dict[str, Array] = {}
+    correlations: dict[str, Array] = {}
+    failures: list[str] = []
+    warnings: list[str] = []
+    off, score = "", math.nan
+    n = robot.n
+    for name in (*TORQUES, *CURRENTS):
+        if name not in rows or rows[name].shape[1:] != (n,):
+            continue
+        model = _model_signal(robot, rows, name)
+        if model is None:
+            continue
+        x, rating, moving = model
+        y = rows[name]
+        sums = Moments(n)
+        sums.add(x, y)
+        ratio, corr = sums.slope(), sums.correlation()
+        informative = moving & (x.std(axis=0) >= INFORMATIVE * rating)
+        ratios[name] = np.where(informative, ratio, np.nan)
+        correlations[name] = np.where(informative, corr, np.nan)
+        swapped = _swaps(x, y, informative, corr)
+        in_swap = {j for pair in swapped for j in pair}
+        for j, k in swapped:
+            failures.append(
+                f"{name} of {joint_label(robot, j)} and {joint_label(robot, k)} look swapped: each "
+                f"follows the other's model (correlations {_cross(x, y, j, k)}; with their own "
+                f"{corr[j]:.2f}, {corr[k]:.2f})"
+            )
+        good = []
+        for j in range(n):
+            if not informative[j] or j in in_swap:
+                continue
+            if corr[j] < -NEGATIVE:
+                failures.append(
+                    f"{name} of {joint_label(robot, j)} has the opposite sign of the model's "
+                    f"(ratio {ratio[j]:.2f}, correlation {corr[j]:.2f}): sign flipped?"
+                )
+            elif not corr[j] >= NEGATIVE:
+                failures.append(
+                    f"{name} of {joint_label(robot, j)} does not follow {robot.name}'s model "
+                    f"(correlation {corr[j]:.2f}, ratio {ratio[j]:.2f})"
+                )
+            else:
+                good.append(j)
+        if not good:
+            continue
+        band = RATIO_BAND["torque" if name in TORQUES else "current"]
+        out = [j for j in good if not band[0] <= ratio[j] <= band[1]]
+        wild = [j for j in good if not WIDE_BAND[0] <= ratio[j] <= WIDE_BAND[1]]
+        seen = ", ".join(f"{joint_label(robot, j)} {ratio[j]:.2f}" for j in (out or good))
+        text = (
+            f"{name} is {seen} times {robot.name}'s model (a matching robot gives "
+            f"{band[0]:.2g} to {band[1]:.2g})"
+        )
+        if wild:  # beyond what a model a little off explains: a unit, a kind, a robot
+            failures.append(text + _kind_hint(robot, name, ratio, wild))
+        if math.isnan(score):  # the first informed signal sets the scale
+            score = float(np.median(np.abs(np.log(np.clip(ratio[good], 1e-12, None)))))
+            if not wild and out and len(out) * 2 >= len(good):
+                off = text
+            elif not wild and out:
+                warnings.append(f"{text}: the model's drives or masses may be off there")
+    if not ratios:
+        return RobotMatch({}, {}, skipped="no motion beside the torques or currents")
+    if not any(np.any(np.isfinite(r)) for r in ratios.values()):
+        return RobotMatch(ratios, correlations, skipped="no joint moves enough to compare")
+    return RobotMatch(
+        ratios, correlations, failures, off, warnings, math.inf if math.isnan(score) else score
+    )
+
+
+def without_effort(text: str) -> str:
+    """``text`` without its hint for ROS 2 bags (``(a ROS 2 bag: --effort ...)``)."""
+    text = re.sub(r" \(a ROS 2 bag: --effort \w+\)", "", text)
+    return re.sub(r" a ROS 2 bag: --effort \w+\)", ")", text)
+
+
+def _kind_hint(robot: Robot, name: str, ratio: Array, joints: Sequence[int]) -> str:
+    """What a signal far off the model may be instead: joint torques logged as currents (a ratio
+    near gear ratio x torque constant) or currents logged as torques (its inverse)."""
+    per_amp = np.abs(np.diag(transmission_matrix(robot))) * np.array(
+        [j.drive.torque_constant for j in robot.joints]
+    )
+    factor = np.median(
+        [ratio[j] * (1 / per_amp[j] if name in CURRENTS else per_amp[j]) for j in joints]
+    )
+    if not 1 / 3 <= factor <= 3:
+        return ""
+    if name in CURRENTS:
+        return ": joint torques in N m logged as currents? (a ROS 2 bag: --effort torque)"
+    return ": motor currents in A logged as torques? (a ROS 2 bag: --effort current)"
+
+
+def _swaps(x: Array, y: Array, informative: Array, corr: Array) -> list[tuple[int, int]]:
+    """Pairs of informative joints whose logged columns follow each other's model far better
+    than their own."""
+    pairs = []
+    n = x.shape[1]
+    for j in range(n):
+        for k in range(j + 1, n):
+            if not (informative[j] and informative[k]):
+                continue
+            if corr[j] > MATCH and corr[k] > MATCH:
+                continue
+            jk = float(np.corrcoef(x[:, k], y[:, j])[0, 1])
+            kj = float(np.corrcoef(x[:, j], y[:, k])[0, 1])
+            # each follows the other's model clearly better than its own
+            if jk > SWAP_MATCH and kj > SWAP_MATCH and jk > corr[j] + 0.1 and kj > corr[k] + 0.1:
+                pairs.append((j, k))
+    return pairs
+
+
+def _cross(x: Array, y: Array, j: int, k: int) -> str:
+    jk = float(np.corrcoef(x[:, k], y[:, j])[0, 1])
+    kj = float(np.corrcoef(x[:, j], y[:, k])[0, 1])
+    return f"{jk:.2f}, {kj:.2f}"
+
+
+def _swapped(rows: dict[str, Array], j: int, k: int) -> dict[str, Array]:
+    """``rows`` with joints ``j`` and ``k`` exchanged in every signal."""
+    out = {}
+    for name, x in rows.items():
+        y = x.copy()
+        y[:, [j, k]] = x[:, [k, j]]
+        out[name] = y
+    return out
+
+
+def _flipped(rows: dict[str, Array], j: int) -> dict[str, Array]:
+    """``rows`` with joint ``j``'s sign reversed in every signal."""
+    out = {}
+    for name, x in rows.items():
+        y = x.copy()
+        y[:, j] = -x[:, j]
+        out[name] = y
+    return out
+
+
+def _informed(match: RobotMatch, joints: Sequence[int]) -> bool:
+    """Whether every signal informs ``match`` about all of ``joints``."""
+    return bool(match.ratios) and all(
+        all(np.isfinite(r[j]) for j in joints) for r in match.ratios.values()
+    )
+
+
+def payload_explains(robot: Robot, rows: dict[str, Array]) -> str:
+    """A warning when a point mass at the flange, missing from ``robot``, explains the logged
+    torques where the model alone does not (a payload the user did not give); "" otherwise.
+
+    The mass ``m`` and its first moment ``m c`` are least squares of the torques the model
+    misses on the last link's columns of the regressor (``Y @ pi == rnea``, nursing eq 15; a
+    point mass's inertia is left out: second order at a robot's speeds), from the reference
+    torque (``target_moment`` or measured torques), else from the currents through the torque
+    constants and gear ratios. The model with that payload must then fit the log.
+    """
+    name = next((n for n in (*TORQUES, *CURRENTS) if n in rows), None)
+    if name is None:
+        return ""
+    prefix = "target" if name.startswith("target") and "target_q" in rows else "actual"
+    if f"{prefix}_q" not in rows:
+        return ""
+    q, qd, qdd = (rows[f"{prefix}_{k}"] for k in ("q", "qd", "qdd"))
+    model = _model_signal(robot, rows, name)
+    if model is None:
+        return ""
+    missed = rows[name] - model[0]
+    if name in CURRENTS:  # motor current -> joint torque, through k_t and the gear
+        gear = np.abs(np.diag(transmission_matrix(robot)))
+        missed = missed * gear * np.array([j.drive.torque_constant for j in robot.joints])
+    last = slice(10 * (robot.n - 1), 10 * (robot.n - 1) + 4)
+    columns = regressor(robot, q, qd, qdd)[:, :, last].reshape(-1, 4)
+    theta = np.linalg.lstsq(columns, missed.reshape(-1), rcond=None)[0]
+    mass = float(theta[0])
+    if not 0.05 <= mass <= 100.0:
+        return ""
+    com_link = theta[1:] / mass
+    com = (np.linalg.inv(robot.flange) @ np.append(com_link, 1.0))[:3]
+    loaded = robot.with_payload(Payload(mass=mass, com=com))
+    if not robot_match(loaded, rows).fits:
+        return ""
+    where = ",".join(f"{c:.3g}" for c in com)
+    return (
+        f"the logged {name} fits {robot.name} carrying about {mass:.3g} kg at [{where}] m (flange "
+        f"frame) that the model lacks: give the payload (--payload {mass:.3g},{where}) or identify "
+        "it (identify --payload-only)"
+    )
+
+
+def better_robot(robot: Robot, rows: dict[str, Array], score: float) -> str:
+    """The built-in robot (of the same joint count) whose model fits the logged ``rows`` with
+    the lowest score below ``score``; "" when none does."""
+    best, best_score = "", score
+    for name in library_names():
+        other = load_robot(name)
+        if other.n != robot.n or other.name == robot.name:
+            continue
+        m = robot_match(other, rows)
+        if m.fits and m.score < best_score:
+            best, best_score = other.name, m.score
+    return best
+
+
+def explain_mismatch(
+    robot: Robot, rows: dict[str, Array], match: RobotMatch, *, library: bool = True
+) -> str:
+    """What would explain a failed robot check: a built-in robot (of the same joint count)
+    whose model fits the log better (unless not ``library``), two joints exchanged in every
+    logged signal, or one joint's sign reversed in every signal; "" when none does."""
+    with np.errstate(all="ignore"):
+        best = better_robot(robot, rows, match.score) if library else ""
+        if best:
+            return f"looks like {best} (its model fits this log)"
+        for j in range(robot.n):
+            for k in range(j + 1, robot.n):
+                m = robot_match(robot, _swapped(rows, j, k))
+                if m.fits and _informed(m, (j, k)) and m.score <= SWAP_SCORE:
+                    return (
+                        f"with joints {j + 1} and {k + 1} exchanged in every signal the model "
+                        "fits: their columns look swapped"
+                    )
+        for j in range(robot.n):
+            m = robot_match(robot, _flipped(rows, j))
+            if m.fits and _informed(m, (j,)) and m.score <= SWAP_SCORE:
+                return (
+                    f"with joint {j + 1}'s sign reversed in every signal the model fits: its "
+                    "sign looks flipped"
+                )
+    return ""
+
+
+def judge_robot(robot: Robot, rows: dict[str, Array], found: Findings) -> None:
+    """The ``robot`` check on the thinned rows ``rows`` (name -> (k, ...)): its verdict into
+    ``found`` (module docstring)."""
+    if not any(n in rows for n in (*TORQUES, *CURRENTS)):
+        found.verdict(Check.ROBOT, False, "no torques or currents logged")
+        return
+    if next(iter(rows.values())).shape[0] < 20:
+        found.verdict(Check.ROBOT, False, "too few samples")
+        return
+    with np.errstate(all="ignore"):
+        match = robot_match(robot, rows)
+    if match.skipped:
+        found.verdict(Check.ROBOT, False, match.skipped)
+        return
+    if match.failures or match.off or match.warnings:
+        payload = payload_explains(robot, rows)
+        if payload:
+            found.warnings.append(payload)
+            found.verdict(Check.ROBOT, True)
+            return
+    if match.failures or match.off:
+        hint = explain_mismatch(robot, rows, match)
+        seen = first(match.failures) or match.off
+        if match.failures or hint:
+            found.fail(Check.ROBOT, f"{hint}: {seen}" if hint else seen)
+        else:
+            found.warnings.append(
+                f"{match.off}; no built-in robot fits better: the model's masses or torque "
+                "constants, a payload, or the logged signal's scale are off (what is fitted "
+                "to it will be too)"
+            )
+    elif match.warnings and (hint := explain_mismatch(robot, rows, match, library=False)):
+        found.fail(Check.ROBOT, f"{hint}: {match.warnings[0].split(': the model')[0]}")
+    elif match.score > POOR_SCORE:
+        with np.errstate(all="ignore"):
+            best = better_robot(robot, rows, CLOSE_SCORE)
+        if best:
+            found.fail(
+                Check.ROBOT,
+                f"{robot.name}'s model is {math.exp(match.score):.2f} times off the "
+                f"log's torques where {best}'s fits within {math.exp(CLOSE_SCORE):.2f}: "
+                f"looks like {best} (or a payload the model lacks: --payload)",
+            )
+    if Check.ROBOT not in found.failed:
+        found.warnings.extend(match.warnings)
+    found.verdict(Check.ROBOT, True)
