@@ -27,6 +27,7 @@ from kinergy.io.rosbag import bag_options
 from kinergy.jsonable import dumps, to_jsonable
 from kinergy.logs.checks import Check, parse_accept
 from kinergy.logs.reading import InputLogs, LogReading
+from kinergy.logs.window import TimeWindow
 from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
@@ -57,6 +58,7 @@ __all__ = [
     "tell",
     "topic_option",
     "warn",
+    "window_options",
     "writes",
 ]
 
@@ -162,9 +164,13 @@ def log_reading(
     accept: Sequence[str] = (),
     topic: str | None = None,
     effort: str | None = None,
+    payload: str | None = None,
+    start: float | None = None,
+    stop: float | None = None,
 ) -> LogReading:
     """The log-reading options of a command, parsed for ``robot`` (its joint count checks the
-    ``--columns`` spec)."""
+    ``--columns`` spec); ``payload`` is ``--payload`` (it replaces the log's and the robot
+    file's: :meth:`LogReading.loaded`), ``start`` and ``stop`` are ``--from`` and ``--to``."""
     names = None if columns is None else parse_column_spec(columns, robot.n)
     return LogReading(
         columns=names,
@@ -172,6 +178,8 @@ def log_reading(
         cutoff=cutoff,
         accept=parse_accept(accept),
         bag=bag_options(topic, effort),
+        payload=None if payload is None else parse_payload(payload),
+        window=None if start is None and stop is None else TimeWindow(start, stop),
     )
 
 
@@ -183,8 +191,9 @@ def load(robot_name: str, payload: str | None) -> Robot:
 payload_option = click.option(
     "--payload",
     metavar="MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]",
-    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2 about its "
-    "centre of mass.",
+    help="Payload at the flange: kg, m (flange frame), kg m^2 about its centre of mass. It "
+    "replaces the model's and the one a log's controller logged (payload, payload_cog, "
+    "payload_inertia), which is used otherwise.",
 )
 
 
@@ -257,6 +266,28 @@ repair_option = click.option(
     is_flag=True,
     help="Drop malformed rows (cut short, non-numeric, time out of order) instead of rejecting.",
 )
+
+
+def window_options(command: F) -> F:
+    """``--from`` and ``--to`` (as ``start`` and ``stop``): the time window of every log a
+    command reads."""
+    command = click.option(
+        "--to",
+        "stop",
+        type=Finite(),
+        default=None,
+        metavar="S",
+        help="Read each log up to this time (s, on the log's own time axis: its timestamp "
+        "column; a ROS 2 bag's from its first message) [its end].",
+    )(command)
+    return click.option(
+        "--from",
+        "start",
+        type=Finite(),
+        default=None,
+        metavar="S",
+        help="Read each log from this time (s, on the log's own time axis) [its start].",
+    )(command)
 
 
 seed_option = click.option(

@@ -44,7 +44,8 @@ from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.io.fields import FIELDS, JOINTS
 from kinergy.io.log import Log
-from kinergy.logs.robot_check import judge_robot, without_effort
+from kinergy.logs.payload import from_columns, payload_columns, payload_problem
+from kinergy.logs.robot_check import LOADS, judge_robot, noise_name, without_effort
 from kinergy.logs.signal_checks import (
     CURRENTS,
     PAIRS,
@@ -58,7 +59,7 @@ from kinergy.logs.signal_checks import (
     check_units,
     moving,
 )
-from kinergy.logs.sums import Moments, Thinned
+from kinergy.logs.sums import Moments, Noise, Thinned
 from kinergy.logs.verdicts import CHECKS, Check, Findings, LogChecks, first, parse_accept
 from kinergy.model.robot import Robot
 
@@ -66,6 +67,9 @@ __all__ = ["CHECKS", "Check", "LogCheck", "LogChecks", "check_log", "parse_accep
 
 #: rows the robot check keeps (evenly thinned over the whole log)
 ROBOT_ROWS = 4096
+#: the most distinct payloads the checks keep of a log (a payload ramped by
+#: ``set_target_payload``'s transition time takes a few hundred)
+MAX_LOADS = 256
 #: s: the robot check's acceleration is the speed's central difference over this span
 DIFF_SPAN = 0.02
 
@@ -93,8 +97,16 @@ class LogCheck:
         self.accept = frozenset(accept)
         self.samples = 0
         self.last: Log | None = None
-        self.seen = Seen(robot, path, speeds={pair: Moments(robot.n) for pair in PAIRS})
+        n = robot.n
+        self.seen = Seen(
+            robot,
+            path,
+            speeds={pair: Moments(n) for pair in PAIRS},
+            noise={pair: (Noise(n), Noise(n)) for pair in PAIRS},
+        )
         self.thinned: Thinned | None = None
+        #: the distinct payloads the log carries (:func:`kinergy.logs.payload.payload_columns`)
+        self.loads: dict[bytes, Array] = {}
 
     @property
     def period(self) -> float:
@@ -123,6 +135,7 @@ class LogCheck:
         self._extremes(chunk)
         self._speeds(chunk)
         self._robot_rows(chunk)
+        self._loads(chunk)
         self.samples += len(chunk)
         last = slice(len(chunk) - 1, len(chunk))
         self.last = Log(self.path, chunk.t[last], {k: x[last] for k, x in chunk.signals.items()})
@@ -136,7 +149,11 @@ class LogCheck:
 
     def _extremes(self, chunk: Log) -> None:
         for name, x in chunk.signals.items():
-            if x.ndim != 2 and name not in ("actual_robot_voltage", "actual_robot_current"):
+            if x.ndim != 2 and name not in (
+                "actual_robot_voltage",
+                "actual_robot_current",
+                "payload",
+            ):
                 continue
             lo, hi = np.nanmin(x, axis=0), np.nanmax(x, axis=0)
             seen = self.seen
@@ -164,7 +181,11 @@ class LogCheck:
                 q = np.concatenate([self.last[q_name], q])
                 qd = np.concatenate([self.last[qd_name], qd])
             step, mean = np.diff(q, axis=0), 0.5 * (qd[1:] + qd[:-1])
-            if not every:
+            if every:  # the noise of consecutive samples (a chunk with a gap leaves it out)
+                speed, quotient = self.seen.noise[(q_name, qd_name)]
+                speed.add(qd)
+                quotient.add(step / dt[:, None])
+            else:
                 step, mean = step[ok], mean[ok]
             moments.add(mean, step / dt[:, None])
 
@@ -197,9 +218,23 @@ class LogCheck:
             rows[q_name], rows[qd_name], rows[f"{prefix}_qdd"] = chunk[q_name][k], qd[k], qdd
         for name in (*TORQUES, *CURRENTS):
             if name in chunk and chunk[name].ndim == 2:
-                rows[name] = chunk[name][k]
+                y = chunk[name]
+                rows[name] = y[k]
+                # the second difference of consecutive samples: the signal's noise
+                rows[noise_name(name)] = y[k + 1] - 2.0 * y[k] + y[k - 1]
+        loads = payload_columns(chunk)
+        if loads is not None:
+            rows[LOADS] = loads[k]
         if rows:
             thinned.add(self.samples + k[valid], {n: x[valid] for n, x in rows.items()})
+
+    def _loads(self, chunk: Log) -> None:
+        """Keep the distinct payloads the chunk logs (at most :data:`MAX_LOADS` in all)."""
+        cols = payload_columns(chunk)
+        if cols is None or len(self.loads) >= MAX_LOADS:
+            return
+        for row in np.unique(cols, axis=0)[: MAX_LOADS - len(self.loads)]:
+            self.loads.setdefault(row.tobytes(), row)
 
     # -- the verdict ---------------------------------------------------------------------------
 
@@ -214,6 +249,21 @@ class LogCheck:
         """
         with np.errstate(all="ignore"):  # absurd values are judged, not warned about
             return self._finish()
+
+    def _check_loads(self, found: Findings) -> None:
+        """The ``ratings`` check of the payloads the controller logged (:func:`payload_problem`);
+        columns that hold no load at all are refused outright."""
+        if not self.loads:
+            return
+        try:
+            loads = [from_columns(row) for row in self.loads.values() if row.any()]
+        except KinergyError as exc:
+            raise KinergyError(
+                f"{self.path}: the controller's payload columns hold no load: {exc}"
+            ) from None
+        problem = payload_problem(self.robot, loads)
+        if problem:
+            found.fail(Check.RATINGS, problem)
 
     def _is_bag(self) -> bool:
         """Whether the log is a ROS 2 bag (its hints name --effort)."""
@@ -231,6 +281,7 @@ class LogCheck:
         check_units(seen, found)
         check_speeds(seen, found, joints_moving)
         check_ratings(seen, found)
+        self._check_loads(found)
         check_constant(seen, found, joints_moving)
         thinned = self.thinned
         rows = {} if thinned is None else {name: thinned.get(name) for name in thinned.rows}
@@ -254,6 +305,7 @@ class LogCheck:
             accepted=tuple(accepted),
             not_checked=tuple(f"{c.value}: {why}" for c, why in found.skipped.items()),
             warnings=tuple(f"{self.path}: {w}" for w in found.warnings),
+            notes=tuple(f"{self.path}: {n}" for n in found.notes),
         )
 
 

@@ -30,7 +30,9 @@ from kinergy.io.log import Log
 from kinergy.io.panda_layout import is_panda_layout, panda_files
 from kinergy.io.rosbag import BagOptions
 from kinergy.logs.checks import Check, LogCheck, LogChecks
-from kinergy.model.robot import Robot
+from kinergy.logs.payload import PAYLOAD_SIGNALS, describe, from_columns, payload_columns
+from kinergy.logs.window import TimeWindow, WindowCut
+from kinergy.model.robot import Payload, Robot
 
 __all__ = ["CHECKED_SIGNALS", "CheckedLog", "InputLogs", "LogReading", "Provenance"]
 
@@ -41,6 +43,7 @@ CHECKED_SIGNALS = (
     "target_qdd",
     "actual_q",
     "actual_qd",
+    "actual_qdd",
     "target_moment",
     "actual_current",
     "target_current",
@@ -50,6 +53,7 @@ CHECKED_SIGNALS = (
     "joint_temperatures",
     "actual_robot_voltage",
     "actual_robot_current",
+    *PAYLOAD_SIGNALS,
 )
 
 
@@ -73,6 +77,12 @@ class LogReading:
     bag : BagOptions or None
         How to read a ROS 2 bag (``--topic``, ``--effort``); None: its defaults. Refused for a
         log that is not a bag.
+    payload : Payload or None
+        The payload at the flange (``--payload``): it replaces the one the controller logged
+        (``payload``, ``payload_cog``, ``payload_inertia``, :mod:`kinergy.logs.payload`) and the
+        robot file's. None: the log's where it logs one, else the robot file's.
+    window : TimeWindow or None
+        The samples read (``--from``/``--to``, s on the log's own time axis); None: all.
     """
 
     columns: Columns | None = None
@@ -80,6 +90,12 @@ class LogReading:
     cutoff: float | None = None
     accept: frozenset[Check] = frozenset()
     bag: BagOptions | None = None
+    payload: Payload | None = None
+    window: TimeWindow | None = None
+
+    def loaded(self, robot: Robot) -> Robot:
+        """``robot`` with the payload :attr:`payload` gives, when it gives one."""
+        return robot if self.payload is None else robot.with_payload(self.payload)
 
 
 @dataclass(frozen=True)
@@ -250,6 +266,7 @@ class CheckedLog:
     checks: LogChecks | None = None
     provenance: Provenance | None = None
     notes: list[str] = field(default_factory=list)
+    _told: bool = field(default=False, repr=False)
 
     @property
     def path(self) -> str:
@@ -327,6 +344,21 @@ class CheckedLog:
         have = self.names()
         return [s for s in dict.fromkeys([*self.select, *CHECKED_SIGNALS]) if s in have]
 
+    def _given_payload(self, chunk: Log) -> Log:
+        """``chunk`` without the logged payload when ``--payload`` replaces it (noted once)."""
+        if self.reading.payload is None or not any(s in chunk for s in PAYLOAD_SIGNALS):
+            return chunk
+        if not self._told:
+            cols = payload_columns(chunk)
+            logged = "" if cols is None else f" ({describe(from_columns(cols[0]))} first)"
+            self.notes.append(
+                f"{self.path}: the controller's logged payload{logged} is not used: --payload "
+                f"gives {describe(self.reading.payload)}"
+            )
+            self._told = True
+        keep = {k: v for k, v in chunk.signals.items() if k not in PAYLOAD_SIGNALS}
+        return Log(chunk.path, chunk.t, keep, chunk.notes, chunk.ignored)
+
     def _selected(self, chunk: Log) -> Log:
         """``chunk`` with only the selected signals: those only the checks read are not
         carried on (a consumer joining chunks would copy them for nothing)."""
@@ -348,7 +380,7 @@ class CheckedLog:
             the user did not accept (:meth:`kinergy.logs.checks.LogCheck.finish`).
         """
         self._check_names()
-        check = LogCheck(self.robot, self.path, self.reading.accept)
+        check = LogCheck(self.reading.loaded(self.robot), self.path, self.reading.accept)
         hashed: list[str] = []
         stop = threading.Event()
         hasher = None
@@ -356,17 +388,25 @@ class CheckedLog:
             args = (Path(self.source), hashed, stop)
             hasher = threading.Thread(target=_file_hash, args=args, daemon=True)
         rows = 0
+        window = self.reading.window
+        cut = None if window is None else WindowCut(window, self.path)
         try:
-            for chunk in self._raw(self._wanted()):
+            for raw in self._raw(self._wanted()):
                 if hasher is not None and hasher.ident is None:
                     hasher.start()  # the file opened: hash it beside the reading
-                self.notes.extend(chunk.notes)
-                check.add(chunk)
-                rows += len(chunk)
-                yield self._selected(chunk)
+                self.notes.extend(raw.notes)
+                chunk = self._given_payload(raw if cut is None else cut.cut(raw))
+                if len(chunk):
+                    check.add(chunk)
+                    rows += len(chunk)
+                    yield self._selected(chunk)
+                if cut is not None and cut.done:
+                    break
         except BaseException:
             stop.set()
             raise
+        if cut is not None:
+            self.notes.append(cut.finish())
         if rows == 0:
             raise KinergyError(f"{self.path}: the log has no samples")
         self.checks = check.finish()
@@ -444,4 +484,4 @@ class InputLogs:
                 )
         self.provenance.append(log.provenance)
         self.checks.append(log.checks)
-        self.notes.extend(log.notes)
+        self.notes.extend([*log.notes, *log.checks.notes])

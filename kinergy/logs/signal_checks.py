@@ -14,7 +14,7 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.errors import KinergyError
-from kinergy.logs.sums import Moments
+from kinergy.logs.sums import Moments, Noise
 from kinergy.logs.verdicts import Check, Findings, joint_label
 from kinergy.model.robot import Robot
 
@@ -49,6 +49,10 @@ MOVE_SPEED = 0.01
 #: the slope and correlation of logged speed against the position's derivative that pass
 SPEED_SLOPE = (0.8, 1.25)
 SPEED_CORRELATION = 0.9
+#: a joint's speeds are judged when their spread is this many times the larger noise of the
+#: logged speed and of the position's difference quotient (a right log then correlates at 0.97 or
+#: more; a joint that barely moves, or moves within a short window, shows no more than noise)
+SPEED_TO_NOISE = 4.0
 #: positions may exceed the joint limits by this much (rad) before they are not radians
 POSITION_MARGIN = 0.1
 #: speeds may exceed the speed limit by this factor
@@ -84,6 +88,8 @@ class Seen:
     speeds : dict of (str, str) to Moments
         Per (position, speed) pair of :data:`PAIRS`: the logged speed against the position's
         difference quotient, over steps within a segment.
+    noise : dict of (str, str) to (Noise, Noise)
+        Per pair, the noise of the logged speed and of the difference quotient.
     """
 
     robot: Robot
@@ -92,6 +98,7 @@ class Seen:
     hi: dict[str, Array] = field(default_factory=dict)
     period: float = math.nan
     speeds: dict[tuple[str, str], Moments] = field(default_factory=dict)
+    noise: dict[tuple[str, str], tuple[Noise, Noise]] = field(default_factory=dict)
 
 
 def rated_current(robot: Robot) -> Array:
@@ -204,15 +211,27 @@ def check_speeds(seen: Seen, found: Findings, moving: Array) -> None:
         if not np.any(m.n > 0):
             continue
         slope, corr, rms = m.slope(), m.correlation(), m.rms_x()
+        noise = np.zeros(robot.n)
+        if (q_name, qd_name) in seen.noise:
+            speed, quotient = seen.noise[(q_name, qd_name)]
+            noise = np.maximum(speed.sigma(), quotient.sigma())
+        with np.errstate(invalid="ignore", divide="ignore"):
+            spread = np.sqrt(np.maximum(m.sxx / m.n - (m.sx / m.n) ** 2, 0.0))
         bad: list[tuple[int, float, float]] = []
         for j in range(robot.n):
             derivative_rms = math.sqrt(m.syy[j] / m.n[j]) if m.n[j] else 0.0
             if not moving[j] or max(rms[j], derivative_rms) < MOVE_SPEED:
                 continue
+            if not max(rms[j], derivative_rms) >= SPEED_TO_NOISE * noise[j]:
+                continue  # nothing but noise to compare
             ran = True
-            # s: slope of the derivative on the logged speed
+            # s: slope of the derivative on the logged speed; the correlation only where the
+            # speed varies beyond its noise (a constant speed correlates with nothing)
             s, r = float(slope[j]), float(corr[j])
-            if not (SPEED_SLOPE[0] <= s <= SPEED_SLOPE[1] and r >= SPEED_CORRELATION):
+            varies = spread[j] >= max(MOVE_SPEED, SPEED_TO_NOISE * noise[j])
+            if not (
+                SPEED_SLOPE[0] <= s <= SPEED_SLOPE[1] and (r >= SPEED_CORRELATION or not varies)
+            ):
                 bad.append((j, s, r))
         if not bad:
             continue
@@ -301,6 +320,8 @@ def check_constant(seen: Seen, found: Findings, moving: Array) -> None:
             continue
         ran = True
         flat = seen.lo[name] == seen.hi[name]
+        if name in ("actual_qd", "target_qd"):  # a joint cruises at one speed: not stuck unless 0
+            flat &= seen.lo[name] == 0.0
         stuck = np.flatnonzero(flat & moving)
         if flat.all() and moving.any():
             found.fail(

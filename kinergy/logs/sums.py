@@ -9,7 +9,7 @@ from numpy.typing import NDArray
 
 from kinergy.arrays import Array
 
-__all__ = ["Moments", "Thinned"]
+__all__ = ["Moments", "Noise", "Thinned"]
 
 
 class Moments:
@@ -84,3 +84,27 @@ class Thinned:
 
     def get(self, name: str) -> Array:
         return np.concatenate(self.rows[name]) if name in self.rows else np.empty((0, 0))
+
+
+class Noise:
+    """A signal's white noise per column from its second differences over consecutive samples
+    (a smooth signal keeps them near 0; white noise of deviation s gives them a mean square of
+    6 s^2): running sums of their squares."""
+
+    def __init__(self, n: int):
+        self.ss = np.zeros(n)
+        self.count = 0
+
+    def add(self, x: Array) -> None:
+        """Consecutive samples ``x`` (k, n) of one segment."""
+        if len(x) < 3:
+            return
+        d2 = x[2:] - 2.0 * x[1:-1] + x[:-2]
+        self.ss += np.einsum("ij,ij->j", d2, d2)
+        self.count += len(d2)
+
+    def sigma(self) -> Array:
+        """The noise's standard deviation per column (0 before any sample)."""
+        if not self.count:
+            return np.zeros_like(self.ss)
+        return np.asarray(np.sqrt(self.ss / self.count / 6.0), dtype=float)

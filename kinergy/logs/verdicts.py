@@ -84,6 +84,8 @@ class LogChecks:
         Checks the log gave nothing to run on, with why.
     warnings : tuple of str
         What passed but may still make a result wrong.
+    notes : tuple of str
+        What the checks could not judge in part (joints in the noise), routine.
     """
 
     log: str
@@ -91,6 +93,7 @@ class LogChecks:
     accepted: tuple[str, ...] = ()
     not_checked: tuple[str, ...] = ()
     warnings: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
 
 @dataclass
@@ -101,6 +104,7 @@ class Findings:
     passed: list[Check] = field(default_factory=list)
     skipped: dict[Check, str] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
 
     def fail(self, check: Check, text: str) -> None:
         self.failed.setdefault(check, []).append(text)
