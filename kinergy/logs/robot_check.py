@@ -370,10 +370,9 @@ def _flipped(rows: dict[str, Array], j: int) -> dict[str, Array]:
 
 
 def _informed(match: RobotMatch, joints: Sequence[int]) -> bool:
-    """Whether every signal informs ``match`` about all of ``joints``."""
-    return bool(match.ratios) and all(
-        all(np.isfinite(r[j]) for j in joints) for r in match.ratios.values()
-    )
+    """Whether some signal informs ``match`` about all of ``joints`` (a current that friction
+    dominates may not: the torque does)."""
+    return any(all(np.isfinite(r[j]) for j in joints) for r in match.ratios.values())
 
 
 @dataclass(frozen=True)
