@@ -153,3 +153,41 @@ def test_a_log_at_rest_most_of_its_length_has_too_little_motion(tmp_path: Path) 
     )
     assert "too little motion to identify from" in case.err
     assert "layout, units or robot" not in case.err
+
+
+#: one-second windows of the realistic twin (api.simulate, seed 2) whose currents are mostly
+#: friction on some joint (the nominal friction, power-flow jumps and all, does not predict it)
+FRICTION_WINDOWS = [
+    ("ur3e", "test-b", 1.36),
+    ("ur3e", "test-b", 4.08),
+    ("ur5e", "test-b", 4.08),
+    ("ur5", "test-b", 4.23),
+    ("ur3e", "test-a", 6.77),
+]
+
+
+@pytest.mark.parametrize(("robot", "trajectory", "start"), FRICTION_WINDOWS)
+def test_a_window_where_friction_makes_the_current_is_accepted(
+    robot: str, trajectory: str, start: float
+) -> None:
+    from kinergy.api import simulate as twin
+    from kinergy.logs.reading import CheckedLog, LogReading
+    from kinergy.logs.window import TimeWindow
+
+    log = twin(robot, trajectory, mismatch="realistic", seed=2)
+    reading = LogReading(window=TimeWindow(start, start + 1.0))
+    checked = CheckedLog(log, load_robot(robot), reading)
+    checked.read()
+    assert checked.checks is not None
+    assert any("mostly friction" in n for n in checked.checks.notes), checked.checks
+
+
+@pytest.mark.parametrize("robot", ["ur5e", "ur10e"])
+def test_a_short_window_of_measured_signals_only_is_accepted(tmp_path: Path, robot: str) -> None:
+    # a ROS 2 bag's signals: no commanded motion, the measured speeds' noise differentiated
+    log = _twin(robot)
+    keep = log.t <= 1.2
+    signals = {k: log[k][keep] for k in ("actual_q", "actual_qd", "actual_current")}
+    write_log(tmp_path / "measured.csv", log.t[keep], signals)
+    err = _energy(tmp_path, "measured.csv", robot, refuse=False)
+    assert "not judged" in err

@@ -105,6 +105,8 @@ class RobotMatch:
     unjudged : dict of str to list of str
         Joints that move but are not judged, by why (:data:`NOISY`, :data:`FRICTION`): per
         reason ``"actual_current of joints 1, 3"`` texts, one per signal.
+    scale : str
+        The signal that set :attr:`score` ("" when none did).
     """
 
     ratios: dict[str, Array]
@@ -115,6 +117,7 @@ class RobotMatch:
     score: float = math.inf
     skipped: str = ""
     unjudged: dict[str, list[str]] = field(default_factory=dict)
+    scale: str = ""
 
     @property
     def fits(self) -> bool:
@@ -254,7 +257,7 @@ def robot_match(robot: Robot, rows: dict[str, Array]) -> RobotMatch:
     failures: list[str] = []
     warnings: list[str] = []
     unjudged: dict[str, list[str]] = {}
-    off, score = "", math.nan
+    off, score, scale = "", math.nan, ""
     for name in (*TORQUES, *CURRENTS):
         if name not in rows or rows[name].shape[1:] != (robot.n,):
             continue
@@ -285,6 +288,7 @@ def robot_match(robot: Robot, rows: dict[str, Array]) -> RobotMatch:
             failures.append(text + _kind_hint(robot, name, ratio, wild))
         if math.isnan(score):  # the first informed signal sets the scale
             score = float(np.median(np.abs(np.log(np.clip(ratio[good], 1e-12, None)))))
+            scale = name
             if not wild and out and len(out) * 2 >= len(good):
                 off = text
             elif not wild and out:
@@ -297,7 +301,9 @@ def robot_match(robot: Robot, rows: dict[str, Array]) -> RobotMatch:
             why = "no joint's modelled signal stands out of the log's noise"
         return RobotMatch(ratios, correlations, skipped=why, unjudged=unjudged)
     final = math.inf if math.isnan(score) else score
-    return RobotMatch(ratios, correlations, failures, off, warnings, final, unjudged=unjudged)
+    return RobotMatch(
+        ratios, correlations, failures, off, warnings, final, unjudged=unjudged, scale=scale
+    )
 
 
 def without_effort(text: str) -> str:
@@ -555,7 +561,9 @@ def _judge_mismatch(
             )
     elif match.warnings and (hint := explain_mismatch(robot, rows, match, library=False)):
         found.fail(Check.ROBOT, f"{hint}: {match.warnings[0].split(': the model')[0]}")
-    elif match.score > POOR_SCORE:
+    elif match.score > POOR_SCORE and match.scale in TORQUES:
+        # a current's scale carries the robot file's nominal torque constants (off by up to 2):
+        # only a torque's tells one robot from another this finely
         with np.errstate(all="ignore"):
             best = better_robot(robot, rows, CLOSE_SCORE)
         if best:
