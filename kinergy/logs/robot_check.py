@@ -51,13 +51,14 @@ INFORMATIVE = 0.02
 #: log's correlation is 0.9 or less, and a short window or a joint that barely moves shows
 #: nothing the check could judge
 SIGNAL_TO_NOISE = 2.0
-#: a joint's current is judged where the model's load torque varies by at least this share of its
-#: friction's variation (where friction dominates, a nominal robot file's friction, its jumps with
-#: the direction of power flow too, does not predict the current: the joint shows no robot)
+#: a joint's current is mostly friction where the model's load torque varies by less than this
+#: share of its friction's variation: a nominal robot file's friction, its jumps with the
+#: direction of power flow too, does not predict it, so such a current that does not follow the
+#: model tells nothing about the robot (only a reversed sign does)
 RIGID_SHARE = 1.0
 #: why a joint is not judged (:attr:`RobotMatch.unjudged`)
 NOISY = "its modelled signal does not stand out of the log's noise: a short window, a joint that barely moves"
-FRICTION = "its current is mostly friction, which the model's nominal values do not predict"
+FRICTION = "its current is mostly friction, which the model's nominal values do not predict, and does not follow it"
 #: the rows' key of the logged payload (:func:`kinergy.logs.payload.payload_columns`, (k, 10))
 LOADS = "payload"
 #: the ratio band of a matching robot, per kind of signal (nominal torque constants of a robot
@@ -189,13 +190,16 @@ class _Signal:
     failures: list[str]
     good: list[int]
     unjudged: dict[str, list[int]]
+    rigid: Array
 
 
 def _signal_match(robot: Robot, rows: dict[str, Array], name: str) -> _Signal | None:
     """The logged signal ``name`` of ``rows`` against ``robot``'s model of it (None without a
     motion): flipped signs, swapped joints and joints that do not follow the model, judged on
     the joints that move and whose modelled signal varies by :data:`INFORMATIVE` of the rating
-    and stands out of the logged signal's noise (:data:`SIGNAL_TO_NOISE`)."""
+    and stands out of the logged signal's noise (:data:`SIGNAL_TO_NOISE`). A current that
+    friction dominates (:data:`RIGID_SHARE`) and does not follow the model is not judged (the
+    nominal friction does not predict it) unless its sign is reversed."""
     model = _model_signal(robot, rows, name)
     if model is None:
         return None
@@ -207,10 +211,12 @@ def _signal_match(robot: Robot, rows: dict[str, Array], name: str) -> _Signal | 
     spread, noise = x.std(axis=0), _noise(rows, name)
     varies = moving & (spread >= INFORMATIVE * rating)
     clear = spread >= SIGNAL_TO_NOISE * noise
-    judged = varies & clear & rigid
+    judged = varies & clear
+    loose = judged & np.logical_not(rigid) & ~(corr >= NEGATIVE) & ~(corr < -NEGATIVE)
+    judged &= ~loose
     unjudged = {
         NOISY: [int(j) for j in np.flatnonzero(varies & ~clear)],
-        FRICTION: [int(j) for j in np.flatnonzero(varies & clear & np.logical_not(rigid))],
+        FRICTION: [int(j) for j in np.flatnonzero(loose)],
     }
     failures: list[str] = []
     swapped = _swaps(x, y, judged, corr)
@@ -237,7 +243,7 @@ def _signal_match(robot: Robot, rows: dict[str, Array], name: str) -> _Signal | 
             )
         else:
             good.append(j)
-    return _Signal(ratio, corr, judged, failures, good, unjudged)
+    return _Signal(ratio, corr, judged, failures, good, unjudged, rigid)
 
 
 def robot_match(robot: Robot, rows: dict[str, Array]) -> RobotMatch:
@@ -264,7 +270,9 @@ def robot_match(robot: Robot, rows: dict[str, Array]) -> RobotMatch:
         found = _signal_match(robot, rows, name)
         if found is None:
             continue
-        ratio, good = found.ratio, found.good
+        # the scale: on joints the rigid body drives (a friction-made current's scale is the
+        # robot file's nominal friction's)
+        ratio, good = found.ratio, [j for j in found.good if found.rigid[j]]
         ratios[name] = np.where(found.judged, ratio, np.nan)
         correlations[name] = np.where(found.judged, found.corr, np.nan)
         failures += found.failures
