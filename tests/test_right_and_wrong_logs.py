@@ -158,11 +158,12 @@ def test_a_log_at_rest_most_of_its_length_has_too_little_motion(tmp_path: Path) 
 #: one-second windows of the realistic twin (api.simulate, seed 2) whose currents are mostly
 #: friction on some joint (the nominal friction, power-flow jumps and all, does not predict it)
 FRICTION_WINDOWS = [
-    ("ur3e", "test-b", 1.36),
-    ("ur3e", "test-b", 4.08),
-    ("ur5e", "test-b", 4.08),
-    ("ur5", "test-b", 4.23),
-    ("ur3e", "test-a", 6.77),
+    ("ur3e", "test-b", 1.36, 2.36),
+    ("ur3e", "test-b", 4.08, 5.08),
+    ("ur5e", "test-b", 4.08, 5.08),
+    ("ur5", "test-b", 4.23, 5.23),
+    ("ur3e", "test-a", 6.77, 7.77),
+    ("nursing-arm", "test-b", None, 1.2),  # friction sets the scale of two joints' currents
 ]
 
 
@@ -172,9 +173,9 @@ def test_windows_where_friction_makes_the_current_are_accepted() -> None:
     from kinergy.logs.window import TimeWindow
 
     notes = []
-    for robot, trajectory, start in FRICTION_WINDOWS:
+    for robot, trajectory, start, stop in FRICTION_WINDOWS:
         log = twin(robot, trajectory, mismatch="realistic", seed=2)
-        reading = LogReading(window=TimeWindow(start, start + 1.0))
+        reading = LogReading(window=TimeWindow(start, stop))
         checked = CheckedLog(log, load_robot(robot), reading)
         checked.read()  # accepted
         assert checked.checks is not None
