@@ -205,3 +205,24 @@ def test_the_ur3e_rad_fit_uses_the_logged_payload() -> None:
         identify([_rad_in_memory(payload=False)], "ur3e")
     cut = identify([_rad_in_memory(payload=False)], "ur3e", accept="fit")
     assert min(m.r2 for m in cut.fit.torque[:5]) < 0.5
+
+
+def test_the_report_and_the_fleet_carry_the_logged_payload(tmp_path: Path) -> None:
+    from kinergy.fleet.analysis import _powers
+    from kinergy.workflows.energy import log_energy_report
+
+    payload = Payload(MASS, COG, UR_INERTIA[[0, 1, 2, 3, 5, 4]])
+    twin = _twin_log(payload)
+    logged = Log("logged.csv", twin.t, {**twin.signals, **_columns(len(twin.t))})
+    write_log(tmp_path / "logged.csv", logged.t, logged.signals)
+    robot = load_robot("ur5e")
+    expected = energy(robot.with_payload(payload), tmp_path / "logged.csv", payload=payload)
+    e_elec = expected.to_dict()["total"]["e_elec"]
+    report, _ = log_energy_report(robot, tmp_path / "logged.csv")
+    assert report.figures().total_e_elec == pytest.approx(e_elec, rel=1e-6)
+    bare = _powers(robot, Log("bare", twin.t, twin.signals))["predicted"]
+    carried = _powers(robot, logged)["predicted"]
+    loaded = _powers(robot.with_payload(payload), Log("bare", twin.t, twin.signals))["predicted"]
+    assert bare is not None and carried is not None and loaded is not None
+    np.testing.assert_allclose(carried, loaded, rtol=1e-9, atol=1e-9)
+    assert not np.allclose(carried, bare)

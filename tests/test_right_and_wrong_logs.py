@@ -208,3 +208,16 @@ def test_a_noisy_loggers_window_is_judged_where_the_signal_stands_out() -> None:
     checked.read()
     assert checked.checks is not None and "robot" in checked.checks.passed
     assert any("does not stand out of the log's noise" in n for n in checked.checks.notes)
+
+
+def test_a_window_where_every_joint_cruises_is_accepted() -> None:
+    # the nursing arm's test B: one second where every commanded speed holds one value
+    from kinergy.api import simulate as twin
+    from kinergy.logs.reading import CheckedLog, LogReading
+    from kinergy.logs.window import TimeWindow
+
+    log = twin("nursing-arm", "test-b", seed=2)
+    window = TimeWindow(23.61, 24.61)
+    keep = window.keep(log.t)
+    assert np.ptp(log["target_qd"][keep], axis=0).max() == 0.0  # cruising, every joint
+    CheckedLog(log, load_robot("nursing-arm"), LogReading(window=window)).read()
