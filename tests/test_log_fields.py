@@ -300,3 +300,13 @@ def test_measured_accelerations_are_used_where_logged() -> None:
     with_qdd = Log("mem", t, {**log.signals, "actual_qdd": qdd})
     assert np.array_equal(motion_from_log(with_qdd, source="actual").qdd, qdd)
     assert not np.allclose(motion_from_log(log, source="actual").qdd, qdd)
+
+
+def test_a_mapping_leaves_columns_unread_with_an_underscore(tmp_path: Path) -> None:
+    path = _logger_file(tmp_path / "lab.csv")
+    spec = parse_column_spec("_=output_double_register_3,_=my_station,_=actual_current_*", 6)
+    checked = CheckedLog(path, load_robot("ur5e"), LogReading(columns=spec))
+    log = checked.read()
+    assert "output_double_register_3" not in log.signals and "actual_current" not in log.signals
+    note = next(n for n in checked.notes if "ignored" in n)
+    assert "_id" in note and "my_station" not in note  # what the user left out is not noted

@@ -233,8 +233,8 @@ columns_option = click.option(
     help="Layout of a headerless log: UR's RTDE field names, NAME:N for an N-vector, _ (or _:N) "
     'for columns to skip, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6"; or a header '
     "log's own names mapped to RTDE fields, FIELD=COLUMN with * for a vector's index, e.g. "
-    '"timestamp=time,actual_q=positions_*". A header\'s columns that are no RTDE field are '
-    "ignored (a note names them).",
+    '"timestamp=time,actual_q=positions_*" (_=COLUMN leaves a column unread). A header\'s '
+    "columns that are no RTDE field are ignored (a note names them).",
 )
 topic_option = click.option(
     "--topic",

@@ -8,7 +8,8 @@
 - how a header log's own names map to RTDE's (:class:`ColumnMap`): entries ``FIELD=COLUMN``,
   ``*`` in ``COLUMN`` standing for a vector's index (``actual_q=positions_*`` reads the columns
   ``positions_0``, ``positions_1``, ... as ``actual_q``, in the order of their numbers, whatever
-  the first one is). Columns the header names by RTDE's names stay as they are.
+  the first one is); ``_=COLUMN`` leaves the column(s) unread, as ``_`` skips columns of a
+  headerless file. Columns the header names by RTDE's names stay as they are.
 
 Both are capped (:data:`MAX_COLUMNS`) and checked before anything is allocated.
 
@@ -174,6 +175,10 @@ class ColumnMap:
         out = list(header)
         taken: dict[int, str] = {}
         for name, column in self.entries:
+            if name == SKIP:
+                for member in self._members(name, column, header, path):
+                    out[member] = f"{SKIP}{member}"  # a skipped column (never read)
+                continue
             if name in header or f"{name}_0" in header:
                 raise KinergyError(
                     f"{path}: --columns maps {printable(column)} to {name}, but the header names "
@@ -218,7 +223,7 @@ class ColumnMap:
             )
         want = FIELDS.get(name, 1)
         count = self.n_joints if want == JOINTS else want
-        if isinstance(count, int) and len(found) != count:
+        if name != SKIP and isinstance(count, int) and len(found) != count:
             what = "the robot's joints" if want == JOINTS else f"the values of {name}"
             raise KinergyError(
                 f"{path}: --columns {name}={printable(column)} matches {len(found)} columns, but "
@@ -268,6 +273,8 @@ def _check_mapped(name: str, column: str, item: str, seen: list[tuple[str, str]]
     scalar with it), or repeats a field or a column."""
     if not name or not column:
         raise KinergyError(f"--columns: {printable(item)!r} must be FIELD=COLUMN")
+    if name == SKIP:  # _=COLUMN: not read
+        return
     if not is_known(name):
         guess = closest(name)
         hint = f" (did you mean {guess}?)" if guess else ""

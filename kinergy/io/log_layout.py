@@ -250,6 +250,9 @@ def _read_columns(
     textual: set[str] = set()
     first = cells if len(cells) == len(named) else [""] * len(named)
     for k, name in enumerate(named):
+        if name == f"_{k}":  # skipped by the user's mapping (``_=COLUMN``): not noted
+            names.append(name)
+            continue
         member = vector_member(name)
         field = member[0] if member is not None else name
         if not (is_known(name) or member is not None):
