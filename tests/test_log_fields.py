@@ -300,6 +300,13 @@ def test_measured_accelerations_are_used_where_logged() -> None:
     with_qdd = Log("mem", t, {**log.signals, "actual_qdd": qdd})
     assert np.array_equal(motion_from_log(with_qdd, source="actual").qdd, qdd)
     assert not np.allclose(motion_from_log(log, source="actual").qdd, qdd)
+    # identification's preparation filters the logged acceleration as it filters the speed
+    from kinergy.logs.filtering import default_cutoff, lowpass
+    from kinergy.logs.prepare import prepare
+
+    d = prepare(Log("mem", t, {**with_qdd.signals, "actual_current": signals["actual_current"]}), 6)
+    fs = 1.0 / float(t[1] - t[0])
+    np.testing.assert_allclose(d.qdd, lowpass(qdd, fs, default_cutoff(t)), atol=1e-12)
 
 
 def test_a_mapping_leaves_columns_unread_with_an_underscore(tmp_path: Path) -> None:

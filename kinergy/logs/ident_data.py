@@ -133,6 +133,7 @@ JOINT_SIGNALS = (
     "target_qdd",
     "actual_q",
     "actual_qd",
+    "actual_qdd",
     "target_moment",
     "actual_current",
     MEASURED_TORQUE,

@@ -117,7 +117,7 @@ def spill_chunks(path: str, chunks: Iterator[Log], notes: Sequence[str]) -> LogS
         raise KinergyError(f"{path}: the log has no samples")
     names = first.signals
     # with the commanded motion, the measured positions are not used (only looked for)
-    skip = {"actual_q"} if {"target_q", "target_qd"} <= set(names) else set()
+    skip = {"actual_q", "actual_qdd"} if {"target_q", "target_qd"} <= set(names) else set()
     layout = [
         (s, 1 if names[s].ndim == 1 else names[s].shape[1], names[s].ndim == 2)
         for s in SIGNALS
