@@ -21,6 +21,7 @@ from kinergy.cli.common import (
     table,
     tell,
     topic_option,
+    window_options,
     writes,
 )
 from kinergy.workflows.energy import energy_of_log
@@ -112,6 +113,7 @@ def energy_text(report: dict[str, Any]) -> str:
     help="Which motion of a log: commanded (target_*) or measured (actual_*).",
 )
 @payload_option
+@window_options
 @writes(inputs=("model", "motion_path"))
 def energy(
     model: str,
@@ -125,6 +127,8 @@ def energy(
     accept: tuple[str, ...],
     topic: str | None,
     effort: str | None,
+    start: float | None,
+    stop: float | None,
 ) -> None:
     """What a logged or planned motion draws from the arm's supply, and per-joint mechanical and
     electrical energy; a log's measured supply energy beside the prediction.
@@ -133,9 +137,17 @@ def energy(
     with --columns), a motion file, a URScript program (.script) or a built-in motion (test-a,
     test-b: the UR5e doc's tests A and B planned for MODEL).
     """
-    r = load(model, payload)
+    r = load(model, None)
     reading = log_reading(
-        r, columns=columns, repair=repair, accept=accept, topic=topic, effort=effort
+        r,
+        columns=columns,
+        repair=repair,
+        accept=accept,
+        topic=topic,
+        effort=effort,
+        payload=payload,
+        start=start,
+        stop=stop,
     )
     result = energy_of_log(r, motion_path, reading, source=source, recovery=not no_recovery)
     tell(result.notes, result.warnings)

@@ -13,11 +13,13 @@ from kinergy.cli.common import (
     json_result,
     log_reading,
     output_file_option,
+    payload_option,
     progress,
     repair_option,
     table,
     tell,
     topic_option,
+    window_options,
     writes,
 )
 from kinergy.cli.validate import validation_text
@@ -230,6 +232,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 )
 @cutoff_option
 @repair_option
+@payload_option
+@window_options
 @writes(files=("out",), inputs=("logs", "robot_name"))
 def identify(
     logs: tuple[str, ...],
@@ -248,6 +252,9 @@ def identify(
     accept: tuple[str, ...],
     topic: str | None,
     effort: str | None,
+    payload: str | None,
+    start: float | None,
+    stop: float | None,
 ) -> None:
     """Identify a model from controller logs and write it as a robot file.
 
@@ -257,7 +264,16 @@ def identify(
     """
     r = load_robot(robot_name)
     reading = log_reading(
-        r, columns=columns, repair=repair, cutoff=cutoff, accept=accept, topic=topic, effort=effort
+        r,
+        columns=columns,
+        repair=repair,
+        cutoff=cutoff,
+        accept=accept,
+        topic=topic,
+        effort=effort,
+        payload=payload,
+        start=start,
+        stop=stop,
     )
     options = IdentifyOptions(
         method=Method(method),

@@ -21,6 +21,7 @@ from kinergy.cli.common import (
     table,
     tell,
     topic_option,
+    window_options,
     writes,
 )
 from kinergy.identification.metrics import JointMetrics
@@ -133,6 +134,7 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
 @cutoff_option
 @payload_option
 @repair_option
+@window_options
 @writes(folders=("plots",), inputs=("model", "logs"))
 def validate(
     model: str,
@@ -146,15 +148,26 @@ def validate(
     accept: tuple[str, ...],
     topic: str | None,
     effort: str | None,
+    start: float | None,
+    stop: float | None,
 ) -> None:
     """How well a model predicts logs: torque (UR5e Table V) and current (Table VII) errors and R^2.
 
     A LOG may also be a built-in motion (test-a, test-b): the log the realistic twin of MODEL
     writes running it (a simulated robot that differs from the model as a real arm does).
     """
-    r = load(model, payload)
+    r = load(model, None)
     reading = log_reading(
-        r, columns=columns, repair=repair, cutoff=cutoff, accept=accept, topic=topic, effort=effort
+        r,
+        columns=columns,
+        repair=repair,
+        cutoff=cutoff,
+        accept=accept,
+        topic=topic,
+        effort=effort,
+        payload=payload,
+        start=start,
+        stop=stop,
     )
     report = validate_logs(r, logs, reading, plots=plots)
     tell(report.notes, report.warnings)

@@ -311,6 +311,7 @@ def validation_report(
     *,
     rows: int = CHUNK_ROWS,
     plot_samples: int = 0,
+    robots: Sequence[Robot] | None = None,
 ) -> ValidationReport:
     """How well ``robot`` predicts ``logs`` (prepared segments, or prepared logs in memory):
     pooled and per log, moving and holding apart (module docstring), in one pass over each
@@ -320,6 +321,8 @@ def validation_report(
     (:func:`~kinergy.identification.chunks.data_history`). With ``plot_samples`` > 0, each
     log's :attr:`LogValidation.series` keeps its signals for plots: every sample of a log up to
     that many samples, every ``k``-th of a longer one (the figures use every sample).
+    ``robots``: each log's model where they differ (the payload each log's controller logged:
+    :meth:`kinergy.logs.prepare.PreparedSegment.robot`); default ``robot`` for every log.
 
     Raises
     ------
@@ -337,7 +340,7 @@ def validation_report(
         for chunk in segment.chunks(rows):
             check_signals([chunk])
             data, skip = held.ahead(k, chunk)
-            pred = predict(robot, data).after(skip)
+            pred = predict(robot if robots is None else robots[k], data).after(skip)
             held.update(data, skip)
             found = _rows(robot, chunk, pred)
             if sampled is not None:

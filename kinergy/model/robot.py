@@ -376,14 +376,20 @@ class Limits:
         Maximum |tau|, N m.
     acceleration : float or None
         Maximum |qdd|, rad/s^2, where published.
+    continuous : bool
+        The joint turns without limit (no end stop: the UR3e's wrist 3): ``position`` is then
+        the range a planner uses, and a logged angle beyond it is no error.
     """
 
     position: Array
     speed: float
     torque: float
     acceleration: float | None = None
+    continuous: bool = False
 
     def __post_init__(self) -> None:
+        if not isinstance(self.continuous, bool):
+            raise KinergyError(f"limits.continuous must be true or false, got {self.continuous!r}")
         pos = _vector(self.position, 2, "limits.position")
         if not pos[0] < pos[1]:
             raise KinergyError(

@@ -14,12 +14,12 @@ from kinergy.accounting.energy import EnergyAccumulator, EnergyReport, energy
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.arrays import Array
 from kinergy.io.log import Log
-from kinergy.io.motion import iter_motion
+from kinergy.io.motion import iter_motion, motion_from_log
 from kinergy.io.urscript_reader import read_program
+from kinergy.logs.payload import PAYLOAD_SIGNALS, logged_loads
 from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
-from kinergy.optimize.program_samples import drive_by_payload
-from kinergy.predict import drive_state
+from kinergy.predict import DriveState, drive_by_payload, drive_state
 from kinergy.trajectory.motion import Motion, MotionSource
 from kinergy.trajectory.program_motion import payload_index, program_motion
 from kinergy.trajectory.program_path import program_path
@@ -27,7 +27,14 @@ from kinergy.trajectory.programs import paper_trajectory
 from kinergy.trajectory.robot_program import Move
 from kinergy.workflows.twin import is_builtin
 
-__all__ = ["ENERGY_ROWS", "LogEnergy", "energy_of_log", "program_energy", "unused_payload"]
+__all__ = [
+    "ENERGY_ROWS",
+    "LogEnergy",
+    "energy_of_log",
+    "log_energy_report",
+    "program_energy",
+    "unused_payload",
+]
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -82,7 +89,13 @@ def _measured_power(log: Log) -> Array | None:
 
 
 #: the signals besides the motion that the energy of a log uses
-_EXTRAS = ("joint_temperatures", "actual_robot_voltage", "actual_robot_current", "segment")
+_EXTRAS = (
+    "joint_temperatures",
+    "actual_robot_voltage",
+    "actual_robot_current",
+    "segment",
+    *PAYLOAD_SIGNALS,
+)
 
 
 def _signals_used(log: CheckedLog, source: MotionSource) -> list[str] | None:
@@ -112,6 +125,18 @@ def _derived(signals: list[str] | None) -> str | None:
     if source == "target" and "target_qdd" not in signals:
         return "target_qdd not in the log: accelerations from a spline of target_qd"
     return None
+
+
+def _drive(robot: Robot, log: Log, motion: Motion) -> DriveState:
+    """The drive model over a chunk's motion, each sample with the payload the log says it
+    carried (:func:`kinergy.logs.payload.logged_loads`), else with the robot's own; friction at
+    the log's joint temperatures where it has them."""
+    temperature = _temperature(log, motion)
+    loads = logged_loads(log)
+    if loads is None:
+        return drive_state(robot, motion.q, motion.qd, motion.qdd, temperature=temperature)
+    m = motion
+    return drive_by_payload(robot, *loads, m.q, m.qd, m.qdd, temperature=temperature)
 
 
 #: how far past a joint's torque limit the modelled torque of a motion may go before the
@@ -188,6 +213,8 @@ def energy_of_log(
     integrated across. A URScript program (``*.script``) is run as the controller would, with
     the loads it sets (:func:`program_energy`)."""
     inputs = InputLogs()
+    reading = reading or LogReading()
+    robot = reading.loaded(robot)
     if is_builtin(path) or os.fspath(path).endswith(".script"):
         if is_builtin(path):  # test-a, test-b: the motion as planned for the robot
             motion = paper_trajectory(robot, os.fspath(path))
@@ -202,12 +229,12 @@ def energy_of_log(
     acc = EnergyAccumulator(robot, recovery=recovery)
     measured = False
     peak = np.zeros(robot.n)
-    log = CheckedLog(path, robot, reading or LogReading(), rows=rows, ahead=True)
+    log = CheckedLog(path, robot, reading, rows=rows, ahead=True)
     source = checks.choice(source, MotionSource, "source")
     log.select = _signals_used(log, source)
     for part in iter_motion(log.chunks(), n_joints=robot.n, source=source):
         m = part.motion
-        state = drive_state(robot, m.q, m.qd, m.qdd, temperature=_temperature(part.log, m))
+        state = _drive(robot, part.log, m)
         power = _measured_power(part.log)
         measured = power is not None
         acc.add(m.t, state, starts=part.starts, measured_power=power)
@@ -217,3 +244,23 @@ def energy_of_log(
     if derived := _derived(log.select):
         inputs.notes.append(f"{log.path}: {derived}")
     return _with(acc.figures(measured=measured), inputs, _beyond_limits(robot, peak))
+
+
+def log_energy_report(
+    robot: Robot,
+    path: str | os.PathLike[str],
+    reading: LogReading | None = None,
+    *,
+    source: str = "auto",
+) -> tuple[EnergyReport, InputLogs]:
+    """The energy of a log's motion with its time series (:class:`EnergyReport`, as the study
+    report plots it), each sample with the payload the log's controller logged (else the
+    robot's, or ``--payload``'s), and what the log was; the log read whole through its checks."""
+    reading = reading or LogReading()
+    robot = reading.loaded(robot)
+    checked = CheckedLog(path, robot, reading)
+    log = checked.read()
+    inputs = InputLogs()
+    inputs.add(checked)
+    motion = motion_from_log(log, n_joints=robot.n, source=source)
+    return energy(robot, motion, state=_drive(robot, log, motion)), inputs

@@ -41,10 +41,11 @@ from kinergy.messages import coded
 from kinergy.model import Robot, save_robot
 from kinergy.model.robot import Identified, InputRecord, Source
 from kinergy.predict import drive_state
-from kinergy.workflows.logs import chunked_logs
+from kinergy.workflows.logs import chunked_logs, one_payload
 
 __all__ = [
     "METHODS",
+    "MIN_MOTION_SHARE",
     "MIN_SECONDS",
     "PayloadRun",
     "identify_chunks",
@@ -52,6 +53,7 @@ __all__ = [
     "identify_model",
     "identify_payload_model",
     "measured_electrics",
+    "motion_share",
     "unsupported_fit",
 ]
 
@@ -115,10 +117,24 @@ def identify_model(
     return identify_chunks(robot, LogChunks.of(datas, check=_checks), options)
 
 
-def unsupported_fit(result: IdentificationResult) -> str:
+#: the least share of their samples the logs must move on (any joint faster than
+#: :data:`~kinergy.identification.chunks.STILL_SPEED`) before a fit they do not support is
+#: blamed on their layout rather than on too little motion
+MIN_MOTION_SHARE = 0.25
+
+
+def motion_share(summary: Summary) -> float:
+    """The share of a log's samples some joint moves on (its most moving joint's)."""
+    moving = np.asarray(summary.forward + summary.backward, dtype=float)
+    return float(np.max(moving) / max(summary.samples, 1))
+
+
+def unsupported_fit(result: IdentificationResult, share: float = 1.0) -> str:
     """Why the identified model is not supported by its own logs, or "": no drive parameter
     identified, or an R^2 below 0 on the identification logs for a joint that moved (module
-    docstring of :mod:`kinergy.logs.checks`, check ``fit``)."""
+    docstring of :mod:`kinergy.logs.checks`, check ``fit``); logs that move on less than
+    :data:`MIN_MOTION_SHARE` of their samples (``share``) are told they hold too little motion,
+    not that their layout is wrong."""
     flags = [f for j in result.joints for k, f in j.flags.items()]
     if flags and all(f != IDENTIFIED for f in flags):
         return (
@@ -134,6 +150,13 @@ def unsupported_fit(result: IdentificationResult) -> str:
         for k, m in enumerate(metrics):
             if moved[k] and m.r2 < 0:
                 worst.append(f"{result.robot.joints[k].name} {unit} R^2 {m.r2:.2f}")
+    if worst and share < MIN_MOTION_SHARE:
+        return (
+            f"too little motion to identify from: the joints move on {100 * share:.0f} % of the "
+            f"logs' samples and the model fitted to them does not explain them "
+            f"({', '.join(worst)}); log more motion (kinergy excite designs it), or cut the logs "
+            "to where the arm moves (--from/--to)"
+        )
     if worst:
         return (
             f"the identified model does not explain its own logs ({', '.join(worst)}): the "
@@ -185,13 +208,17 @@ def identify_logs(
     reading = reading or LogReading()
     options = options or IdentifyOptions()
     with chunked_logs(logs, robot, reading, rows=max(rows, 2)) as (segments, inputs):
+        start = one_payload(reading.loaded(robot), segments, inputs.notes)
         chunks = LogChunks(segments, rows, check=_checks)
         try:
-            result = identify_chunks(robot, chunks, options)
+            result = identify_chunks(start, chunks, options)
+            share = motion_share(Summary.pooled(chunks.summaries))
         finally:
             chunks.close()
+    # the payload was the run's, not the arm's: the model keeps its file's own
+    result = dataclasses.replace(result, robot=result.robot.with_payload(robot.payload))
     accepted = [a for c in inputs.checks for a in c.accepted]
-    problem = unsupported_fit(result)
+    problem = unsupported_fit(result, share)
     if problem:
         if Check.FIT not in reading.accept:
             raise KinergyError(
@@ -201,7 +228,11 @@ def identify_logs(
         accepted.append(f"fit: {problem}")
     result = dataclasses.replace(result, inputs=inputs, accepted=tuple(accepted))
     if out is not None:
-        columns = compact_columns(reading.columns) if reading.columns else None
+        columns = None
+        if isinstance(reading.columns, tuple):
+            columns = compact_columns(reading.columns)
+        elif reading.columns is not None:
+            columns = str(reading.columns)
         model = _record(result.robot, inputs, options, columns, accepted)
         what = f"{robot.name} identified ({result.method} method)"
         save_robot(model, out, header=_header(what, [p.path for p in inputs.provenance]))

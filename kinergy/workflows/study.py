@@ -15,16 +15,16 @@ from kinergy.identification.chunks import Segment
 from kinergy.identification.result import IdentificationResult
 from kinergy.identification.validation import PLOT_SAMPLES, validation_report
 from kinergy.io.task import Task
-from kinergy.logs.prepare import IdentData
+from kinergy.logs.prepare import IdentData, PreparedSegment
 from kinergy.logs.reading import LogReading
 from kinergy.messages import Messages
 from kinergy.model.robot import Robot
 from kinergy.report.html import Section, Table, write_report
 from kinergy.report.study import Comparison, Study, Timing, study_sections
 from kinergy.trajectory.motion import Motion
-from kinergy.workflows.energy import program_energy
+from kinergy.workflows.energy import log_energy_report, program_energy
 from kinergy.workflows.identify import identify_logs as identified
-from kinergy.workflows.logs import chunked_logs, read_motion
+from kinergy.workflows.logs import chunked_logs
 from kinergy.workflows.optimize import optimize_task
 
 __all__ = ["optimal_timing", "run_study", "study_report", "write_study"]
@@ -42,7 +42,8 @@ def _comparisons(
     current: dict[str, Comparison] = {}
     for name, log in validation.items():
         say(f"validating on {name}")
-        found = validation_report(model, [log], plot_samples=PLOT_SAMPLES).logs[0]
+        loaded = log.robot(model) if isinstance(log, PreparedSegment) else model
+        found = validation_report(loaded, [log], plot_samples=PLOT_SAMPLES).logs[0]
         for key, out in (("torque", torque), ("current", current)):
             series, metrics = found.series.get(key), getattr(found, key)
             if series is not None and metrics is not None:
@@ -147,15 +148,16 @@ def study_report(
         said.notes += result.notes
         said.warnings += result.warnings
         robot = result.robot
+    robot = reading.loaded(robot)  # --payload: of every log and motion
     motions: dict[str, Motion | EnergyReport] = {}
     for p in energy_logs:
         if p.endswith(".script"):  # run with the loads it sets
             motions[Path(p).name] = program_energy(robot, p)
             continue
-        motion, inputs = read_motion(p, robot, reading)
+        report, inputs = log_energy_report(robot, p, reading)
         said.notes += inputs.notes
         said.warnings += inputs.warnings
-        motions[Path(p).name] = motion
+        motions[Path(p).name] = report
     with chunked_logs(validate_logs, robot, reading) as (segments, inputs):
         said.notes += inputs.notes
         said.warnings += inputs.warnings
