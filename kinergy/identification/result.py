@@ -21,6 +21,7 @@ from typing import Any, TypedDict
 from kinergy.arrays import Array
 from kinergy.drives.transmission import joint_torque
 from kinergy.identification.chunks import LogChunks, data_history
+from kinergy.identification.electrics import StandingDraw
 from kinergy.identification.metrics import JointMetrics, MetricSums
 from kinergy.jsonable import to_jsonable
 from kinergy.logs.prepare import IdentData
@@ -148,6 +149,9 @@ class IdentificationResult:
         The logs it was identified from (by content) and what their checks found.
     accepted : tuple of str
         Checks that failed and the user accepted (``--accept``), with what they saw.
+    standing_draw : StandingDraw or None
+        The arm's standing draw found from the logs' measured supply (None where they do not
+        measure it).
     """
 
     robot: Robot = field(metadata={"json": lambda r: r.name})
@@ -156,6 +160,7 @@ class IdentificationResult:
     fit: Fit
     inputs: InputLogs = field(default_factory=InputLogs, metadata={"json": lambda i: i.records()})
     accepted: tuple[str, ...] = ()
+    standing_draw: StandingDraw | None = None
 
     @property
     def warnings(self) -> list[str]:
