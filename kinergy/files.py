@@ -33,6 +33,7 @@ __all__ = [
     "Terminated",
     "all_or_none",
     "atomic_folder",
+    "atomic_open",
     "atomic_write",
     "check_folder",
     "check_output",
@@ -243,12 +244,13 @@ def _fsync_folder(folder: Path) -> None:
             os.close(fd)
 
 
-def atomic_write(
-    path: PathLike, write: Callable[[IO[Any]], object], *, binary: bool = False
-) -> Path:
-    """Write a file through ``write(handle)`` into a temporary file beside it, flush it to disk
-    and rename it into place: readers never see a half-written file, and a failure (an
-    exception, Ctrl-C, SIGTERM under :func:`terminate_on_signals`) leaves nothing behind.
+@contextlib.contextmanager
+def atomic_open(path: PathLike, *, binary: bool = False) -> Iterator[IO[Any]]:
+    """A handle to a temporary file beside ``path`` that becomes ``path`` when the ``with``
+    block ends without an exception: flushed to disk and renamed into place, so readers never
+    see a half-written file and a failure (an exception, Ctrl-C, SIGTERM under
+    :func:`terminate_on_signals`) leaves nothing behind. For output written as it is computed
+    (a trace of a long log).
 
     Raises
     ------
@@ -261,7 +263,7 @@ def atomic_write(
             mode = "wb" if binary else "w"
             kwargs: dict[str, Any] = {} if binary else {"encoding": "utf-8", "newline": "\n"}
             with os.fdopen(fd, mode, **kwargs) as handle:
-                write(handle)
+                yield handle
                 handle.flush()
                 os.fsync(handle.fileno())
             os.chmod(tmp, 0o644)  # mkstemp makes it private; outputs are for reading
@@ -270,7 +272,21 @@ def atomic_write(
         except OSError as exc:
             raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
     _fsync_folder(target.parent)
-    return target
+
+
+def atomic_write(
+    path: PathLike, write: Callable[[IO[Any]], object], *, binary: bool = False
+) -> Path:
+    """Write a file through ``write(handle)``, whole or not at all (:func:`atomic_open`).
+
+    Raises
+    ------
+    KinergyError
+        ``PATH: cannot write (reason)``, or :func:`check_output`'s refusals.
+    """
+    with atomic_open(path, binary=binary) as handle:
+        write(handle)
+    return Path(path)
 
 
 def _sha256(path: Path) -> str:

@@ -8,10 +8,12 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import kinergy
 from kinergy.accounting.supply import measured_supply, supply_energy
+from kinergy.accounting.trace import PowerSeries, TraceWriter, trace_columns
 from kinergy.cli import main
 from kinergy.drives.bus import BUS_RESISTANCE, supply_power
 from kinergy.io.rtde import write_log
@@ -96,3 +98,91 @@ def test_the_twin_logs_each_joints_bus_voltage_not_its_motors(ur5e: kinergy.Robo
     assert np.ptp(joint) < 2.0  # a volt or so of cable drop at the peak current
     motor = drive_state(ur5e, twin["actual_q"], twin["actual_qd"], twin["target_qdd"]).voltage
     assert np.ptp(motor) > 10.0  # what the twin used to write: swings with speed
+
+
+def test_the_trace_streams_chunk_by_chunk_and_adds_up_to_the_figures(
+    ur5e: kinergy.Robot, exact_log: Path, tmp_path: Path
+) -> None:
+    """A trace written 300 samples at a time is the trace written at once, row for row; its
+    powers integrate to the report's supply energies, and each joint's to its E_elec."""
+    traces = {}
+    for rows in (300, 100_000):
+        path = tmp_path / f"trace{rows}.parquet"
+        with path.open("wb") as fh:
+            writer = TraceWriter(fh, ur5e, "parquet")
+            report = energy_of_log(ur5e, exact_log, rows=rows, sinks=[writer])
+            writer.close()
+        traces[rows] = pd.read_parquet(path)
+    a, b = traces[300], traces[100_000]
+    pd.testing.assert_frame_equal(a, b, rtol=1e-12)
+    assert list(a.columns) == trace_columns(ur5e, measured=True)
+    assert len(a) == report.samples
+    t = a["time"].to_numpy()
+    assert np.trapezoid(a["supply_predicted"], t) == pytest.approx(report.supply.drawn, rel=1e-9)
+    assert report.measured is not None
+    assert np.trapezoid(a["supply_measured"], t) == pytest.approx(report.measured.drawn, rel=1e-9)
+    for j, name in enumerate(ur5e.joint_names):
+        e = np.trapezoid(a[f"p_elec_{name}"], t)
+        assert e == pytest.approx(report.e_elec[j], rel=1e-9)
+    # the standing draw is in every sample of the supply
+    motors = np.maximum(a[[f"p_elec_{n}" for n in ur5e.joint_names]].sum(axis=1), 0.0)
+    np.testing.assert_allclose(a["supply_predicted"] - motors, ur5e.standby_power, atol=1e-9)
+
+
+def test_a_plots_series_stays_bounded_and_keeps_every_kth_sample() -> None:
+    series = PowerSeries(limit=1000)
+    t = np.arange(25_000, dtype=float)
+    for start in range(0, t.size, 1234):
+        part = t[start : start + 1234]
+        series.add(part, 2.0 * part, None, np.zeros((part.size, 6)))
+    assert len(series.t) <= 1000 and series.measured is None
+    step = series.stride
+    np.testing.assert_array_equal(series.t, t[::step])
+    np.testing.assert_array_equal(series.predicted, 2.0 * t[::step])
+
+
+def test_cli_trace_and_plot(
+    exact_log: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    trace, plot = tmp_path / "t.csv", tmp_path / "p.png"
+    argv = ["energy", "ur5e", str(exact_log)]
+    assert main([*argv, "--trace", str(trace), "--plot", str(plot)]) == 0
+    assert pd.read_csv(trace).columns[2] == "supply_measured"
+    assert plot.read_bytes()[:4] == b"\x89PNG"
+    capsys.readouterr()
+    # an extension that is neither: one line before any work, nothing written
+    assert main([*argv, "--trace", str(tmp_path / "t.txt")]) == 1
+    err = capsys.readouterr().err
+    assert "--trace" in err and ".csv" in err and err.count("\n") == 1
+    assert not (tmp_path / "t.txt").exists()
+    # a file of the user's is never replaced
+    mine = tmp_path / "mine.csv"
+    mine.write_text("precious\n")
+    assert main([*argv, "--trace", str(mine)]) == 1
+    assert mine.read_text() == "precious\n"
+
+
+def test_validate_compares_the_supply_where_the_log_measures_it(
+    ur5e: kinergy.Robot, exact_log: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """On the exact twin the supply's power is the model's: RMSE 0, energy error 0; the figures
+    are the independent numpy ones of the trace."""
+    assert main(["validate", "ur5e", str(exact_log), "--json"]) == 0
+    supply = json.loads(capsys.readouterr().out)["supply"]
+    report = energy_of_log(ur5e, exact_log)
+    assert report.measured is not None
+    assert supply["rms"] < 1e-6 and abs(supply["error"]) < 1e-6
+    assert supply["measured"] == pytest.approx(report.measured.drawn, rel=1e-9)
+    assert main(["validate", "ur5e", str(exact_log)]) == 0
+    assert "Supply power against actual_robot_voltage x actual_robot_current" in (
+        capsys.readouterr().out
+    )
+
+
+def test_the_report_shows_the_supply_plot(exact_log: Path, tmp_path: Path) -> None:
+    out = tmp_path / "report"
+    assert main(["report", "ur5e", "--energy", str(exact_log), "--out", str(out)]) == 0
+    figure = out / "figures" / "a-csv_supply.png"
+    assert figure.read_bytes()[:4] == b"\x89PNG"
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert "figures/a-csv_supply.png" in html and "power drawn from the arm&#39;s supply" in html

@@ -276,8 +276,9 @@ def measured_electrics(result: IdentificationResult, logs: LogChunks) -> Identif
     )
     draw = None
     if has_supply:
-        currents = _predicted_currents(robot, logs) if logs.every("current") else None
-        draw = _standing_draw(robot, logs, currents)
+        model = result.robot  # the currents its validation kept
+        currents = _predicted_currents(model, logs) if logs.every("current") else None
+        draw = _standing_draw(model, logs, currents)
         robot = dataclasses.replace(robot, standby_power=max(draw.power, 0.0))
         sources["supply"] = Source(
             "identified",
