@@ -310,9 +310,9 @@ def _manifest(folder: Path) -> str:
 
 
 def _foreign(folder: Path) -> Path | None:
-    """A file in ``folder`` that kinergy did not write there or that changed since (None: there
-    is none, the folder is kinergy's to replace). Without a marker listing its files, every file
-    is foreign."""
+    """A file in ``folder`` that kinergy did not write there or that changed since, or a folder
+    in it holding none of kinergy's files (None: there is none, the folder is kinergy's to
+    replace). Without a marker listing its files, every file and folder is foreign."""
     written: dict[str, str] = {}
     marker = folder / MARKER
     if marker.is_file() and not marker.is_symlink():
@@ -325,13 +325,20 @@ def _foreign(folder: Path) -> Path | None:
         rel = f.relative_to(folder).as_posix()
         if f.is_symlink() or not f.is_file() or written.get(rel) != _sha256(f):
             return f
+    for d in sorted(p for p in folder.rglob("*") if p.is_dir()):
+        # a folder of the user's, even an empty one (a folder named report.html), or a link to
+        # one: kinergy's own folders hold the files it wrote
+        rel = d.relative_to(folder).as_posix() + "/"
+        if d.is_symlink() or not any(name.startswith(rel) for name in written):
+            return d
     return None
 
 
 def check_folder(path: PathLike) -> Path:
     """``path`` as a folder of outputs (:func:`atomic_folder`): refused, before any work, when it
     is a file or a link, or a folder holding a file kinergy did not write there (or changed since:
-    the marker lists what it wrote, by SHA-256); an empty folder is taken.
+    the marker lists what it wrote, by SHA-256) or a folder of the user's (an empty one too); an
+    empty folder is taken.
 
     Returns the path. Raises KinergyError, one line naming it.
     """
@@ -341,10 +348,11 @@ def check_folder(path: PathLike) -> Path:
     if target.is_dir():
         other = _foreign(target)
         if other is not None:
+            kind = " (a folder)" if other.is_dir() else ""
             raise KinergyError(
-                f"{target}: holds {other.relative_to(target)}, which kinergy did not write there "
-                "(or which changed since): replacing the folder would delete it; give an empty "
-                "or new folder"
+                f"{target}: holds {other.relative_to(target)}{kind}, which kinergy did not write "
+                "there (or which changed since): replacing the folder would delete it; give an "
+                "empty or new folder"
             )
     if target.parent.exists() and not target.parent.is_dir():
         raise KinergyError(f"{target}: {target.parent} is not a folder")
