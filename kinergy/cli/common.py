@@ -18,6 +18,7 @@ import numpy as np
 from rich.console import Console
 from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElapsedColumn
 
+from kinergy._version import __version__
 from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_outputs, check_replaceable
@@ -452,8 +453,6 @@ def json_result(result: Any, inputs: InputLogs | None = None) -> str:
     ``kinergy`` (``version``, ``command``, the command's ``options`` as given) and ``inputs``
     (every input file by content: ``path``, ``sha256``, ``size``; a log also ``rows`` and its
     ``checks``, from ``inputs``). A result that is a list is printed as it is."""
-    from kinergy import __version__
-
     out = to_jsonable(result)
     if not isinstance(out, dict):  # a list (robot list): nothing to record beside it
         return dumps(out)

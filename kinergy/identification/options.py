@@ -12,6 +12,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
+from kinergy import checks
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import MODELS
 
@@ -134,8 +135,7 @@ class IdentifyOptions:
 
     def __post_init__(self) -> None:
         _check_friction(self.friction)
-        if not 0.0 <= self.ridge < float("inf"):
-            raise KinergyError(f"--ridge must be >= 0 and finite, got {self.ridge}")
+        object.__setattr__(self, "ridge", checks.number(self.ridge, "--ridge", ge=0.0))
 
 
 #: the nursing doc's low-pass cutoff for the motor currents, Hz
