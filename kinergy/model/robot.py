@@ -14,7 +14,6 @@ Units are SI throughout (m, rad, kg, kg m^2, N m, A). Inertia 6-vectors are
 from __future__ import annotations
 
 import dataclasses
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -104,23 +103,6 @@ MAGNITUDES = {
 def _vector(value: Any, length: int, what: str) -> Array:
     """``length`` finite numbers no larger than :data:`MAGNITUDES` allows for ``what``."""
     return checks.vector(value, what, length=length, size=MAGNITUDES.get(what))
-
-
-#: control characters a name may not hold (a terminal would act on them: colours, bells, a
-#: cursor sent elsewhere); a description may hold line breaks and tabs
-_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
-_CONTROL_IN_TEXT = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
-
-
-def _plain(text: str, what: str, pattern: re.Pattern[str] = _CONTROL) -> None:
-    """Refuse ``text`` when it holds control characters, naming them (escaped) and ``what``."""
-    found = sorted(set(pattern.findall(text)))
-    if found:
-        shown = ", ".join(repr(c)[1:-1] for c in found)
-        raise KinergyError(
-            f"{what} '{text.encode('unicode_escape').decode('ascii')}' holds control characters "
-            f"({shown}), which every result would print to the terminal; give it in plain text"
-        )
 
 
 def _number(value: Any, what: str, *, low: float | None = None, strict: bool = True) -> float:
@@ -382,7 +364,7 @@ class Joint:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise KinergyError(f"joint name must be a non-empty string, got {self.name!r}")
-        _plain(self.name, "joint name")
+        checks.plain_text(self.name, "joint name")
         for name in ("d", "a", "alpha", "offset"):
             object.__setattr__(self, name, _number(getattr(self, name), name))
 
@@ -499,9 +481,9 @@ class Robot:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise KinergyError(f"robot name must be a non-empty string, got {self.name!r}")
-        _plain(self.name, "robot name")
+        checks.plain_text(self.name, "robot name")
         if isinstance(self.description, str):
-            _plain(self.description, "robot description", _CONTROL_IN_TEXT)
+            checks.plain_text(self.description, "robot description", breaks=True)
         if self.convention not in CONVENTIONS:
             raise KinergyError(
                 f"convention must be one of {', '.join(CONVENTIONS)}, got {self.convention!r}"
