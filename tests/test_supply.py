@@ -186,3 +186,39 @@ def test_the_report_shows_the_supply_plot(exact_log: Path, tmp_path: Path) -> No
     assert figure.read_bytes()[:4] == b"\x89PNG"
     html = (out / "report.html").read_text(encoding="utf-8")
     assert "figures/a-csv_supply.png" in html and "power drawn from the arm&#39;s supply" in html
+
+
+@pytest.mark.parametrize("fmt", ["csv", "parquet"])
+def test_a_traces_memory_does_not_grow_with_the_log(
+    ur5e: kinergy.Robot, tmp_path: Path, fmt: str
+) -> None:
+    """Chunk after chunk, the writer and a plot's series hold what one chunk needs: the peak of
+    numpy's and Python's memory (tracemalloc) and of Arrow's pool over 200 chunks of 5,000 rows
+    (1,000,000 samples) is that of 20 chunks."""
+    import tracemalloc
+
+    import pyarrow as pa
+
+    rng = np.random.default_rng(0)
+    rows = 5_000
+    chunk = [rng.standard_normal(rows) for _ in range(2)], rng.standard_normal((rows, 6))
+
+    def peak(chunks: int) -> tuple[int, int]:
+        arrow = 0
+        tracemalloc.start()
+        with (tmp_path / f"t{chunks}.{fmt}").open("wb") as fh:
+            writer, series = TraceWriter(fh, ur5e, fmt), PowerSeries(limit=2_000)
+            for k in range(chunks):
+                t = np.arange(k * rows, (k + 1) * rows) * 0.002
+                for sink in (writer, series):
+                    sink.add(t, chunk[0][0], chunk[0][1], chunk[1])
+                arrow = max(arrow, pa.total_allocated_bytes())
+            writer.close()
+        _, top = tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+        return top, arrow
+
+    short, long = peak(20), peak(200)
+    assert long[0] < 1.2 * short[0] + 1_000_000
+    assert long[1] < 1.2 * short[1] + 1_000_000
+    assert (tmp_path / f"t200.{fmt}").stat().st_size > 5 * (tmp_path / f"t20.{fmt}").stat().st_size

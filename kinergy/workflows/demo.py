@@ -26,6 +26,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from kinergy.drives.electrics import back_emf_constants, winding_resistances
 from kinergy.files import output_folder
 from kinergy.friction.model import SMOOTHING
 from kinergy.identification.metrics import fit_metrics
@@ -104,8 +105,8 @@ def truth_tables(truth: Robot, model: Robot, held_out: IdentData) -> list[Table]
         electrics.append(
             [
                 mj.name,
-                _pct(m.winding_resistance or float("nan"), t.winding_resistance or float("nan")),
-                _pct(m.torque_constant / m.kt_over_kb, t.torque_constant / t.kt_over_kb),
+                _pct(float(winding_resistances(model)[j]), float(winding_resistances(truth)[j])),
+                _pct(float(back_emf_constants(model)[j]), float(back_emf_constants(truth)[j])),
             ]
         )
     headers = [
