@@ -228,12 +228,13 @@ def _drive_table(truth: Robot, result: IdentificationResult, data: IdentData) ->
         errs = [
             _pct(idd.torque_constant, td.torque_constant),
             _pct(idd.rotor_inertia, td.rotor_inertia),
-            _pct(idd.winding_resistance or np.nan, td.winding_resistance or np.nan),
-            _pct(idd.torque_constant / idd.kt_over_kb, td.torque_constant / td.kt_over_kb),
+            _pct(winding_resistances(ident)[j], winding_resistances(truth)[j]),
+            _pct(back_emf_constants(ident)[j], back_emf_constants(truth)[j]),
         ]
         tf, f = t_state.tau_friction[:, j], i_state.tau_friction[:, j]
         errs.append(100.0 * np.sqrt(np.mean((f - tf) ** 2) / np.mean(tf**2)))
-        worst = max(worst, *(abs(e) for e in errs))
+        # R and k_b are the model's (not identified): left out of the worst identified error
+        worst = max(worst, *(abs(e) for k, e in enumerate(errs) if k not in (2, 3)))
         notes = [
             _in_std(errs[0], idd.torque_constant, std.get("torque_constant")),
             _in_std(errs[1], idd.rotor_inertia, std.get("rotor_inertia")),
