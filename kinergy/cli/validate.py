@@ -17,6 +17,7 @@ from kinergy.cli.common import (
     load,
     log_reading,
     payload_option,
+    prose,
     repair_option,
     table,
     tell,
@@ -34,7 +35,7 @@ from kinergy.identification.validation import (
 )
 from kinergy.workflows.validate import validate_logs
 
-__all__ = ["report_text", "validate", "validation_text"]
+__all__ = ["report_text", "supply_text", "validate", "validation_text"]
 
 
 def _r2(m: JointMetrics) -> str:
@@ -97,8 +98,22 @@ def _per_log_text(report: ValidationReport, names: Sequence[str]) -> str:
     return "\n".join(parts).rstrip()
 
 
+def supply_text(report: ValidationReport) -> str:
+    """The supply's power and energy, predicted against measured ('' where no log measures it)."""
+    s = report.supply
+    if s is None:
+        return ""
+    return (
+        f"Supply power against actual_robot_voltage x actual_robot_current ({s.samples} samples):"
+        f" RMSE {s.rms:.2f} W, R^2 {s.r2:.4f}, mean error {s.mean:+.2f} W; energy predicted "
+        f"{s.predicted:.1f} J against {s.measured:.1f} J measured ({s.error:+.1f} %). Predicted: "
+        "the motors summed on the DC bus plus the model's standing draw."
+    )
+
+
 def report_text(report: ValidationReport, names: Sequence[str]) -> str:
-    """``validate``'s text: pooled tables, the moving and holding segments, and each log."""
+    """``validate``'s text: pooled tables, the supply, the moving and holding segments, and
+    each log."""
     text = validation_text(report, names)
     if not text:
         return "the logs have neither target_moment nor actual_current nor measured torques"
@@ -107,6 +122,8 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
         f"below {HOLD_SPEED} rad/s for {HOLD_SECONDS} s or more)\n",
         text,
     ]
+    if supply := supply_text(report):
+        lines += ["", prose(supply)]
     for label, part in (("moving", report.moving), ("holding", report.holding)):
         if part is not None and report.moving is not None and report.holding is not None:
             lines += [f"\n--- {label} samples only ---", validation_text(part, names)]

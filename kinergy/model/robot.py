@@ -424,6 +424,7 @@ class Joint:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise KinergyError(f"joint name must be a non-empty string, got {self.name!r}")
+        checks.plain_text(self.name, "joint name")
         for name in ("d", "a", "alpha", "offset"):
             object.__setattr__(self, name, _number(getattr(self, name), name))
 
@@ -544,6 +545,9 @@ class Robot:
         object.__setattr__(
             self, "convention", checks.choice(self.convention, Convention, "convention")
         )
+        checks.plain_text(self.name, "robot name")
+        if isinstance(self.description, str):
+            checks.plain_text(self.description, "robot description", breaks=True)
         joints = tuple(self.joints)
         if not joints:
             raise KinergyError("a robot needs at least one joint")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -12,7 +13,16 @@ import numpy as np
 from kinergy import checks
 from kinergy.accounting.energy import EnergyAccumulator, EnergyReport, energy
 from kinergy.accounting.figures import EnergyFigures
+from kinergy.accounting.supply import standing_draw_notes
+from kinergy.accounting.trace import (
+    PowerSeries,
+    PowerSink,
+    TraceWriter,
+    supply_predicted,
+    trace_format,
+)
 from kinergy.arrays import Array
+from kinergy.files import atomic_open
 from kinergy.io.log import Log
 from kinergy.io.motion import iter_motion, motion_from_log
 from kinergy.io.urscript_reader import read_program
@@ -31,6 +41,7 @@ __all__ = [
     "ENERGY_ROWS",
     "LogEnergy",
     "energy_of_log",
+    "energy_with_outputs",
     "log_energy_report",
     "program_energy",
     "unused_payload",
@@ -200,6 +211,7 @@ def energy_of_log(
     source: MotionSource | str = MotionSource.AUTO,
     recovery: bool = True,
     rows: int = ENERGY_ROWS,
+    sinks: Sequence[PowerSink] = (),
 ) -> LogEnergy:
     """The energy of the motion in a log or motion file and what the log was (what ``kinergy
     energy`` prints: :class:`LogEnergy`): the log read in one
@@ -211,10 +223,13 @@ def energy_of_log(
     measured, ``actual_robot_voltage`` x ``actual_robot_current``, beside the predicted one);
     memory bounded by the chunk. Segments (a time gap or a ``segment`` change) are never
     integrated across. A URScript program (``*.script``) is run as the controller would, with
-    the loads it sets (:func:`program_energy`)."""
+    the loads it sets (:func:`program_energy`). Each of ``sinks`` gets the power of every chunk
+    (:class:`~kinergy.accounting.trace.PowerSink`: the supply's, predicted and measured, and each
+    motor's)."""
     inputs = InputLogs()
     reading = reading or LogReading()
     robot = reading.loaded(robot)
+    inputs.notes.extend(standing_draw_notes(robot))
     if is_builtin(path) or os.fspath(path).endswith(".script"):
         if is_builtin(path):  # test-a, test-b: the motion as planned for the robot
             motion = paper_trajectory(robot, os.fspath(path))
@@ -222,6 +237,8 @@ def energy_of_log(
             report = energy(robot, motion, recovery=recovery)
         else:
             report = program_energy(robot, path, recovery=recovery)
+        for sink in sinks:
+            sink.add(report.t, supply_predicted(robot, report.drive), None, report.drive.power)
         said = _beyond_limits(robot, np.abs(report.drive.tau_sim).max(axis=0))
         if not is_builtin(path):
             said += unused_payload(robot, path)
@@ -238,6 +255,8 @@ def energy_of_log(
         power = _measured_power(part.log)
         measured = power is not None
         acc.add(m.t, state, starts=part.starts, measured_power=power)
+        for sink in sinks:
+            sink.add(m.t, supply_predicted(robot, state), power, state.power)
         if len(m.t):
             peak = np.maximum(peak, np.abs(state.tau_sim).max(axis=0))
     inputs.add(log)
@@ -264,3 +283,51 @@ def log_energy_report(
     inputs.add(checked)
     motion = motion_from_log(log, n_joints=robot.n, source=source)
     return energy(robot, motion, state=_drive(robot, log, motion)), inputs
+
+
+def energy_with_outputs(
+    robot: Robot,
+    path: str | os.PathLike[str],
+    reading: LogReading | None = None,
+    *,
+    source: str = "auto",
+    recovery: bool = True,
+    trace: str | os.PathLike[str] | None = None,
+    plot: str | os.PathLike[str] | None = None,
+) -> LogEnergy:
+    """:func:`energy_of_log`, writing the power trace to ``trace`` (CSV or Parquet by its
+    extension, :mod:`kinergy.accounting.trace`; streamed chunk by chunk, whole or not at all)
+    and the plot of the supply's power, predicted against measured, to ``plot`` (PNG,
+    :func:`kinergy.report.plots.supply_power`), each when given.
+
+    Raises
+    ------
+    KinergyError
+        A trace file that is neither ``.csv`` nor ``.parquet`` (before any work), and whatever
+        :func:`energy_of_log` raises; nothing is written then.
+    """
+    fmt = trace_format(trace) if trace is not None else None
+    series = PowerSeries() if plot is not None else None
+    with contextlib.ExitStack() as stack:
+        sinks: list[PowerSink] = [] if series is None else [series]
+        writer = None
+        if trace is not None and fmt is not None:
+            writer = TraceWriter(stack.enter_context(atomic_open(trace, binary=True)), robot, fmt)
+            sinks.append(writer)
+        result = energy_of_log(robot, path, reading, source=source, recovery=recovery, sinks=sinks)
+        if writer is not None:
+            writer.close()
+    if plot is not None and series is not None:
+        from kinergy.report.plots import save, supply_power  # matplotlib: only for a plot
+
+        measured = result.measured
+        figure = supply_power(
+            series.t,
+            series.predicted,
+            energy=result.supply.drawn,
+            measured=series.measured,
+            measured_energy=None if measured is None else measured.drawn,
+            standing=robot.standby_power,
+        )
+        save(figure, plot)
+    return result

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from kinergy._version import __version__
 from kinergy.accounting.energy import EnergyReport, energy
+from kinergy.accounting.trace import PowerSeries, SupplyTrace
 from kinergy.files import output_folder
 from kinergy.identification.chunks import Segment
 from kinergy.identification.result import IdentificationResult
@@ -22,10 +23,11 @@ from kinergy.model.robot import Robot
 from kinergy.report.html import Section, Table, write_report
 from kinergy.report.study import Comparison, Study, Timing, study_sections
 from kinergy.trajectory.motion import Motion
-from kinergy.workflows.energy import log_energy_report, program_energy
+from kinergy.workflows.energy import energy_of_log, log_energy_report, program_energy
 from kinergy.workflows.identify import identify_logs as identified
 from kinergy.workflows.logs import chunked_logs
 from kinergy.workflows.optimize import optimize_task
+from kinergy.workflows.twin import is_builtin
 
 __all__ = ["optimal_timing", "run_study", "study_report", "write_study"]
 
@@ -67,6 +69,7 @@ def run_study(
     paper: bool = False,
     task: Task | None = None,
     progress: Progress | None = None,
+    supply: Mapping[str, SupplyTrace] | None = None,
 ) -> Study:
     """Compute everything a study report shows (:class:`kinergy.report.study.Study`).
 
@@ -83,6 +86,8 @@ def run_study(
         See :class:`~kinergy.report.study.Study`.
     task : Task, optional
         A movej program whose energy-optimal timing and Pareto front the report shows.
+    supply : mapping of str to SupplyTrace, optional
+        Per log name, the supply's power to plot (:func:`supply_trace`).
     """
     say = progress or (lambda _msg: None)
     torque, current = _comparisons(model, validation or {}, say)
@@ -94,7 +99,7 @@ def run_study(
     if task is not None:
         say(f"optimising the timing of {task.name}")
         timing = optimal_timing(model, task)
-    return Study(model, result, truth, paper, torque, current, reports, timing)
+    return Study(model, result, truth, paper, torque, current, reports, timing, supply or {})
 
 
 def write_study(
@@ -117,6 +122,22 @@ def write_study(
         meta={**meta, "kinergy": __version__, "date": time.strftime("%Y-%m-%d %H:%M")},
     )
     return Path(path), tables
+
+
+def supply_trace(robot: Robot, path: str, reading: LogReading) -> SupplyTrace:
+    """The supply's power over the log at ``path`` for a plot, predicted and (where the log has
+    ``actual_robot_voltage`` and ``actual_robot_current``) measured, with their energies: one
+    more pass over the log (:func:`~kinergy.workflows.energy.energy_of_log`), memory bounded."""
+    series = PowerSeries()
+    figures = energy_of_log(robot, path, reading, sinks=[series])
+    return SupplyTrace(
+        series.t,
+        series.predicted,
+        series.measured,
+        figures.supply.drawn,
+        None if figures.measured is None else figures.measured.drawn,
+        robot.standby_power,
+    )
 
 
 def study_report(
@@ -150,6 +171,7 @@ def study_report(
         robot = result.robot
     robot = reading.loaded(robot)  # --payload: of every log and motion
     motions: dict[str, Motion | EnergyReport] = {}
+    supply: dict[str, SupplyTrace] = {}
     for p in energy_logs:
         if p.endswith(".script"):  # run with the loads it sets
             motions[Path(p).name] = program_energy(robot, p)
@@ -158,12 +180,19 @@ def study_report(
         said.notes += inputs.notes
         said.warnings += inputs.warnings
         motions[Path(p).name] = report
+        if not is_builtin(p):
+            supply[Path(p).name] = supply_trace(robot, p, reading)
     with chunked_logs(validate_logs, robot, reading) as (segments, inputs):
         said.notes += inputs.notes
         said.warnings += inputs.warnings
         validation = {Path(s.path).name: s for s in segments}
         study = run_study(
-            robot, validation=validation, motions=motions, result=result, progress=progress
+            robot,
+            validation=validation,
+            motions=motions,
+            result=result,
+            progress=progress,
+            supply=supply,
         )
     with output_folder(out, prefix="kinergy-report") as (folder, target):
         _, tables = write_study(
