@@ -18,6 +18,11 @@ with its checks), ``notes`` and ``warnings``.
 ``optimize_program(model, prog)``  ``kinergy optimize``: a URScript program's or a task's
                                     energy-optimal version at the same cycle time
 =================================  ==========================================================
+
+Every function that reads a log takes ``payload`` (a :class:`~kinergy.model.robot.Payload` or
+``--payload``'s text: it replaces the payload the log's controller logged, which is used
+otherwise, and the model's) and ``start``, ``stop`` (``--from``, ``--to``: seconds on the log's
+own time axis).
 """
 
 from __future__ import annotations
@@ -31,17 +36,19 @@ from kinergy.accounting.energy import EnergyReport
 from kinergy.accounting.energy import energy as _energy_of_motion
 from kinergy.errors import KinergyError
 from kinergy.files import check_replaceable
-from kinergy.identification.options import IdentifyOptions, Method, Solver, Target
+from kinergy.identification.options import IdentifyOptions, Method, Solver, Target, friction_option
 from kinergy.identification.result import IdentificationResult
 from kinergy.identification.validation import ValidationReport
-from kinergy.io.columns import parse_columns
+from kinergy.io.columns import ColumnMap, parse_column_spec
 from kinergy.io.formats import read_log as _read_file
 from kinergy.io.log import Log
 from kinergy.io.rosbag import bag_options
 from kinergy.logs.checks import parse_accept
 from kinergy.logs.reading import CheckedLog, LogReading
+from kinergy.logs.window import TimeWindow
 from kinergy.model.library import load_robot
-from kinergy.model.robot import Robot
+from kinergy.model.robot import Payload, Robot
+from kinergy.model.toml import parse_payload
 from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import TEST_TRAJECTORIES, paper_trajectory
@@ -85,22 +92,33 @@ def _choice(kind: type[E], value: str, name: str) -> E:
 
 def _reading(
     robot: Robot,
-    columns: str | Sequence[str] | None,
+    columns: str | ColumnMap | Sequence[str] | None,
     repair: bool,
     cutoff: float | None,
     accept: str | Sequence[str],
     topic: str | None,
     effort: str | None,
+    payload: str | Payload | None = None,
+    window: tuple[float | None, float | None] = (None, None),
 ) -> LogReading:
-    """The reading options of the commands, parsed as the command line parses them."""
-    names = parse_columns(columns, robot.n) if isinstance(columns, str) else columns
+    """The reading options of the commands, parsed as the command line parses them
+    (``payload`` as ``--payload``, ``window`` as ``--from``, ``--to``)."""
+    if isinstance(columns, str):
+        columns = parse_column_spec(columns, robot.n)
     return LogReading(
-        columns=None if names is None else tuple(names),
+        columns=columns if columns is None or isinstance(columns, ColumnMap) else tuple(columns),
         repair=repair,
         cutoff=cutoff,
         accept=parse_accept([accept] if isinstance(accept, str) else accept),
         bag=bag_options(topic, effort),
+        payload=None if payload is None else _payload(payload),
+        window=None if window == (None, None) else TimeWindow(*window),
     )
+
+
+def _payload(payload: str | Payload) -> Payload:
+    """``payload`` as ``--payload`` takes it (text ``MASS[,CX,CY,CZ[,...]]``) or as it is."""
+    return parse_payload(payload) if isinstance(payload, str) else payload
 
 
 def read_log(
@@ -112,6 +130,9 @@ def read_log(
     accept: str | Sequence[str] = (),
     topic: str | None = None,
     effort: str | None = None,
+    payload: str | Payload | None = None,
+    start: float | None = None,
+    stop: float | None = None,
 ) -> Log:
     """A log read whole: UR's record.py layout, a headerless file with ``columns`` (a column
     spec ``"timestamp,actual_q:6,..."``), a ROS 2 bag, the panda-gaz layout.
@@ -129,7 +150,9 @@ def read_log(
     if robot is None:
         return _read_file(path, columns=columns, repair=repair)
     r = _robot(robot)
-    return CheckedLog(path, r, _reading(r, columns, repair, None, accept, topic, effort)).read()
+    return CheckedLog(
+        path, r, _reading(r, columns, repair, None, accept, topic, effort, payload, (start, stop))
+    ).read()
 
 
 def identify(
@@ -147,6 +170,9 @@ def identify(
     accept: str | Sequence[str] = (),
     topic: str | None = None,
     effort: str | None = None,
+    payload: str | Payload | None = None,
+    start: float | None = None,
+    stop: float | None = None,
     out: PathLike | None = None,
 ) -> IdentificationResult:
     """``kinergy identify``: a model identified from ``logs`` (files or logs in memory) starting
@@ -164,12 +190,12 @@ def identify(
     r = _robot(robot)
     options = IdentifyOptions(
         method=_choice(Method, method, "method"),
-        friction=friction,
+        friction=friction_option(friction, "friction"),
         target=_choice(Target, target, "target"),
         solver=_choice(Solver, solver, "solver"),
         ridge=ridge,
     )
-    reading = _reading(r, columns, repair, cutoff, accept, topic, effort)
+    reading = _reading(r, columns, repair, cutoff, accept, topic, effort, payload, (start, stop))
     if out is not None:
         check_replaceable(out)
     return identify_logs(r, list(logs), out, reading=reading, options=options)
@@ -186,6 +212,9 @@ def identify_payload(
     accept: str | Sequence[str] = (),
     topic: str | None = None,
     effort: str | None = None,
+    payload: str | Payload | None = None,
+    start: float | None = None,
+    stop: float | None = None,
 ) -> PayloadRun:
     """``kinergy identify --payload-only``: the payload ``robot`` (the model without it)
     carried in ``logs``, with standard errors, written to ``out`` as the robot carrying it.
@@ -197,7 +226,7 @@ def identify_payload(
     """
     r = _robot(robot)
     check_replaceable(out)
-    reading = _reading(r, columns, repair, cutoff, accept, topic, effort)
+    reading = _reading(r, columns, repair, cutoff, accept, topic, effort, payload, (start, stop))
     return identify_payload_model(r, list(logs), out, reading)
 
 
@@ -211,6 +240,9 @@ def validate(
     accept: str | Sequence[str] = (),
     topic: str | None = None,
     effort: str | None = None,
+    payload: str | Payload | None = None,
+    start: float | None = None,
+    stop: float | None = None,
     plots: PathLike | None = None,
 ) -> ValidationReport:
     """``kinergy validate``: how well ``model`` predicts ``logs`` (UR5e Tables V and VII,
@@ -218,7 +250,7 @@ def validate(
     a warning. ``logs`` may name the built-in motions ``"test-a"``, ``"test-b"`` (the realistic
     twin of the model running them)."""
     r = _robot(model)
-    reading = _reading(r, columns, repair, cutoff, accept, topic, effort)
+    reading = _reading(r, columns, repair, cutoff, accept, topic, effort, payload, (start, stop))
     return validate_logs(r, list(logs), reading, plots=plots)
 
 
@@ -234,6 +266,9 @@ def energy(
     temperature: Any = None,
     topic: str | None = None,
     effort: str | None = None,
+    payload: str | Payload | None = None,
+    start: float | None = None,
+    stop: float | None = None,
 ) -> EnergyReport | LogEnergy:
     """``kinergy energy``: per-joint and total mechanical and electrical energy, what the arm
     draws from its supply, and where the energy goes.
@@ -245,8 +280,9 @@ def energy(
     """
     r = _robot(model)
     if isinstance(log_or_motion, Motion):
-        return _energy_of_motion(r, log_or_motion, recovery=recovery, temperature=temperature)
-    reading = _reading(r, columns, repair, None, accept, topic, effort)
+        loaded = r if payload is None else r.with_payload(_payload(payload))
+        return _energy_of_motion(loaded, log_or_motion, recovery=recovery, temperature=temperature)
+    reading = _reading(r, columns, repair, None, accept, topic, effort, payload, (start, stop))
     return energy_of_log(r, log_or_motion, reading, source=source, recovery=recovery)
 
 

@@ -17,10 +17,11 @@ Energy accounting, validation, the twin and the optimiser all predict through
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, fields
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from kinergy.arrays import Array
 from kinergy.drives.electrics import (
@@ -33,9 +34,9 @@ from kinergy.drives.electrics import (
 from kinergy.drives.transmission import reflected_inertia, transmission_matrix
 from kinergy.dynamics.chain import check_state
 from kinergy.dynamics.rnea import gravity_torque, rnea
-from kinergy.model.robot import Robot
+from kinergy.model.robot import Payload, Robot
 
-__all__ = ["DriveState", "drive_state"]
+__all__ = ["DriveState", "drive_by_payload", "drive_state", "payload_robots"]
 
 
 @dataclass(frozen=True)
@@ -137,3 +138,53 @@ def drive_state(
         voltage=voltage,
         power=power,
     )
+
+
+def drive_by_payload(
+    robots: Sequence[Robot],
+    load: NDArray[np.intp],
+    q: Array,
+    qd: Array,
+    qdd: Array,
+    *,
+    temperature: Array | None = None,
+) -> DriveState:
+    """:func:`drive_state` at samples that carry different loads (a program's ``set_payload``, a
+    log's ``payload`` column).
+
+    Parameters
+    ----------
+    robots : sequence of Robot
+        The robot carrying each load (:func:`payload_robots`; built once by whoever evaluates
+        many motions with the same loads, as the optimiser does).
+    load : ndarray of int, shape (N,)
+        Index into ``robots`` of each sample's load.
+    q, qd, qdd : ndarray, shape (N, n)
+    temperature : ndarray, shape (N, n), optional
+        As :func:`drive_state`'s.
+
+    Returns
+    -------
+    DriveState
+        Arrays of shape (N, n), each sample computed with its load.
+    """
+    used = np.unique(load)
+    if used.size == 1:
+        return drive_state(robots[int(used[0])], q, qd, qdd, temperature=temperature)
+    parts = {}
+    for i in used:
+        m = load == i
+        temp = None if temperature is None else temperature[m]
+        parts[int(i)] = drive_state(robots[int(i)], q[m], qd[m], qdd[m], temperature=temp)
+    out = {}
+    for f in fields(DriveState):
+        arr = np.zeros(np.shape(q))
+        for i, state in parts.items():
+            arr[load == i] = getattr(state, f.name)
+        out[f.name] = arr
+    return DriveState(**out)
+
+
+def payload_robots(robot: Robot, payloads: Sequence[Payload | None]) -> tuple[Robot, ...]:
+    """``robot`` carrying each of ``payloads`` (``None``: nothing at the flange), in order."""
+    return tuple(robot if p is robot.payload else robot.with_payload(p) for p in payloads)

@@ -12,11 +12,12 @@ motion is sampled (the controller's 500 Hz), the RTDE signals the UR5e doc works
   measured angle and speed carry encoder noise;
 - ``actual_current``: UR5e eq 17 on the *real* motion (friction included, at the joints'
   temperatures) plus current noise, quantised to the controller's current step;
-- ``actual_joint_voltage``: UR5e eq 19 as the controller logs it (dq voltage, 2/3 of the
-  equivalent DC motor's, :mod:`kinergy.drives.electrics`), plus noise;
 - ``actual_robot_voltage`` and ``actual_robot_current``: the arm's supply, the DC bus voltage
   (with ripple) and the current it draws for the bus model's power (:mod:`kinergy.drives.bus`:
-  motors summed on the bus, surplus braking power to the shunt, plus standby);
+  motors summed on the bus, surplus braking power to the shunt, plus the standing draw);
+- ``actual_joint_voltage``: each joint's supply as a UR controller logs it, the bus voltage at
+  the joint (the supply's less the arm's cable drop,
+  :func:`kinergy.drives.bus.joint_bus_voltage`), plus noise; not the motor's voltage;
 - ``joint_temperatures``: each joint warmed by its losses and its share of the arm's standby
   power (:mod:`kinergy.drives.thermal`), when the true robot has thermal models;
   temperature-dependent friction follows them;
@@ -34,29 +35,39 @@ The UR5e doc's test programs A and B that the twin usually runs are in
 from __future__ import annotations
 
 import dataclasses
+import enum
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from kinergy import checks
 from kinergy.arrays import Array
-from kinergy.drives.bus import supply_power
-from kinergy.drives.electrics import controller_voltage, winding_resistances
+from kinergy.drives.bus import joint_bus_voltage, supply_power
+from kinergy.drives.electrics import winding_resistances
 from kinergy.drives.thermal import joint_losses, joint_temperatures
 from kinergy.errors import KinergyError
+from kinergy.friction.load_thermal_power_law import MODEL as LOAD_THERMAL_POWER_LAW
 from kinergy.friction.model import SMOOTHING
 from kinergy.friction.power_law import speed_power
-from kinergy.friction.registry import friction_torque
 from kinergy.io.log import Log
 from kinergy.model.robot import Friction, Joint, Robot, Source, Thermal
 from kinergy.predict import DriveState, drive_state
 from kinergy.trajectory.motion import Motion
 
-__all__ = ["MISMATCHES", "TwinSettings", "realistic_truth", "simulate"]
+__all__ = ["MISMATCHES", "Mismatch", "TwinSettings", "realistic_truth", "simulate"]
 
 
-#: what ``--mismatch`` takes: the model itself is the truth, or a realistic true robot
-MISMATCHES = ("none", "realistic")
+class Mismatch(enum.StrEnum):
+    """How the twin's true robot differs from the model it simulates (``--mismatch``): not at all
+    (the model is the truth) or as a real arm does (:func:`realistic_truth`)."""
+
+    NONE = "none"
+    REALISTIC = "realistic"
+
+
+#: what ``--mismatch`` takes, as text
+MISMATCHES = tuple(m.value for m in Mismatch)
 
 
 @dataclass(frozen=True)
@@ -108,9 +119,7 @@ class TwinSettings:
             "voltage_noise",
             "ripple",
         ):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0.0):
-                raise KinergyError(f"{name} must be >= 0, got {value}")
+            object.__setattr__(self, name, checks.number(getattr(self, name), name, ge=0.0))
 
     @classmethod
     def exact(cls) -> TwinSettings:
@@ -217,9 +226,9 @@ def simulate(
     current = actual.current + settings.current_noise * rng.standard_normal((big_n, n))
     actual_q = real.q + settings.position_noise * rng.standard_normal((big_n, n))
     actual_qd = real.qd + settings.speed_noise * rng.standard_normal((big_n, n))
-    joint_voltage = controller_voltage(actual.voltage)
-    joint_voltage = joint_voltage + settings.voltage_noise * rng.standard_normal((big_n, n))
+    voltage_noise = settings.voltage_noise * rng.standard_normal((big_n, n))
     bus_voltage, bus_current = _supply(robot, actual, target.t, settings, rng)
+    joint_voltage = joint_bus_voltage(bus_voltage, bus_current, n) + voltage_noise
     signals = {
         "target_q": target.q,
         "actual_q": actual_q,
@@ -258,20 +267,18 @@ def _true_friction(joint: Joint, rng: np.random.Generator, scale: float) -> Fric
     term falling 18 % over 20 K."""
     drive = joint.drive
     wm = np.abs(drive.gear_ratio) * np.concatenate([[1e-3], _MATCH_SPEEDS])
-    model, params = drive.friction.model, dict(drive.friction.params)
+    params = dict(drive.friction.params)
     params.pop("standstill", None)
     params.pop("holding", None)
-    level = 0.5 * (
-        friction_torque(model, params, wm, np.ones_like(wm))
-        + friction_torque(model, params, wm, -np.ones_like(wm))
-    )
+    moving = Friction(drive.friction.model, params)  # without the standstill hold
+    level = 0.5 * (moving.torque(wm, np.ones_like(wm)) + moving.torque(wm, -np.ones_like(wm)))
     exponent = float(rng.uniform(0.5, 0.65))
     coulomb = max(float(level[0]), 1e-4)
     speed = speed_power(wm[1:], exponent)
     viscous = max(float(speed @ (level[1:] - coulomb) / (speed @ speed)), 1e-6)
     viscous *= 1.0 + scale * rng.uniform(-1, 1)
     return Friction(
-        "load_thermal_power_law",
+        LOAD_THERMAL_POWER_LAW,
         {
             "coulomb": coulomb * (1.0 + scale * rng.uniform(-1, 1)),
             "load": float(rng.uniform(0.01, 0.03)),

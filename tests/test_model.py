@@ -90,7 +90,7 @@ def test_table_iii_link5_izz_as_printed_is_rejected() -> None:
         ([0.01, 0.01, -0.01, 0, 0, 0], "positive definite"),
         ([0.01, 0.01, 0.01, 0.02, 0, 0], "positive definite"),
         ([0.001, 0.001, 0.01, 0, 0, 0], "triangle inequality"),
-        ([0.01, 0.01, 0.01], "6 numbers"),
+        ([0.01, 0.01, 0.01], "6 finite numbers"),
         ([0.01, 0.01, np.nan, 0, 0, 0], "finite"),
     ],
 )
@@ -100,7 +100,7 @@ def test_link_inertia_validation(inertia: list[float], message: str) -> None:
 
 
 def test_link_mass_must_be_positive() -> None:
-    with pytest.raises(KinergyError, match="mass must be > 0"):
+    with pytest.raises(KinergyError, match="mass: must be a finite number > 0"):
         Link(mass=0.0, com=[0, 0, 0], inertia=[0.01, 0.01, 0.01, 0, 0, 0])
 
 
@@ -113,7 +113,9 @@ def test_friction_validation() -> None:
         Friction(
             "viscous_coulomb", {"viscous": 1e-3, "coulomb": 0.1, "smoothing": 1e-3, "stiction": 1}
         )
-    with pytest.raises(KinergyError, match="'smoothing' must be > 0"):
+    with pytest.raises(
+        KinergyError, match="friction parameter 'smoothing': must be a finite number > 0, got 0"
+    ):
         Friction("viscous_coulomb", {"viscous": 1e-3, "coulomb": 0.1, "smoothing": 0.0})
 
 
@@ -121,7 +123,7 @@ def test_payload_validation_and_parsing() -> None:
     assert kinergy.model.parse_payload("2.5").mass == 2.5
     p = kinergy.model.parse_payload("2.5,0,0,0.05")
     np.testing.assert_array_equal(p.com, [0, 0, 0.05])
-    with pytest.raises(KinergyError, match="payload mass must be >= 0"):
+    with pytest.raises(KinergyError, match="payload mass: must be a finite number >= 0"):
         Payload(mass=-1.0)
     with pytest.raises(KinergyError, match="--payload"):
         kinergy.model.parse_payload("1,2")
@@ -141,7 +143,7 @@ def _ur5e_dict() -> dict:
         ),
         (
             lambda d: d["joints"][0].update(mass=-3.0),
-            r"joints\[0\] \(shoulder_pan\): mass must be > 0",
+            r"joints\[0\] \(shoulder_pan\): mass: must be a finite number > 0",
         ),
         (
             lambda d: d["joints"][1]["drive"].update(gear_ratio=0.0),
@@ -159,7 +161,7 @@ def _ur5e_dict() -> dict:
             lambda d: d["joints"][3].update(colour="blue"),
             r"joints\[3\] \(wrist_1\): unknown field\(s\) 'colour'",
         ),
-        (lambda d: d.update(convention="euler"), "convention must be one of dh, mdh"),
+        (lambda d: d.update(convention="euler"), "convention: must be one of dh, mdh, got 'euler'"),
         (
             lambda d: d["joints"][5]["limits"].update(position=[1.0, -1.0]),
             r"limits.position must be \[lower, upper\]",
@@ -172,7 +174,7 @@ def _ur5e_dict() -> dict:
             lambda d: d["sources"].update(colour={"status": "published"}),
             "unknown source categories: colour",
         ),
-        (lambda d: d["joints"][0].update(com=[0, 0]), r"com must be 3 numbers"),
+        (lambda d: d["joints"][0].update(com=[0, 0]), r"com: must be 3 finite numbers"),
     ],
 )
 def test_bad_robot_file_names_file_and_field(tmp_path: Path, edit, message: str) -> None:
@@ -299,7 +301,10 @@ def test_cli_bad_file_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[
     path.write_text(tomli_w.dumps(data))
     assert main(["robot", "show", str(path)]) == 1
     err = capsys.readouterr().err
-    assert "neg.toml: joints[1] (shoulder_lift): mass must be > 0" in err and err.count("\n") == 1
+    assert (
+        "neg.toml: joints[1] (shoulder_lift): mass: must be a finite number > 0" in err
+        and err.count("\n") == 1
+    )
 
 
 def test_saved_file_is_valid_toml_with_header(tmp_path: Path) -> None:
@@ -321,7 +326,7 @@ def _rz_ry_rx(roll: float, pitch: float, yaw: float) -> np.ndarray:
 
 
 def test_rpy_is_urdfs_fixed_axis_convention_and_round_trips() -> None:
-    from kinergy.model.toml import matrix_rpy, rpy_matrix
+    from kinergy.model.frames import matrix_rpy, rpy_matrix
 
     rng = np.random.default_rng(4)
     angles = rng.uniform(-np.pi, np.pi, (200, 3)) * np.array([1.0, 0.5, 1.0])

@@ -149,7 +149,10 @@ def test_monitor_text(ur5e_twin, capsys):
     [
         (["monitor", "127.0.0.1:1", "--model", "ur5e"], "cannot connect to 127.0.0.1:1"),
         (["monitor", "127.0.0.1:1", "--model", "no-such-robot"], "no-such-robot"),
-        (["monitor", "127.0.0.1", "--model", "ur5e", "--duration", "-1"], "--duration must be > 0"),
+        (
+            ["monitor", "127.0.0.1", "--model", "ur5e", "--duration", "-1"],
+            "--duration: must be a finite number > 0",
+        ),
     ],
 )
 def test_monitor_errors(argv, message, capsys):

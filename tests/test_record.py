@@ -188,7 +188,7 @@ def _free_port() -> int:
         (["127.0.0.1:{free}"], "cannot connect to 127.0.0.1:{free}: Connection refused"),
         (["no-such-host.invalid"], "cannot resolve host 'no-such-host.invalid'"),
         (["robot:99999"], "bad address 'robot:99999'"),
-        (["127.0.0.1:{free}", "--duration", "0"], "--duration must be > 0"),
+        (["127.0.0.1:{free}", "--duration", "0"], "--duration: must be a finite number > 0"),
         (["127.0.0.1:{free}", "--frequency", "1000"], None),
     ],
 )

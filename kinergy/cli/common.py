@@ -18,15 +18,17 @@ import numpy as np
 from rich.console import Console
 from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElapsedColumn
 
+from kinergy._version import __version__
 from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_outputs, check_replaceable
-from kinergy.io.columns import parse_columns
+from kinergy.io.columns import parse_column_spec
 from kinergy.io.formats import NOT_LOGS
 from kinergy.io.rosbag import bag_options
 from kinergy.jsonable import dumps, to_jsonable
 from kinergy.logs.checks import Check, parse_accept
 from kinergy.logs.reading import InputLogs, LogReading
+from kinergy.logs.window import TimeWindow
 from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
@@ -57,6 +59,7 @@ __all__ = [
     "tell",
     "topic_option",
     "warn",
+    "window_options",
     "writes",
 ]
 
@@ -162,16 +165,22 @@ def log_reading(
     accept: Sequence[str] = (),
     topic: str | None = None,
     effort: str | None = None,
+    payload: str | None = None,
+    start: float | None = None,
+    stop: float | None = None,
 ) -> LogReading:
     """The log-reading options of a command, parsed for ``robot`` (its joint count checks the
-    ``--columns`` spec)."""
-    names = None if columns is None else tuple(parse_columns(columns, robot.n))
+    ``--columns`` spec); ``payload`` is ``--payload`` (it replaces the log's and the robot
+    file's: :meth:`LogReading.loaded`), ``start`` and ``stop`` are ``--from`` and ``--to``."""
+    names = None if columns is None else parse_column_spec(columns, robot.n)
     return LogReading(
         columns=names,
         repair=repair,
         cutoff=cutoff,
         accept=parse_accept(accept),
         bag=bag_options(topic, effort),
+        payload=None if payload is None else parse_payload(payload),
+        window=None if start is None and stop is None else TimeWindow(start, stop),
     )
 
 
@@ -183,8 +192,9 @@ def load(robot_name: str, payload: str | None) -> Robot:
 payload_option = click.option(
     "--payload",
     metavar="MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]",
-    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2 about its "
-    "centre of mass.",
+    help="Payload at the flange: kg, m (flange frame), kg m^2 about its centre of mass. It "
+    "replaces the model's and the one a log's controller logged (payload, payload_cog, "
+    "payload_inertia), which is used otherwise.",
 )
 
 
@@ -222,7 +232,10 @@ columns_option = click.option(
     "--columns",
     metavar="SPEC",
     help="Layout of a headerless log: UR's RTDE field names, NAME:N for an N-vector, _ (or _:N) "
-    'for columns to skip, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6".',
+    'for columns to skip, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6"; or a header '
+    "log's own names mapped to RTDE fields, FIELD=COLUMN with * for a vector's index, e.g. "
+    '"timestamp=time,actual_q=positions_*" (_=COLUMN leaves a column unread). A header\'s '
+    "columns that are no RTDE field are ignored (a note names them).",
 )
 topic_option = click.option(
     "--topic",
@@ -257,6 +270,28 @@ repair_option = click.option(
     is_flag=True,
     help="Drop malformed rows (cut short, non-numeric, time out of order) instead of rejecting.",
 )
+
+
+def window_options(command: F) -> F:
+    """``--from`` and ``--to`` (as ``start`` and ``stop``): the time window of every log a
+    command reads."""
+    command = click.option(
+        "--to",
+        "stop",
+        type=Finite(),
+        default=None,
+        metavar="S",
+        help="Read each log up to this time (s, on the log's own time axis: its timestamp "
+        "column; a ROS 2 bag's from its first message) [its end].",
+    )(command)
+    return click.option(
+        "--from",
+        "start",
+        type=Finite(),
+        default=None,
+        metavar="S",
+        help="Read each log from this time (s, on the log's own time axis) [its start].",
+    )(command)
 
 
 seed_option = click.option(
@@ -452,8 +487,6 @@ def json_result(result: Any, inputs: InputLogs | None = None) -> str:
     ``kinergy`` (``version``, ``command``, the command's ``options`` as given) and ``inputs``
     (every input file by content: ``path``, ``sha256``, ``size``; a log also ``rows`` and its
     ``checks``, from ``inputs``). A result that is a list is printed as it is."""
-    from kinergy import __version__
-
     out = to_jsonable(result)
     if not isinstance(out, dict):  # a list (robot list): nothing to record beside it
         return dumps(out)

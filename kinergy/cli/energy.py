@@ -21,9 +21,10 @@ from kinergy.cli.common import (
     table,
     tell,
     topic_option,
+    window_options,
     writes,
 )
-from kinergy.workflows.energy import energy_of_log
+from kinergy.workflows.energy import energy_with_outputs
 
 __all__ = ["energy", "energy_text"]
 
@@ -46,10 +47,12 @@ def _row(name: str, e: dict[str, Any], efficiency: float | None, mean_power: flo
 def _supply_lines(report: dict[str, Any]) -> list[str]:
     """What the arm draws from its supply, predicted and (where logged) measured."""
     sup = report["supply"]
+    share = f", {100 * sup['standby'] / sup['drawn']:.0f} % of it" if sup["drawn"] > 0 else ""
     lines = [
-        f"Drawn from the arm's supply: {sup['drawn']:.1f} J predicted (motors {sup['motors']:.1f} J "
-        f"+ standby {sup['standby']:.1f} J; {sup['shunt']:.1f} J of braking burnt in the shunt), "
-        f"mean {sup['mean_power']:.1f} W, peak {sup['peak_power']:.1f} W.",
+        f"Drawn from the arm's supply: {sup['drawn']:.1f} J predicted = motors {sup['motors']:.1f} J"
+        f" + standing draw {sup['standby']:.1f} J ({sup['standby_power']:.3g} W for "
+        f"{report['duration']:.1f} s{share}); {sup['shunt']:.1f} J of braking burnt in the shunt, "
+        f"not drawn. Mean {sup['mean_power']:.1f} W, peak {sup['peak_power']:.1f} W.",
     ]
     measured = report.get("measured")
     if measured is not None:
@@ -111,8 +114,23 @@ def energy_text(report: dict[str, Any]) -> str:
     show_default=True,
     help="Which motion of a log: commanded (target_*) or measured (actual_*).",
 )
+@click.option(
+    "--trace",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Write the power sample by sample: time, supply_predicted, supply_measured (where the "
+    "log measures it) and each joint's electrical power, W; CSV or Parquet by the extension.",
+)
+@click.option(
+    "--plot",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Draw the supply's power over time, predicted against measured, with the energy of "
+    "each (PNG).",
+)
 @payload_option
-@writes(inputs=("model", "motion_path"))
+@window_options
+@writes(files=("trace", "plot"), inputs=("model", "motion_path"))
 def energy(
     model: str,
     motion_path: str,
@@ -125,6 +143,10 @@ def energy(
     accept: tuple[str, ...],
     topic: str | None,
     effort: str | None,
+    start: float | None,
+    stop: float | None,
+    trace: str | None,
+    plot: str | None,
 ) -> None:
     """What a logged or planned motion draws from the arm's supply, and per-joint mechanical and
     electrical energy; a log's measured supply energy beside the prediction.
@@ -133,11 +155,21 @@ def energy(
     with --columns), a motion file, a URScript program (.script) or a built-in motion (test-a,
     test-b: the UR5e doc's tests A and B planned for MODEL).
     """
-    r = load(model, payload)
+    r = load(model, None)
     reading = log_reading(
-        r, columns=columns, repair=repair, accept=accept, topic=topic, effort=effort
+        r,
+        columns=columns,
+        repair=repair,
+        accept=accept,
+        topic=topic,
+        effort=effort,
+        payload=payload,
+        start=start,
+        stop=stop,
     )
-    result = energy_of_log(r, motion_path, reading, source=source, recovery=not no_recovery)
+    result = energy_with_outputs(
+        r, motion_path, reading, source=source, recovery=not no_recovery, trace=trace, plot=plot
+    )
     tell(result.notes, result.warnings)
     report = result.to_dict()
     click.echo(json_result(report, result.inputs) if as_json else energy_text(report))

@@ -13,13 +13,17 @@ from kinergy.cli.common import (
     effort_option,
     json_result,
     output_file_option,
+    payload_option,
     progress,
     table,
     topic_option,
     warn,
+    window_options,
 )
 from kinergy.fleet.analysis import LogResult
 from kinergy.logs.checks import parse_accept
+from kinergy.logs.window import TimeWindow
+from kinergy.model import parse_payload
 from kinergy.workflows.fleet import fleet_energy
 
 __all__ = ["fleet"]
@@ -48,6 +52,8 @@ def fleet() -> None:
 @topic_option
 @effort_option
 @accept_option
+@payload_option
+@window_options
 def energy(
     logs: tuple[str, ...],
     manifest: str,
@@ -60,6 +66,9 @@ def energy(
     topic: str | None,
     effort: str | None,
     accept: tuple[str, ...],
+    payload: str | None,
+    start: float | None,
+    stop: float | None,
 ) -> None:
     """Energy per cycle of every log (LOGS and the manifest's globs), by robot and by day.
 
@@ -80,6 +89,8 @@ def energy(
             logs, manifest, out, report=report, scheduler=scheduler, workers=workers,
             min_rise=min_rise, progress=tick, bag=bag_options(topic, effort),
             accept=parse_accept(accept),
+            payload=None if payload is None else parse_payload(payload),
+            window=None if start is None and stop is None else TimeWindow(start, stop),
         )  # fmt: skip
     if as_json:
         click.echo(json_result(result))

@@ -13,17 +13,19 @@ from kinergy.cli.common import (
     json_result,
     log_reading,
     output_file_option,
+    payload_option,
     progress,
     repair_option,
     table,
     tell,
     topic_option,
+    window_options,
     writes,
 )
 from kinergy.cli.validate import validation_text
-from kinergy.friction.registry import MODELS, parameter_units
+from kinergy.friction.registry import MODELS
 from kinergy.identification.full import FullFit
-from kinergy.identification.options import IdentifyOptions, Method, Solver, Target
+from kinergy.identification.options import IdentifyOptions, Method, Solver, Target, friction_option
 from kinergy.identification.payload import PayloadEstimate
 from kinergy.identification.result import FLAGS, IDENTIFIED, DriveEstimate, IdentificationResult
 from kinergy.model import load_robot
@@ -103,8 +105,8 @@ def _choice_text(result: IdentificationResult) -> list[str]:
         rows.append(
             [
                 name,
-                c.model,
-                f"{c.cv_rms[c.model]:.4f}",
+                c.model.name,
+                f"{c.cv_rms[c.model.name]:.4f}",
                 "-" if gain is None else f"{gain:.1f}",
                 "-" if margin is None else f"{margin:.1f}",
             ]
@@ -118,21 +120,21 @@ def _friction_tables(result: IdentificationResult) -> list[str]:
     """One table per friction model in the result: a column per parameter with its unit (motor
     side), each value with its standard error and flag."""
     lines: list[str] = []
-    models = dict.fromkeys(str(j.friction["model"]) for j in result.joints)
+    models = dict.fromkeys(j.friction.model for j in result.joints)
     for model in models:
-        units = parameter_units(model)
-        names = [k for k in units if any(k in j.friction for j in result.joints)]
+        units = model.parameter_units()
+        names = [k for k in units if any(k in j.friction.params for j in result.joints)]
         headers = ["joint", *(f"{k} [{units[k]}]" if units[k] else k for k in names)]
         rows = [
             [
                 j.name,
                 *(
-                    _with_std(j, k, float(j.friction[k]), ".4g") if k in j.friction else "-"
+                    _with_std(j, k, j.friction.params[k], ".4g") if k in j.friction.params else "-"
                     for k in names
                 ),
             ]
             for j in result.joints
-            if j.friction["model"] == model
+            if j.friction.model is model
         ]
         lines += [f"\nFriction, {model} (motor side)", table(headers, rows)]
     return lines
@@ -198,7 +200,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     default=None,
     help="Friction model for every joint (default: the model's own), e.g. power_law, "
     "load_coulomb, thermal_viscous; auto: per joint, the model with the lowest "
-    "cross-validated current RMS (sequential method).",
+    "cross-validated current RMS (sequential and full methods; the logs need actual_current). "
+    "The nursing method fits its own (Makkar) friction and takes none.",
 )
 @click.option(
     "--target",
@@ -229,6 +232,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 )
 @cutoff_option
 @repair_option
+@payload_option
+@window_options
 @writes(files=("out",), inputs=("logs", "robot_name"))
 def identify(
     logs: tuple[str, ...],
@@ -247,20 +252,35 @@ def identify(
     accept: tuple[str, ...],
     topic: str | None,
     effort: str | None,
+    payload: str | None,
+    start: float | None,
+    stop: float | None,
 ) -> None:
     """Identify a model from controller logs and write it as a robot file.
 
     The sequential method (default, UR5e doc sections 3-4) keeps the model's link data and
     identifies rotor inertias from target_moment and torque constants with friction from
-    actual_current; the full method regresses the base inertial parameters too.
+    actual_current; the full method regresses the base inertial parameters too. Where the logs
+    measure the arm's supply (actual_robot_voltage, actual_robot_current), the standing draw
+    (electronics with the brakes released) is identified with its standard error; the motors' R
+    and k_b stay the model's (actual_joint_voltage is each joint's bus voltage).
     """
     r = load_robot(robot_name)
     reading = log_reading(
-        r, columns=columns, repair=repair, cutoff=cutoff, accept=accept, topic=topic, effort=effort
+        r,
+        columns=columns,
+        repair=repair,
+        cutoff=cutoff,
+        accept=accept,
+        topic=topic,
+        effort=effort,
+        payload=payload,
+        start=start,
+        stop=stop,
     )
     options = IdentifyOptions(
         method=Method(method),
-        friction=friction,
+        friction=friction_option(friction),
         target=Target(target),
         solver=Solver(solver),
         ridge=ridge,

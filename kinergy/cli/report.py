@@ -17,6 +17,7 @@ from kinergy.cli.common import (
     report_folder_option,
     tell,
     topic_option,
+    window_options,
     writes,
 )
 from kinergy.errors import KinergyError
@@ -55,6 +56,7 @@ __all__ = ["report"]
 @effort_option
 @payload_option
 @repair_option
+@window_options
 @writes(folders=("out",), inputs=("model", "identify_logs", "validate_logs", "energy_logs"))
 def report(
     model: str,
@@ -68,13 +70,23 @@ def report(
     accept: tuple[str, ...],
     topic: str | None,
     effort: str | None,
+    start: float | None,
+    stop: float | None,
 ) -> None:
     """Build the study report (tables, figures, report.html) from your own model and logs."""
     if not (identify_logs or validate_logs or energy_logs):
         raise KinergyError("report: give logs with --identify, --validate or --energy")
-    robot = load(model, payload)
+    robot = load(model, None)
     reading = log_reading(
-        robot, columns=columns, repair=repair, accept=accept, topic=topic, effort=effort
+        robot,
+        columns=columns,
+        repair=repair,
+        accept=accept,
+        topic=topic,
+        effort=effort,
+        payload=payload,
+        start=start,
+        stop=stop,
     )
     with progress() as say:
         path, tables, said = study_report(

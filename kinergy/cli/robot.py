@@ -33,6 +33,7 @@ from kinergy.model import (
 )
 from kinergy.model.export import Export
 from kinergy.model.mjcf import robot_to_mjcf
+from kinergy.model.urdf import import_urdf
 from kinergy.model.urdf_export import robot_to_urdf
 from kinergy.workflows.calibration import CalibrationImport, import_calibration
 
@@ -158,7 +159,7 @@ def _drives(r: Robot) -> str:
                 fmt(d.torque_constant),
                 fmt(d.motor_constant),
                 fmt(d.kt_over_kb),
-                f"{d.friction.model} {friction}",
+                f"{d.friction.name} {friction}",
             ]
         )
     return table(headers, rows)
@@ -169,7 +170,8 @@ def _limits(r: Robot) -> str:
     rows = [
         [
             j.name,
-            fmt_vector(np.degrees(j.limits.position)),
+            fmt_vector(np.degrees(j.limits.position))
+            + (" (turns without limit)" if j.limits.continuous else ""),
             fmt(np.degrees(j.limits.speed)),
             "-" if j.limits.acceleration is None else fmt(np.degrees(j.limits.acceleration)),
             fmt(j.limits.torque),
@@ -229,7 +231,7 @@ def _calibration_text(result: CalibrationImport, out: str, points: bool) -> str:
             [
                 j.name,
                 f"{j.torque_constant:.4f}",
-                f"{j.friction.model} {params}",
+                f"{j.friction.model.name} {params}",
                 f"{100 * np.max(np.abs(model / measured - 1)):.1f}",
                 "yes" if np.all(np.abs(model - measured) <= tol) else "NO",
                 f"{100 * np.max(np.abs(contrast / measured - 1)):.1f}",
@@ -313,8 +315,8 @@ _EXPORTERS: dict[str, Callable[..., Export]] = {"urdf": robot_to_urdf, "mjcf": r
     "format_name",
     type=click.Choice(sorted(_EXPORTERS)),
     required=True,
-    help="urdf: kinematics, link inertials, limits and joint-side friction, with the drives in a "
-    "<kinergy:model> element (robot import-urdf reads it back); mjcf: a MuJoCo model with the "
+    help="urdf: kinematics, link inertials, limits and joint-side friction, with the robot file "
+    "itself in a <kinergy:robot> element (robot import-urdf reads it back); mjcf: a MuJoCo model with the "
     "reflected rotor inertia as armature, the friction as damping and frictionloss, torque "
     "actuators.",
 )
@@ -348,14 +350,14 @@ def robot_import_urdf(
 ) -> None:
     """Read a URDF serial chain into a robot file (TOML).
 
-    A URDF written by `kinergy robot export` gives back the model it was written from (its
-    <kinergy:model> element holds the drives and what else URDF cannot). Any other URDF gives
-    modified-DH kinematics, the link inertials and limits, gear ratios from ROS
-    SimpleTransmissions and Coulomb + viscous friction from <dynamics>; the rest of the drives
+    A URDF written by `kinergy robot export` gives back the robot file it was written from (its
+    <kinergy:robot> element holds it), after checking the standard elements against it. Any other
+    URDF, as published (meshes and the like are skipped), gives modified-DH kinematics, the link
+    inertials and limits, gear ratios from <transmission> (ROS or ros2_control
+    SimpleTransmission; Drake's drake:gear_ratio), rotor inertias where a transmission gives them
+    (drake:rotor_inertia) and Coulomb + viscous friction from <dynamics>; the rest of the drives
     is nominal: identify it from logs before trusting energy predictions.
     """
-    from kinergy.model.urdf import import_urdf  # needs the urdf extra (yourdfpy)
-
     if Path(out).suffix.lower() == ".urdf":
         raise KinergyError(
             f"--out: {out} would be written as TOML but read back as URDF; name it .toml"
@@ -365,6 +367,8 @@ def robot_import_urdf(
     save_robot(
         r, out, header=f"{r.name}: imported from {Path(urdf).name} by kinergy robot import-urdf"
     )
+    for text in result.notes:
+        note(text)
     if not result.restored:
         note(
             "the drives not in the URDF are nominal (marked so in the robot file): identify them "

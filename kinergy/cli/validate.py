@@ -17,10 +17,12 @@ from kinergy.cli.common import (
     load,
     log_reading,
     payload_option,
+    prose,
     repair_option,
     table,
     tell,
     topic_option,
+    window_options,
     writes,
 )
 from kinergy.identification.metrics import JointMetrics
@@ -33,7 +35,7 @@ from kinergy.identification.validation import (
 )
 from kinergy.workflows.validate import validate_logs
 
-__all__ = ["report_text", "validate", "validation_text"]
+__all__ = ["report_text", "supply_text", "validate", "validation_text"]
 
 
 def _r2(m: JointMetrics) -> str:
@@ -96,8 +98,22 @@ def _per_log_text(report: ValidationReport, names: Sequence[str]) -> str:
     return "\n".join(parts).rstrip()
 
 
+def supply_text(report: ValidationReport) -> str:
+    """The supply's power and energy, predicted against measured ('' where no log measures it)."""
+    s = report.supply
+    if s is None:
+        return ""
+    return (
+        f"Supply power against actual_robot_voltage x actual_robot_current ({s.samples} samples):"
+        f" RMSE {s.rms:.2f} W, R^2 {s.r2:.4f}, mean error {s.mean:+.2f} W; energy predicted "
+        f"{s.predicted:.1f} J against {s.measured:.1f} J measured ({s.error:+.1f} %). Predicted: "
+        "the motors summed on the DC bus plus the model's standing draw."
+    )
+
+
 def report_text(report: ValidationReport, names: Sequence[str]) -> str:
-    """``validate``'s text: pooled tables, the moving and holding segments, and each log."""
+    """``validate``'s text: pooled tables, the supply, the moving and holding segments, and
+    each log."""
     text = validation_text(report, names)
     if not text:
         return "the logs have neither target_moment nor actual_current nor measured torques"
@@ -106,6 +122,8 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
         f"below {HOLD_SPEED} rad/s for {HOLD_SECONDS} s or more)\n",
         text,
     ]
+    if supply := supply_text(report):
+        lines += ["", prose(supply)]
     for label, part in (("moving", report.moving), ("holding", report.holding)):
         if part is not None and report.moving is not None and report.holding is not None:
             lines += [f"\n--- {label} samples only ---", validation_text(part, names)]
@@ -133,6 +151,7 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
 @cutoff_option
 @payload_option
 @repair_option
+@window_options
 @writes(folders=("plots",), inputs=("model", "logs"))
 def validate(
     model: str,
@@ -146,15 +165,26 @@ def validate(
     accept: tuple[str, ...],
     topic: str | None,
     effort: str | None,
+    start: float | None,
+    stop: float | None,
 ) -> None:
     """How well a model predicts logs: torque (UR5e Table V) and current (Table VII) errors and R^2.
 
     A LOG may also be a built-in motion (test-a, test-b): the log the realistic twin of MODEL
     writes running it (a simulated robot that differs from the model as a real arm does).
     """
-    r = load(model, payload)
+    r = load(model, None)
     reading = log_reading(
-        r, columns=columns, repair=repair, cutoff=cutoff, accept=accept, topic=topic, effort=effort
+        r,
+        columns=columns,
+        repair=repair,
+        cutoff=cutoff,
+        accept=accept,
+        topic=topic,
+        effort=effort,
+        payload=payload,
+        start=start,
+        stop=stop,
     )
     report = validate_logs(r, logs, reading, plots=plots)
     tell(report.notes, report.warnings)

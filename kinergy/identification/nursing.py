@@ -26,7 +26,7 @@ steps:
 
 Passes over the logs' chunks (:class:`~kinergy.identification.chunks.LogChunks`): the first finds each
 log's moving joints; the filtered, cycle-averaged signals of the excitation logs are folded
-chunk by chunk (the zero-phase filter on windows reaching :data:`~kinergy.logs.prepare.FILTER_REACH`
+chunk by chunk (the zero-phase filter on windows reaching :data:`~kinergy.logs.filtering.FILTER_REACH`
 periods of its cutoff into the neighbouring chunks, :func:`~kinergy.identification.chunks.windowed`;
 eq 24 as sums per sample of the period, :class:`~kinergy.identification.cycles.CycleAverage`: the same
 bits as whole). Three things take a log's samples of a few signals instead, because their maths
@@ -58,6 +58,7 @@ from kinergy.drives.coupled import (
 from kinergy.drives.transmission import reflected_inertia, transmission_matrix
 from kinergy.dynamics.regressor import inertial_parameters
 from kinergy.errors import KinergyError
+from kinergy.friction.makkar import MODEL as MAKKAR
 from kinergy.friction.makkar import PARAMETERS as MAKKAR_PARAMETERS
 from kinergy.identification.chunks import LogChunks, one_blas_thread, windowed
 from kinergy.identification.cycles import CycleAverage, find_period
@@ -83,7 +84,8 @@ from kinergy.identification.result import (
 )
 from kinergy.identification.ridge import RidgeFit, ridge_minimal
 from kinergy.jsonable import OPTIONAL
-from kinergy.logs.prepare import FILTER_REACH, IdentData, lowpass
+from kinergy.logs.filtering import FILTER_REACH, lowpass
+from kinergy.logs.prepare import IdentData
 from kinergy.messages import Messages
 from kinergy.model.robot import Friction, Joint, Link, Robot, Source
 
@@ -307,7 +309,7 @@ def _motor_friction(motor: Joint, gamma_motor: Array) -> Friction:
     old = motor.drive.friction.params
     params = {name: float(x) for name, x in zip(MAKKAR_PARAMETERS, gamma_motor, strict=True)}
     params.update({key: old[key] for key in ("standstill", "holding") if key in old})
-    return Friction("makkar", params)
+    return Friction(MAKKAR, params)
 
 
 def _motor_fits(

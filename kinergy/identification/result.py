@@ -14,19 +14,22 @@ Results are frozen dataclasses, written as JSON by :mod:`kinergy.jsonable`:
 
 from __future__ import annotations
 
+import enum
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypedDict
 
 from kinergy.arrays import Array
+from kinergy.drives.bus import supply_power
 from kinergy.drives.transmission import joint_torque
 from kinergy.identification.chunks import LogChunks, data_history
+from kinergy.identification.electrics import StandingDraw
 from kinergy.identification.metrics import JointMetrics, MetricSums
 from kinergy.jsonable import to_jsonable
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs
 from kinergy.messages import Messages
-from kinergy.model.robot import Joint, Robot
+from kinergy.model.robot import Friction, Joint, Robot
 from kinergy.predict import drive_state
 
 __all__ = [
@@ -37,6 +40,7 @@ __all__ = [
     "DriveEstimate",
     "DriveFields",
     "Fit",
+    "Flag",
     "IdentificationResult",
     "Prediction",
     "Validation",
@@ -51,12 +55,19 @@ __all__ = [
 #: a per-joint metrics field: one entry per joint, or None when no log has the signal
 Metrics = tuple[JointMetrics, ...] | None
 
-#: what the data did with a parameter: fitted, left at the starting model's value, or held at a
-#: physical bound by the constrained fit
-IDENTIFIED = "identified"
-KEPT = "kept from prior"
-AT_BOUND = "at bound"
-FLAGS = (IDENTIFIED, KEPT, AT_BOUND)
+
+class Flag(enum.StrEnum):
+    """What the data did with a parameter: fitted, left at the starting model's value, or held at
+    a physical bound by the constrained fit (``--json`` writes the value)."""
+
+    IDENTIFIED = "identified"
+    KEPT = "kept from prior"
+    AT_BOUND = "at bound"
+
+
+IDENTIFIED, KEPT, AT_BOUND = Flag.IDENTIFIED, Flag.KEPT, Flag.AT_BOUND
+#: every flag, in the order tables count them
+FLAGS = tuple(Flag)
 
 
 @dataclass(frozen=True)
@@ -83,11 +94,6 @@ class Fit(Validation):
     notes: tuple[str, ...] = ()
 
 
-def friction_entry(joint: Joint) -> dict[str, str | float]:
-    """``{"model": name, **parameters}`` of a joint's friction, as results report it."""
-    return {"model": joint.drive.friction.model, **joint.drive.friction.params}
-
-
 class DriveFields(TypedDict):
     """The fields every method's per-joint result starts from (:func:`drive_fields`)."""
 
@@ -95,7 +101,7 @@ class DriveFields(TypedDict):
     rotor_inertia: float
     motor_inertia: float
     torque_constant: float
-    friction: dict[str, str | float]
+    friction: Friction
 
 
 def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> DriveFields:
@@ -109,7 +115,7 @@ def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> DriveField
         rotor_inertia=drive.rotor_inertia if rotor_inertia is None else rotor_inertia,
         motor_inertia=drive.motor_inertia,
         torque_constant=drive.torque_constant,
-        friction=friction_entry(joint),
+        friction=drive.friction,
     )
 
 
@@ -117,7 +123,7 @@ def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> DriveField
 class DriveEstimate:
     """One joint's identified drive, motor side: ``rotor_inertia`` = J_m + J_r and
     ``motor_inertia`` J_m (kg m^2), ``torque_constant`` k_t (N m/A), ``friction``
-    (:func:`friction_entry`); per parameter (``rotor_inertia``, ``torque_constant`` and the
+    (its model and parameters; ``--json`` writes ``{"model": name, **parameters}``); per parameter (``rotor_inertia``, ``torque_constant`` and the
     friction's linear parameters by name) its flag (:data:`FLAGS`) and its standard error from the
     residuals (None where not estimated: a parameter kept from the prior)."""
 
@@ -125,8 +131,8 @@ class DriveEstimate:
     rotor_inertia: float
     motor_inertia: float
     torque_constant: float
-    friction: Mapping[str, Any]
-    flags: Mapping[str, str] = field(default_factory=dict)
+    friction: Friction = field(metadata={"json": Friction.as_dict})
+    flags: Mapping[str, Flag] = field(default_factory=dict)
     std: Mapping[str, float | None] = field(default_factory=dict)
 
 
@@ -148,6 +154,9 @@ class IdentificationResult:
         The logs it was identified from (by content) and what their checks found.
     accepted : tuple of str
         Checks that failed and the user accepted (``--accept``), with what they saw.
+    standing_draw : StandingDraw or None
+        The arm's standing draw found from the logs' measured supply (None where they do not
+        measure it).
     """
 
     robot: Robot = field(metadata={"json": lambda r: r.name})
@@ -156,6 +165,7 @@ class IdentificationResult:
     fit: Fit
     inputs: InputLogs = field(default_factory=InputLogs, metadata={"json": lambda i: i.records()})
     accepted: tuple[str, ...] = ()
+    standing_draw: StandingDraw | None = None
 
     @property
     def warnings(self) -> list[str]:
@@ -182,12 +192,15 @@ class Prediction:
 
     ``torque`` is the controller's reference torque (UR5e eq 7, against ``target_moment``),
     ``current`` the motor current (eq 17, against ``actual_current``), ``joint_torque`` the torque
-    at the joints with friction (against measured joint torques).
+    at the joints with friction (against measured joint torques), ``supply`` (N,) what the arm
+    draws from its supply, W (the bus model with the standing draw, :mod:`kinergy.drives.bus`;
+    against ``actual_robot_voltage x actual_robot_current``).
     """
 
     torque: Array | None
     current: Array | None
     joint_torque: Array | None
+    supply: Array | None = None
 
     def after(self, skip: int) -> Prediction:
         """The predictions from row ``skip`` on."""
@@ -200,12 +213,14 @@ def predict(robot: Robot, data: IdentData) -> Prediction:
     torque = None
     if data.tau_ref is not None:
         torque = drive_state(robot, data.q_cmd, data.qd_cmd, data.qdd_cmd).tau_sim
-    current = joint = None
-    if data.current is not None or data.torque is not None:
+    current = joint = supply = None
+    measures = data.supply_voltage is not None and data.supply_current is not None
+    if data.current is not None or data.torque is not None or measures:
         state = drive_state(robot, data.q, data.qd, data.qdd, temperature=data.temperature)
         current = state.current if data.current is not None else None
         joint = joint_torque(robot, state.tau_m) if data.torque is not None else None
-    return Prediction(torque, current, joint)
+        supply = supply_power(state.power, robot.standby_power).supply if measures else None
+    return Prediction(torque, current, joint, supply)
 
 
 def predictions(
@@ -242,11 +257,11 @@ def fit_fields(
 def validation_metrics(robot: Robot, logs: LogChunks | Sequence[IdentData]) -> Validation:
     """UR5e Tables V and VII over several logs (pooled): per joint mean, max, RMS error and R^2
     of the torque (against ``target_moment``), the current (against ``actual_current``) and, for
-    arms with torque sensors, the joint torque. Where every log has joint voltages, the
-    predicted currents are kept (:attr:`LogChunks.currents`) for the electrics' fit."""
+    arms with torque sensors, the joint torque. Where every log measures the supply, the
+    predicted currents are kept (:attr:`LogChunks.currents`) for the standing draw's fit."""
     logs = logs if isinstance(logs, LogChunks) else LogChunks.of(logs)
     sums: dict[str, MetricSums] = {}
-    keep = logs.every("voltage", "current")
+    keep = logs.every("supply_voltage", "current")
     kept = logs.derived() if keep else None
     for _, chunk, pred in predictions(robot, logs):
         for key, measured, predicted in (

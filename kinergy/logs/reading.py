@@ -13,6 +13,7 @@ from __future__ import annotations
 import hashlib
 import os
 import queue
+import re
 import threading
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
@@ -22,14 +23,16 @@ from typing import TypeVar
 import numpy as np
 
 from kinergy.errors import KinergyError
-from kinergy.io.columns import printable
-from kinergy.io.fields import closest, is_known
+from kinergy.io.columns import Columns, printable
+from kinergy.io.fields import closest
 from kinergy.io.formats import CHUNK_ROWS, iter_log
 from kinergy.io.log import Log
 from kinergy.io.panda_layout import is_panda_layout, panda_files
 from kinergy.io.rosbag import BagOptions
 from kinergy.logs.checks import Check, LogCheck, LogChecks
-from kinergy.model.robot import Robot
+from kinergy.logs.payload import PAYLOAD_SIGNALS, describe, from_columns, payload_columns
+from kinergy.logs.window import TimeWindow, WindowCut
+from kinergy.model.robot import Payload, Robot
 
 __all__ = ["CHECKED_SIGNALS", "CheckedLog", "InputLogs", "LogReading", "Provenance"]
 
@@ -40,6 +43,7 @@ CHECKED_SIGNALS = (
     "target_qdd",
     "actual_q",
     "actual_qd",
+    "actual_qdd",
     "target_moment",
     "actual_current",
     "target_current",
@@ -49,6 +53,7 @@ CHECKED_SIGNALS = (
     "joint_temperatures",
     "actual_robot_voltage",
     "actual_robot_current",
+    *PAYLOAD_SIGNALS,
 )
 
 
@@ -58,9 +63,11 @@ class LogReading:
 
     Attributes
     ----------
-    columns : tuple of str or None
+    columns : tuple of str, ColumnMap or None
         The columns of a headerless file (:func:`kinergy.io.columns.parse_columns` of the
-        ``--columns`` spec); None: the file names them in a header line (UR's record.py layout).
+        ``--columns`` spec), or a header log's names mapped to RTDE's
+        (:class:`kinergy.io.columns.ColumnMap`); None: the file names them in a header line by
+        RTDE's names (UR's record.py layout).
     repair : bool
         Drop rows that cannot be read (each drop noted) instead of refusing the file.
     cutoff : float or None
@@ -70,13 +77,25 @@ class LogReading:
     bag : BagOptions or None
         How to read a ROS 2 bag (``--topic``, ``--effort``); None: its defaults. Refused for a
         log that is not a bag.
+    payload : Payload or None
+        The payload at the flange (``--payload``): it replaces the one the controller logged
+        (``payload``, ``payload_cog``, ``payload_inertia``, :mod:`kinergy.logs.payload`) and the
+        robot file's. None: the log's where it logs one, else the robot file's.
+    window : TimeWindow or None
+        The samples read (``--from``/``--to``, s on the log's own time axis); None: all.
     """
 
-    columns: tuple[str, ...] | None = None
+    columns: Columns | None = None
     repair: bool = False
     cutoff: float | None = None
     accept: frozenset[Check] = frozenset()
     bag: BagOptions | None = None
+    payload: Payload | None = None
+    window: TimeWindow | None = None
+
+    def loaded(self, robot: Robot) -> Robot:
+        """``robot`` with the payload :attr:`payload` gives, when it gives one."""
+        return robot if self.payload is None else robot.with_payload(self.payload)
 
 
 @dataclass(frozen=True)
@@ -247,6 +266,7 @@ class CheckedLog:
     checks: LogChecks | None = None
     provenance: Provenance | None = None
     notes: list[str] = field(default_factory=list)
+    _told: bool = field(default=False, repr=False)
 
     @property
     def path(self) -> str:
@@ -296,19 +316,25 @@ class CheckedLog:
         return next(chunks, None)
 
     def _check_names(self) -> None:
-        """Refuse a column whose name is not a known field but a misspelling of one the log
-        lacks (``actual_curent`` for ``actual_current``): a command needing it would otherwise
-        find nothing, or quietly do without. Names that resemble nothing known pass (a recorder
-        may log fields kinergy does not read)."""
-        have = self.names()
-        for name in sorted(have):
-            if is_known(name) or name.startswith("_"):
-                continue
-            guess = closest(name)
-            if guess is not None and guess not in have:
+        """Refuse a column the reader ignored (no field kinergy knows) whose name is a
+        misspelling of a field the command needs and the log lacks (``actual_curent_0`` for
+        ``actual_current`` when currents are needed): the command would otherwise find nothing,
+        or quietly do without. Other ignored columns pass (a recorder may log anything)."""
+        head = self._head()
+        if head is None or not head.ignored:
+            return
+        have = set(head.signals)
+        needed = set(CHECKED_SIGNALS) if self.select is None else set(self.select)
+        lacking = sorted(needed - have)
+        for column in head.ignored:
+            base = re.sub(r"_\d+$", "", column)
+            guess = closest(base, lacking) or closest(column, lacking)
+            if guess is not None:
+                mapped = re.sub(r"_\d+$", "_*", column)
                 raise KinergyError(
-                    f"{self.path}: column {printable(name)} is not a field kinergy knows (did you "
-                    f"mean {guess}?): name it as UR's RTDE does"
+                    f"{self.path}: column {printable(column)} is not a field kinergy knows (did you "
+                    f"mean {guess}?): name it as UR's RTDE does, or map it with --columns "
+                    f"{guess}={printable(mapped)}"
                 )
 
     def _wanted(self) -> list[str] | None:
@@ -317,6 +343,21 @@ class CheckedLog:
             return None
         have = self.names()
         return [s for s in dict.fromkeys([*self.select, *CHECKED_SIGNALS]) if s in have]
+
+    def _given_payload(self, chunk: Log) -> Log:
+        """``chunk`` without the logged payload when ``--payload`` replaces it (noted once)."""
+        if self.reading.payload is None or not any(s in chunk for s in PAYLOAD_SIGNALS):
+            return chunk
+        if not self._told:
+            cols = payload_columns(chunk)
+            logged = "" if cols is None else f" ({describe(from_columns(cols[0]))} first)"
+            self.notes.append(
+                f"{self.path}: the controller's logged payload{logged} is not used: --payload "
+                f"gives {describe(self.reading.payload)}"
+            )
+            self._told = True
+        keep = {k: v for k, v in chunk.signals.items() if k not in PAYLOAD_SIGNALS}
+        return Log(chunk.path, chunk.t, keep, chunk.notes, chunk.ignored)
 
     def _selected(self, chunk: Log) -> Log:
         """``chunk`` with only the selected signals: those only the checks read are not
@@ -339,7 +380,7 @@ class CheckedLog:
             the user did not accept (:meth:`kinergy.logs.checks.LogCheck.finish`).
         """
         self._check_names()
-        check = LogCheck(self.robot, self.path, self.reading.accept)
+        check = LogCheck(self.reading.loaded(self.robot), self.path, self.reading.accept)
         hashed: list[str] = []
         stop = threading.Event()
         hasher = None
@@ -347,17 +388,25 @@ class CheckedLog:
             args = (Path(self.source), hashed, stop)
             hasher = threading.Thread(target=_file_hash, args=args, daemon=True)
         rows = 0
+        window = self.reading.window
+        cut = None if window is None else WindowCut(window, self.path)
         try:
-            for chunk in self._raw(self._wanted()):
+            for raw in self._raw(self._wanted()):
                 if hasher is not None and hasher.ident is None:
                     hasher.start()  # the file opened: hash it beside the reading
-                self.notes.extend(chunk.notes)
-                check.add(chunk)
-                rows += len(chunk)
-                yield self._selected(chunk)
+                self.notes.extend(raw.notes)
+                chunk = self._given_payload(raw if cut is None else cut.cut(raw))
+                if len(chunk):
+                    check.add(chunk)
+                    rows += len(chunk)
+                    yield self._selected(chunk)
+                if cut is not None and cut.done:
+                    break
         except BaseException:
             stop.set()
             raise
+        if cut is not None:
+            self.notes.append(cut.finish())
         if rows == 0:
             raise KinergyError(f"{self.path}: the log has no samples")
         self.checks = check.finish()
@@ -435,4 +484,4 @@ class InputLogs:
                 )
         self.provenance.append(log.provenance)
         self.checks.append(log.checks)
-        self.notes.extend(log.notes)
+        self.notes.extend([*log.notes, *log.checks.notes])

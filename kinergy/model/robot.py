@@ -14,21 +14,25 @@ Units are SI throughout (m, rad, kg, kg m^2, N m, A). Inertia 6-vectors are
 from __future__ import annotations
 
 import dataclasses
+import enum
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import check_friction
+from kinergy.friction.model import FrictionModel
+from kinergy.friction.registry import get_model
 
 __all__ = [
     "CONVENTIONS",
     "MAGNITUDES",
     "SOURCE_CATEGORIES",
     "SOURCE_STATUSES",
+    "Convention",
     "Drive",
     "Friction",
     "Identified",
@@ -45,10 +49,20 @@ __all__ = [
 ]
 
 
-#: ``dh``: frame i = frame i-1 · Rz(q_i + offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i).
-#: ``mdh`` (Craig): frame i = frame i-1 · Rx(alpha_{i-1}) · Tx(a_{i-1}) · Rz(q_i + offset_i) · Tz(d_i),
-#: with joint i storing ``a`` = a_{i-1} and ``alpha`` = alpha_{i-1}.
-CONVENTIONS = ("dh", "mdh")
+class Convention(enum.StrEnum):
+    """How a robot's joints give its link frames.
+
+    ``DH``: frame i = frame i-1 · Rz(q_i + offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i).
+    ``MDH`` (Craig): frame i = frame i-1 · Rx(alpha_{i-1}) · Tx(a_{i-1}) · Rz(q_i + offset_i) ·
+    Tz(d_i), with joint i storing ``a`` = a_{i-1} and ``alpha`` = alpha_{i-1}.
+    """
+
+    DH = "dh"
+    MDH = "mdh"
+
+
+#: the conventions' names, as files write them
+CONVENTIONS = tuple(c.value for c in Convention)
 
 #: Groups of parameters whose provenance a robot file records.
 SOURCE_CATEGORIES = (
@@ -99,39 +113,16 @@ MAGNITUDES = {
 }
 
 
-def _bounded(x: Any, what: str) -> None:
-    """Refuse a number or vector larger than :data:`MAGNITUDES` allows for ``what``."""
-    most = MAGNITUDES.get(what)
-    size = float(np.max(np.abs(x))) if np.size(x) else 0.0
-    if most is not None and size > most:
-        shown = f"{x:g}" if np.ndim(x) == 0 else str(np.asarray(x).tolist())
-        raise KinergyError(f"{what} must be at most {most:g} in size, got {shown}")
-
-
 def _vector(value: Any, length: int, what: str) -> Array:
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise KinergyError(f"{what} must be {length} numbers, got {value!r}") from None
-    if arr.shape != (length,):
-        raise KinergyError(f"{what} must be {length} numbers, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise KinergyError(f"{what} must be finite, got {arr.tolist()}")
-    _bounded(arr, what)
-    arr.setflags(write=False)
-    return arr
+    """``length`` finite numbers no larger than :data:`MAGNITUDES` allows for ``what``."""
+    return checks.vector(value, what, length=length, size=MAGNITUDES.get(what))
 
 
 def _number(value: Any, what: str, *, low: float | None = None, strict: bool = True) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
-        raise KinergyError(f"{what} must be a number, got {value!r}")
-    x = float(value)
-    if not np.isfinite(x):
-        raise KinergyError(f"{what} must be finite, got {value!r}")
-    if low is not None and ((strict and x <= low) or (not strict and x < low)):
-        raise KinergyError(f"{what} must be {'>' if strict else '>='} {low:g}, got {x:g}")
-    _bounded(x, what)
-    return x
+    """A finite number above ``low`` (or at least it, not ``strict``), within
+    :data:`MAGNITUDES`."""
+    gt, ge = (low, None) if strict else (None, low)
+    return checks.number(value, what, gt=gt, ge=ge, size=MAGNITUDES.get(what))
 
 
 def inertia_matrix(inertia: Array) -> Array:
@@ -233,13 +224,54 @@ class Payload:
 
 @dataclass(frozen=True, eq=False)
 class Friction:
-    """A friction model (see :mod:`kinergy.friction.registry`) and its motor-side parameters."""
+    """A joint's friction: its model (family) and motor-side parameters.
 
-    model: str
+    Attributes
+    ----------
+    model : FrictionModel
+        The family (:mod:`kinergy.friction`); given by name (``"power_flow"``), it is resolved
+        here, once.
+    params : mapping of str to float
+        Its parameters, motor side (checked against the family's).
+    """
+
+    model: FrictionModel
     params: Mapping[str, float]
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "params", check_friction(self.model, dict(self.params)))
+        model = get_model(self.model)
+        object.__setattr__(self, "model", model)
+        object.__setattr__(self, "params", model.check(dict(self.params)))
+
+    @property
+    def name(self) -> str:
+        """The family's name, as robot files write it."""
+        return self.model.name
+
+    def torque(
+        self,
+        wm: Array,
+        tau_load: Array | None = None,
+        dwm: Array | None = None,
+        *,
+        temperature: Array | None = None,
+    ) -> Array:
+        """Friction torque, motor side, N m, like ``wm`` (rad/s; see
+        :meth:`~kinergy.friction.model.FrictionModel.friction_torque`)."""
+        return self.model.friction_torque(self.params, wm, tau_load, dwm, temperature=temperature)
+
+    @property
+    def values(self) -> Array:
+        """The values of the family's linear parameters, shape (k,)."""
+        return self.model.values_of(self.params)
+
+    def with_values(self, values: Array) -> Friction:
+        """This friction with its linear parameters replaced by ``values`` (k,)."""
+        return Friction(self.model, self.model.with_values(self.params, values))
+
+    def as_dict(self) -> dict[str, str | float]:
+        """``{"model": name, **parameters}``: a robot file's ``[joints.drive.friction]`` table."""
+        return {"model": self.model.name, **self.params}
 
 
 @dataclass(frozen=True, eq=False)
@@ -344,14 +376,20 @@ class Limits:
         Maximum |tau|, N m.
     acceleration : float or None
         Maximum |qdd|, rad/s^2, where published.
+    continuous : bool
+        The joint turns without limit (no end stop: the UR3e's wrist 3): ``position`` is then
+        the range a planner uses, and a logged angle beyond it is no error.
     """
 
     position: Array
     speed: float
     torque: float
     acceleration: float | None = None
+    continuous: bool = False
 
     def __post_init__(self) -> None:
+        if not isinstance(self.continuous, bool):
+            raise KinergyError(f"limits.continuous must be true or false, got {self.continuous!r}")
         pos = _vector(self.position, 2, "limits.position")
         if not pos[0] < pos[1]:
             raise KinergyError(
@@ -386,6 +424,7 @@ class Joint:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise KinergyError(f"joint name must be a non-empty string, got {self.name!r}")
+        checks.plain_text(self.name, "joint name")
         for name in ("d", "a", "alpha", "offset"):
             object.__setattr__(self, name, _number(getattr(self, name), name))
 
@@ -457,7 +496,8 @@ class Robot:
     Attributes
     ----------
     name : str
-    convention : {'dh', 'mdh'}
+    convention : Convention
+        Given as a Convention or its name (``"dh"``, ``"mdh"``).
     joints : tuple of Joint, length n
     gravity : ndarray, shape (3,)
         Gravitational acceleration in the base frame, m/s^2 (default ``[0, 0, -9.81]``).
@@ -486,7 +526,7 @@ class Robot:
     """
 
     name: str
-    convention: str
+    convention: Convention
     joints: tuple[Joint, ...]
     gravity: Array = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
     payload: Payload | None = None
@@ -502,10 +542,12 @@ class Robot:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise KinergyError(f"robot name must be a non-empty string, got {self.name!r}")
-        if self.convention not in CONVENTIONS:
-            raise KinergyError(
-                f"convention must be one of {', '.join(CONVENTIONS)}, got {self.convention!r}"
-            )
+        object.__setattr__(
+            self, "convention", checks.choice(self.convention, Convention, "convention")
+        )
+        checks.plain_text(self.name, "robot name")
+        if isinstance(self.description, str):
+            checks.plain_text(self.description, "robot description", breaks=True)
         joints = tuple(self.joints)
         if not joints:
             raise KinergyError("a robot needs at least one joint")

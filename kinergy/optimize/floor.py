@@ -32,8 +32,8 @@ from kinergy.arrays import Array
 from kinergy.drives.electrics import friction_torques
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.model.robot import Robot
-from kinergy.optimize.samples import drive_by_payload
 from kinergy.optimize.verify import PathRun
+from kinergy.predict import drive_by_payload
 from kinergy.trajectory.program_motion import payload_index
 
 __all__ = ["EnergyFloor", "energy_floor"]

@@ -34,7 +34,8 @@ from kinergy.dynamics.poses import rotation_about_z, tcp_pose
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
 from kinergy.optimize.options import ToolSymmetry
-from kinergy.optimize.samples import drive_by_payload, piece_nodes
+from kinergy.optimize.samples import piece_nodes
+from kinergy.predict import drive_by_payload
 from kinergy.trajectory.movej import trapezoid, trapezoid_timing
 from kinergy.trajectory.movel import joints_on_path, segment_arrays, tool_motion
 from kinergy.trajectory.program_path import ProgramPath

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from typing import ParamSpec, TypeVar
 
 import numpy as np
@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from kinergy.arrays import Array
 from kinergy.dynamics.threads import kernel_threads
 from kinergy.model.robot import Robot
-from kinergy.predict import DriveState, drive_state
+from kinergy.predict import DriveState, drive_by_payload  # its home is the one forward path
 from kinergy.trajectory.movej import trapezoid_timing
 from kinergy.trajectory.program_motion import (
     LineTables,
@@ -244,46 +244,6 @@ def grid_weights(t: Array) -> Array:
     weights[:-1] += 0.5 * steps
     weights[1:] += 0.5 * steps
     return weights
-
-
-def drive_by_payload(
-    robots: tuple[Robot, ...],
-    load: NDArray[np.intp],
-    q: Array,
-    qd: Array,
-    qdd: Array,
-) -> DriveState:
-    """The drive model (:func:`kinergy.predict.drive_state`) at samples that carry different
-    loads.
-
-    Parameters
-    ----------
-    robots : tuple of Robot
-        The robot carrying each load (:attr:`kinergy.trajectory.program_path.ProgramPath.robots`).
-    load : ndarray of int, shape (N,)
-        Index into ``robots`` of each sample's load.
-    q, qd, qdd : ndarray, shape (N, n)
-
-    Returns
-    -------
-    DriveState
-        Arrays of shape (N, n), each sample computed with its load.
-    """
-    used = np.unique(load)
-    if used.size == 1:
-        return drive_state(robots[int(used[0])], q, qd, qdd)
-    parts = {
-        int(i): drive_state(robots[int(i)], q[m], qd[m], qdd[m])
-        for i in used
-        if np.any(m := load == i)
-    }
-    out = {}
-    for f in fields(DriveState):
-        arr = np.zeros(q.shape)
-        for i, state in parts.items():
-            arr[load == i] = getattr(state, f.name)
-        out[f.name] = arr
-    return DriveState(**out)
 
 
 def path_schedule(path: ProgramPath, t: Array, f: Array) -> Schedule:

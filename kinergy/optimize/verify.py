@@ -31,7 +31,8 @@ from kinergy.model.robot import Robot
 from kinergy.optimize.constraints import LimitCheck, limit_violations
 from kinergy.optimize.objectives import Objective, SupplyEnergy
 from kinergy.optimize.options import ToolSymmetry
-from kinergy.optimize.samples import drive_by_payload, grid_weights, samples_at
+from kinergy.optimize.samples import grid_weights, samples_at
+from kinergy.predict import drive_by_payload
 from kinergy.trajectory.motion import CONTROLLER_DT, Motion
 from kinergy.trajectory.program_motion import Schedule, payload_index, program_motion, sample_path
 from kinergy.trajectory.program_path import ProgramPath

@@ -17,7 +17,9 @@ from kinergy.fleet.run import run_on_dask
 from kinergy.fleet.summary import FleetResult, summarise
 from kinergy.io.rosbag import BagOptions
 from kinergy.logs.checks import Check
+from kinergy.logs.window import TimeWindow
 from kinergy.model.library import load_robot
+from kinergy.model.robot import Payload
 from kinergy.report.fleet import write_fleet_report
 
 __all__ = ["fleet_energy"]
@@ -35,12 +37,15 @@ def fleet_energy(
     progress: Callable[[int, int, LogResult], None] | None = None,
     bag: BagOptions | None = None,
     accept: frozenset[Check] = frozenset(),
+    payload: Payload | None = None,
+    window: TimeWindow | None = None,
 ) -> FleetResult:
     """Analyse every log the manifest and ``logs`` name, write the cycles to ``out`` (Parquet)
     and, with ``report``, the HTML fleet report into that folder. ROS 2 bags are read with their
     robot entry's ``topic`` and ``effort``, else ``bag``'s. Every log passes the plausibility
     checks (:mod:`kinergy.logs.checks`) but those in ``accept``; a log that fails one is
-    reported with the check's line as its error.
+    reported with the check's line as its error. ``payload`` (``--payload``) replaces each log's
+    logged payload and its model's; ``window`` (``--from``/``--to``) cuts every log.
 
     Raises
     ------
@@ -49,7 +54,10 @@ def fleet_energy(
         output that is an input, an unreachable scheduler, or no log that could be analysed.
     """
     fleet = read_manifest(manifest)
-    items = [dataclasses.replace(i, accept=accept) for i in fleet_logs(fleet, logs, bag)]
+    items = [
+        dataclasses.replace(i, accept=accept, payload=payload, window=window)
+        for i in fleet_logs(fleet, logs, bag)
+    ]
     inputs = [Path(manifest), *(Path(i.path) for i in items)]
     inputs += [Path(m) for m in {i.model for i in items} if Path(m).is_file()]
     check_outputs([("--out", out), ("--report", report)], inputs)

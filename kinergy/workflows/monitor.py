@@ -6,7 +6,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 
-from kinergy.errors import KinergyError
+from kinergy import checks
 from kinergy.live.monitor import MONITOR_FIELDS, CycleEnergy, CycleTracker, rows_log
 from kinergy.live.rtde import parse_address
 from kinergy.live.stream import Gap, Stream, stop_on_signals
@@ -36,8 +36,8 @@ def monitor_cycles(
     Returns the tracker (its ``period`` and ``cycles``).
     """
     host, port = parse_address(address)
-    if duration is not None and not duration > 0:
-        raise KinergyError(f"--duration must be > 0, got {duration:g}")
+    if duration is not None:
+        duration = checks.number(duration, "--duration", gt=0.0)
     stop = threading.Event()
     with stop_on_signals(stop):
         stream = Stream(

@@ -6,7 +6,7 @@ import os
 import threading
 from collections.abc import Callable
 
-from kinergy.errors import KinergyError
+from kinergy import checks
 from kinergy.files import check_output
 from kinergy.live.recorder import FIELDS, OPTIONAL_FIELDS, Recording, record
 from kinergy.live.rtde import parse_address
@@ -42,8 +42,8 @@ def record_to_file(
         ("--rotate", rotate_minutes),
         ("--rotate-size", rotate_megabytes),
     ):
-        if value is not None and not value > 0:
-            raise KinergyError(f"{flag} must be > 0, got {value:g}")
+        if value is not None:
+            checks.number(value, flag, gt=0.0)
     check_output(out)
     stop = threading.Event()
     with stop_on_signals(stop) as seen:
