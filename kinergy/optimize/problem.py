@@ -71,7 +71,7 @@ Parts = Callable[[Array, Array], tuple[Array, Array, Array]]
 
 @dataclass(frozen=True, eq=False)
 class TimingProblem:
-    """A movej timing problem as arrays and callables (build it with :func:`timing_problem`).
+    """A program's timing problem as arrays and callables (built by :func:`path_checks`).
 
     Attributes
     ----------
