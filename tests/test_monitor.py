@@ -145,14 +145,18 @@ def test_monitor_text(ur5e_twin, capsys):
 
 
 @pytest.mark.parametrize(
-    ("argv", "message"),
+    ("argv", "message", "status"),
     [
-        (["monitor", "127.0.0.1:1", "--model", "ur5e"], "cannot connect to 127.0.0.1:1"),
-        (["monitor", "127.0.0.1:1", "--model", "no-such-robot"], "no-such-robot"),
-        (["monitor", "127.0.0.1", "--model", "ur5e", "--duration", "-1"], "--duration must be > 0"),
+        (["monitor", "127.0.0.1:1", "--model", "ur5e"], "cannot connect to 127.0.0.1:1", 1),
+        (["monitor", "127.0.0.1:1", "--model", "no-such-robot"], "no-such-robot", 1),
+        (
+            ["monitor", "127.0.0.1", "--model", "ur5e", "--duration", "-1"],
+            "--duration: must be a finite number > 0, got -1",
+            2,
+        ),
     ],
 )
-def test_monitor_errors(argv, message, capsys):
-    assert main(argv) == 1
+def test_monitor_errors(argv, message, status, capsys):
+    assert main(argv) == status
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err

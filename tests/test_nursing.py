@@ -13,6 +13,7 @@ import pytest
 from click.testing import CliRunner
 
 import kinergy
+import kinergy.api
 from kinergy.cli import nursing as nursing_cmd
 from kinergy.drives.coupled import (
     coupled_torques,
@@ -375,7 +376,7 @@ def test_nursing_command_json(monkeypatch) -> None:
 
     canned = {"robot": "nursing-arm", "friction": [], "ridge": {"rmse_test": [0.1] * 6}}
     study = SimpleNamespace(excitation_notes=(), warnings=(), **canned)
-    monkeypatch.setattr(nursing_cmd, "nursing_study", lambda robot, **kw: study)
+    monkeypatch.setattr(kinergy.api, "nursing_study", lambda robot, options, **kw: study)
     monkeypatch.setattr(nursing_cmd, "json_result", lambda s, *a: json.dumps(vars(s)))
     result = CliRunner().invoke(nursing_cmd.nursing, ["--json", "--seed", "3"])
     assert result.exit_code == 0, result.output

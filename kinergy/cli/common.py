@@ -18,44 +18,39 @@ import numpy as np
 from rich.console import Console
 from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElapsedColumn
 
+from kinergy.checks import choice
 from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_outputs, check_replaceable
-from kinergy.io.columns import parse_columns
 from kinergy.io.formats import NOT_LOGS
-from kinergy.io.rosbag import bag_options
+from kinergy.io.rosbag import Effort
 from kinergy.jsonable import dumps, to_jsonable
-from kinergy.logs.checks import Check, parse_accept
-from kinergy.logs.reading import InputLogs, LogReading
+from kinergy.logs.checks import Check
+from kinergy.logs.reading import MAX_CUTOFF, InputLogs, LogReading
 from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
     "TABLE_WIDTH",
     "Finite",
-    "accept_option",
-    "bag_options",
-    "columns_option",
-    "cutoff_option",
-    "effort_option",
+    "as_usage",
+    "choice_of",
     "flag_of",
     "fmt",
     "fmt_vector",
     "json_result",
     "load",
     "log_output",
-    "log_reading",
     "note",
     "output_file_option",
     "payload_option",
     "print_tables",
     "progress",
+    "reading_options",
     "refuse_together",
-    "repair_option",
     "report_folder_option",
     "seed_option",
     "table",
     "tell",
-    "topic_option",
     "warn",
     "writes",
 ]
@@ -153,28 +148,6 @@ def fmt_vector(v: Any) -> str:
     return "[" + ", ".join(fmt(float(x)) for x in np.asarray(v)) + "]"
 
 
-def log_reading(
-    robot: Robot,
-    *,
-    columns: str | None = None,
-    repair: bool = False,
-    cutoff: float | None = None,
-    accept: Sequence[str] = (),
-    topic: str | None = None,
-    effort: str | None = None,
-) -> LogReading:
-    """The log-reading options of a command, parsed for ``robot`` (its joint count checks the
-    ``--columns`` spec)."""
-    names = None if columns is None else tuple(parse_columns(columns, robot.n))
-    return LogReading(
-        columns=names,
-        repair=repair,
-        cutoff=cutoff,
-        accept=parse_accept(accept),
-        bag=bag_options(topic, effort),
-    )
-
-
 def load(robot_name: str, payload: str | None) -> Robot:
     """The robot called ``robot_name`` (built-in or file), with ``--payload`` if given."""
     return load_robot(robot_name, payload=None if payload is None else parse_payload(payload))
@@ -218,50 +191,105 @@ def report_folder_option(contents: str = "the figures") -> Callable[[F], F]:
     )
 
 
-columns_option = click.option(
-    "--columns",
-    metavar="SPEC",
-    help="Layout of a headerless log: UR's RTDE field names, NAME:N for an N-vector, _ (or _:N) "
-    'for columns to skip, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6".',
-)
-topic_option = click.option(
-    "--topic",
-    metavar="TOPIC",
-    default=None,
-    help="ROS 2 bags: the sensor_msgs/JointState topic [/joint_states].",
-)
-effort_option = click.option(
-    "--effort",
-    type=click.Choice(["current", "torque"]),
-    default=None,
-    help="ROS 2 bags: what JointState effort holds, motor currents (A) or joint torques (N m) "
-    "[current for UR arms, as UR's driver publishes by default; torque for others].",
-)
-accept_option = click.option(
-    "--accept",
-    "accept",
-    multiple=True,
-    metavar="CHECK",
-    help="Go on although this check fails (repeatable; recorded in the result): "
-    + ", ".join(c.value for c in Check)
-    + ", or all.",
-)
-cutoff_option = click.option(
-    "--cutoff",
-    type=Finite(0.0, 1e6, min_open=True),
-    default=None,
-    help="Low-pass cutoff for measured speeds, Hz [min(10, fs/5)].",
-)
-repair_option = click.option(
-    "--repair",
-    is_flag=True,
-    help="Drop malformed rows (cut short, non-numeric, time out of order) instead of rejecting.",
-)
+class EnumChoice(click.Choice):
+    """A click choice of the members of an enum, by their values (``--method full``), given to
+    the command as the member (``Method.FULL``)."""
+
+    def __init__(self, kind: type[enum.Enum]) -> None:
+        super().__init__([str(member.value) for member in kind])
+        self.kind = kind
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if isinstance(value, self.kind):
+            return value
+        name = super().convert(value, param, ctx)  # a name not of the enum: a usage error
+        return choice(name, self.kind, param.get_error_hint(ctx) if param and ctx else "value")
+
+
+def choice_of(kind: type[enum.Enum]) -> EnumChoice:
+    """The click type of an option whose values are those of enum ``kind``."""
+    return EnumChoice(kind)
+
+
+@contextlib.contextmanager
+def as_usage() -> Iterator[None]:
+    """Options built from a command's flags: a value the option's type refuses on construction
+    (one line naming the flag, as the Python API gives it) is a usage error, exit status 2."""
+    try:
+        yield
+    except KinergyError as exc:
+        raise click.UsageError(str(exc)) from None
+
+
+#: the flag of each parameter of :meth:`LogReading.parse`: how every command reads its logs
+_READING_FLAGS: dict[str, Callable[[Any], Any]] = {
+    "columns": click.option(
+        "--columns",
+        metavar="SPEC",
+        help="Layout of a headerless log: UR's RTDE field names, NAME:N for an N-vector, _ (or "
+        '_:N) for columns to skip, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6".',
+    ),
+    "repair": click.option(
+        "--repair",
+        is_flag=True,
+        help="Drop malformed rows (cut short, non-numeric, time out of order) instead of "
+        "rejecting.",
+    ),
+    "cutoff": click.option(
+        "--cutoff",
+        type=float,
+        default=None,
+        help=f"Low-pass cutoff for measured speeds, Hz (> 0, <= {MAX_CUTOFF:g}) [min(10, fs/5)].",
+    ),
+    "accept": click.option(
+        "--accept",
+        "accept",
+        multiple=True,
+        metavar="CHECK",
+        help="Go on although this check fails (repeatable; recorded in the result): "
+        + ", ".join(c.value for c in Check)
+        + ", or all.",
+    ),
+    "topic": click.option(
+        "--topic",
+        metavar="TOPIC",
+        default=None,
+        help="ROS 2 bags: the sensor_msgs/JointState topic [/joint_states].",
+    ),
+    "effort": click.option(
+        "--effort",
+        type=choice_of(Effort),
+        default=None,
+        help="ROS 2 bags: what JointState effort holds, motor currents (A) or joint torques "
+        "(N m) [current for UR arms, as UR's driver publishes by default; torque for others].",
+    ),
+}
+
+
+def reading_options(*names: str) -> Callable[[F], F]:
+    """The log-reading flags, one per parameter of :meth:`LogReading.parse` (``names``: those
+    the command takes; default all), parsed there into one :class:`LogReading` that the command
+    receives as ``reading``."""
+    wanted = names or tuple(_READING_FLAGS)
+
+    def decorate(command: F) -> F:
+        @functools.wraps(command)
+        def parsed(**kwargs: Any) -> Any:
+            flags = {name: kwargs.pop(name) for name in wanted}
+            with as_usage():
+                reading = LogReading.parse(**flags)
+            return command(reading=reading, **kwargs)
+
+        for name in reversed(wanted):
+            parsed = _READING_FLAGS[name](parsed)
+        return parsed  # type: ignore[return-value]
+
+    return decorate
 
 
 seed_option = click.option(
     "--seed",
-    type=click.IntRange(0, 2**32 - 1),
+    type=int,
     default=0,
     show_default=True,
     help="Seed of the random generator (0 to 2^32-1).",
@@ -296,7 +324,7 @@ def log_output(flag: str, path: str) -> None:
 
 def refuse_together(*pairs: tuple[str, str, str]) -> None:
     """Refuse, in one line naming both flags, two options given together on the command line
-    that contradict each other: each pair is (parameter, parameter, why)."""
+    that contradict each other (a usage error): each pair is (parameter, parameter, why)."""
     ctx = click.get_current_context()
 
     def given(name: str) -> bool:
@@ -304,7 +332,7 @@ def refuse_together(*pairs: tuple[str, str, str]) -> None:
 
     for a, b, why in pairs:
         if given(a) and given(b):
-            raise KinergyError(
+            raise click.UsageError(
                 f"{flag_of(ctx.command, a)} and {flag_of(ctx.command, b)} together: {why}"
             )
 
@@ -447,13 +475,17 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def json_result(result: Any, inputs: InputLogs | None = None) -> str:
-    """``--json`` of a command: ``result`` (a typed result or a dict) with where it came from:
-    ``kinergy`` (``version``, ``command``, the command's ``options`` as given) and ``inputs``
-    (every input file by content: ``path``, ``sha256``, ``size``; a log also ``rows`` and its
-    ``checks``, from ``inputs``). A result that is a list is printed as it is."""
+def json_result(result: Any) -> str:
+    """``--json`` of a command: ``result.to_dict()`` (a result of :mod:`kinergy.api`; plain data
+    as it is) with where it came from: ``kinergy`` (``version``, ``command``, the command's
+    ``options`` as given) and ``inputs`` (every input file by content: ``path``, ``sha256``,
+    ``size``; a log also ``rows`` and its ``checks``, from the result's ``inputs``). A result
+    that is a list is printed as it is."""
     from kinergy import __version__
 
+    inputs = getattr(result, "inputs", None)
+    inputs = inputs if isinstance(inputs, InputLogs) else None
+    result = result.to_dict() if hasattr(result, "to_dict") else result
     out = to_jsonable(result)
     if not isinstance(out, dict):  # a list (robot list): nothing to record beside it
         return dumps(out)

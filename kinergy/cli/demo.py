@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import click
 
+from kinergy import api
 from kinergy.cli.common import print_tables, progress, report_folder_option, writes
-from kinergy.twin import MISMATCHES
-from kinergy.workflows.demo import run_demo
 
 __all__ = ["TABLES", "demo"]
 
@@ -20,7 +17,7 @@ TABLES = ("IV", "V", "VI", "VII", "VIII", "breakdown", "timing", "truth")
 @report_folder_option("the logs, figures")
 @click.option(
     "--mismatch",
-    type=click.Choice(MISMATCHES),
+    type=click.Choice(api.MISMATCHES),
     default="realistic",
     show_default=True,
     help="realistic: the twin's true robot differs from the model identified; none: the twin is "
@@ -32,8 +29,6 @@ def demo(out: str | None, mismatch: str) -> None:
     and B, compute the energy, print UR5e Tables IV-VIII (and the twin's truth against the
     identified values) and write an HTML report."""
     with progress() as say:
-        tables, report, seconds = run_demo(
-            None if out is None else Path(out), say, mismatch=mismatch
-        )
-    print_tables(tables, TABLES)
-    click.echo(f"\nreport: {report} ({seconds:.1f} s)")
+        run = api.demo(out, mismatch=mismatch, progress=say)
+    print_tables(run.tables, TABLES)
+    click.echo(f"\nreport: {run.report} ({run.seconds:.1f} s)")

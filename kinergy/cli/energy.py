@@ -7,23 +7,20 @@ from typing import Any
 
 import click
 
+from kinergy import api
 from kinergy.accounting.supply import MEASURED_INCLUDES, PREDICTED_INCLUDES
 from kinergy.cli.common import (
-    accept_option,
-    columns_option,
-    effort_option,
+    as_usage,
     json_result,
     load,
-    log_reading,
     payload_option,
     prose,
-    repair_option,
+    reading_options,
     table,
     tell,
-    topic_option,
     writes,
 )
-from kinergy.workflows.energy import energy_of_log
+from kinergy.logs.reading import LogReading
 
 __all__ = ["energy", "energy_text"]
 
@@ -95,36 +92,28 @@ def energy_text(report: dict[str, Any]) -> str:
 @click.command()
 @click.argument("model", metavar="MODEL")
 @click.argument("motion_path", metavar="LOG_OR_MOTION", type=click.Path())
-@columns_option
-@repair_option
-@accept_option
-@topic_option
-@effort_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option(
     "--no-recovery", is_flag=True, help="Clip negative power: the supply takes no energy back."
 )
 @click.option(
     "--source",
-    type=click.Choice(["auto", "target", "actual"]),
+    type=click.Choice(api.MOTION_SOURCES),
     default="auto",
     show_default=True,
     help="Which motion of a log: commanded (target_*) or measured (actual_*).",
 )
 @payload_option
+@reading_options("columns", "repair", "accept", "topic", "effort")
 @writes(inputs=("model", "motion_path"))
 def energy(
     model: str,
     motion_path: str,
-    columns: str | None,
-    repair: bool,
     as_json: bool,
     no_recovery: bool,
     source: str,
     payload: str | None,
-    accept: tuple[str, ...],
-    topic: str | None,
-    effort: str | None,
+    reading: LogReading,
 ) -> None:
     """What a logged or planned motion draws from the arm's supply, and per-joint mechanical and
     electrical energy; a log's measured supply energy beside the prediction.
@@ -133,11 +122,9 @@ def energy(
     with --columns), a motion file, a URScript program (.script) or a built-in motion (test-a,
     test-b: the UR5e doc's tests A and B planned for MODEL).
     """
-    r = load(model, payload)
-    reading = log_reading(
-        r, columns=columns, repair=repair, accept=accept, topic=topic, effort=effort
-    )
-    result = energy_of_log(r, motion_path, reading, source=source, recovery=not no_recovery)
+    with as_usage():
+        options = api.EnergyOptions(source=source, recovery=not no_recovery)
+    result = api.energy(load(model, payload), motion_path, options, reading=reading)
+    assert isinstance(result, api.LogEnergy)  # a file or a built-in motion, not a Motion
     tell(result.notes, result.warnings)
-    report = result.to_dict()
-    click.echo(json_result(report, result.inputs) if as_json else energy_text(report))
+    click.echo(json_result(result) if as_json else energy_text(result.to_dict()))

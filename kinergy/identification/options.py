@@ -3,8 +3,8 @@
 
 Examples
 --------
->>> IdentifyOptions(method=Method("full"), target=Target("current")).method
-<Method.FULL: 'full'>
+>>> IdentifyOptions(method=Method.FULL, target="current").target
+<Target.CURRENT: 'current'>
 """
 
 from __future__ import annotations
@@ -12,12 +12,14 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
+from kinergy.checks import choice, number
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import MODELS
 
 __all__ = [
     "AUTO",
     "FILTER_CUTOFF",
+    "MAX_RIDGE",
     "CurrentOptions",
     "Hold",
     "IdentifyOptions",
@@ -30,6 +32,8 @@ __all__ = [
 
 #: ``friction``: per joint, the model with the lowest cross-validated current RMS
 AUTO = "auto"
+#: the largest ridge weight taken
+MAX_RIDGE = 1e12
 
 
 class Method(enum.StrEnum):
@@ -102,7 +106,8 @@ class CurrentOptions:
 
 @dataclass(frozen=True)
 class IdentifyOptions:
-    """The options of an identification.
+    """The options of an identification, checked on construction (a name given for an enum is
+    parsed into it): one line naming the option.
 
     Attributes
     ----------
@@ -115,7 +120,7 @@ class IdentifyOptions:
     solver : Solver
         Full method only.
     ridge : float
-        The ridge weight (``solver`` ridge), >= 0.
+        The ridge weight (``solver`` ridge), from 0 to :data:`MAX_RIDGE`.
     """
 
     method: Method = Method.SEQUENTIAL
@@ -133,9 +138,11 @@ class IdentifyOptions:
         return out
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "method", choice(self.method, Method, "--method"))
+        object.__setattr__(self, "target", choice(self.target, Target, "--target"))
+        object.__setattr__(self, "solver", choice(self.solver, Solver, "--solver"))
         _check_friction(self.friction)
-        if not 0.0 <= self.ridge < float("inf"):
-            raise KinergyError(f"--ridge must be >= 0 and finite, got {self.ridge}")
+        object.__setattr__(self, "ridge", number(self.ridge, "--ridge", ge=0.0, le=MAX_RIDGE))
 
 
 #: the nursing doc's low-pass cutoff for the motor currents, Hz

@@ -14,24 +14,28 @@ import hashlib
 import os
 import queue
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TypeVar
 
 import numpy as np
 
+from kinergy.checks import number
 from kinergy.errors import KinergyError
-from kinergy.io.columns import printable
+from kinergy.io.columns import check_joint_columns, parse_columns, printable
 from kinergy.io.fields import closest, is_known
 from kinergy.io.formats import CHUNK_ROWS, iter_log
 from kinergy.io.log import Log
 from kinergy.io.panda_layout import is_panda_layout, panda_files
-from kinergy.io.rosbag import BagOptions
-from kinergy.logs.checks import Check, LogCheck, LogChecks
+from kinergy.io.rosbag import BagOptions, bag_options
+from kinergy.logs.checks import Check, LogCheck, LogChecks, parse_accept
 from kinergy.model.robot import Robot
 
-__all__ = ["CHECKED_SIGNALS", "CheckedLog", "InputLogs", "LogReading", "Provenance"]
+__all__ = ["CHECKED_SIGNALS", "MAX_CUTOFF", "CheckedLog", "InputLogs", "LogReading", "Provenance"]
+
+#: Hz: the highest low-pass cutoff ``--cutoff`` takes
+MAX_CUTOFF = 1e6
 
 #: the signals the checks read whenever a log has them (besides those a command asks for)
 CHECKED_SIGNALS = (
@@ -54,19 +58,22 @@ CHECKED_SIGNALS = (
 
 @dataclass(frozen=True)
 class LogReading:
-    """How a command reads its logs, parsed once from its options.
+    """How a command reads its logs, parsed once from its options (:meth:`parse`: from the
+    command line's flags), checked on construction: one line naming the flag at fault.
 
     Attributes
     ----------
     columns : tuple of str or None
         The columns of a headerless file (:func:`kinergy.io.columns.parse_columns` of the
-        ``--columns`` spec); None: the file names them in a header line (UR's record.py layout).
+        ``--columns`` spec, parsed on construction when given as text); None: the file names
+        them in a header line (UR's record.py layout).
     repair : bool
         Drop rows that cannot be read (each drop noted) instead of refusing the file.
     cutoff : float or None
         Low-pass cutoff for measured speeds, Hz; None: min(10 Hz, a fifth of the sample rate).
     accept : frozenset of Check
-        Checks whose failure the user accepts (``--accept``); the results record them.
+        Checks whose failure the user accepts (``--accept``; names, ``all`` or comma-separated
+        lists parsed on construction); the results record them.
     bag : BagOptions or None
         How to read a ROS 2 bag (``--topic``, ``--effort``); None: its defaults. Refused for a
         log that is not a bag.
@@ -77,6 +84,52 @@ class LogReading:
     cutoff: float | None = None
     accept: frozenset[Check] = frozenset()
     bag: BagOptions | None = None
+
+    def __post_init__(self) -> None:
+        columns = self.columns
+        if isinstance(columns, str):
+            columns = tuple(parse_columns(columns))
+        object.__setattr__(self, "columns", None if columns is None else tuple(columns))
+        if self.cutoff is not None:
+            cutoff = number(self.cutoff, "--cutoff", gt=0.0, le=MAX_CUTOFF)
+            object.__setattr__(self, "cutoff", cutoff)
+        accept = [self.accept] if isinstance(self.accept, str) else self.accept
+        names = (c.value if isinstance(c, Check) else c for c in accept)
+        object.__setattr__(self, "accept", parse_accept(names))
+        object.__setattr__(self, "repair", bool(self.repair))
+
+    @classmethod
+    def parse(
+        cls,
+        *,
+        columns: str | None = None,
+        repair: bool = False,
+        cutoff: float | None = None,
+        accept: str | Iterable[str] = (),
+        topic: str | None = None,
+        effort: str | None = None,
+    ) -> LogReading:
+        """The reading options as a command's flags give them, each parsed once: ``columns`` a
+        column spec (``"timestamp,actual_q:6,..."``, :func:`kinergy.io.columns.parse_columns`),
+        ``accept`` check names (``--accept``, repeatable or comma-separated, ``all``),
+        ``topic`` and ``effort`` a ROS 2 bag's (:func:`kinergy.io.rosbag.bag_options`).
+
+        The parameters are the command line's flags (``--columns``, ``--repair``,
+        ``--cutoff``, ``--accept``, ``--topic``, ``--effort``), which the commands build from
+        this signature.
+
+        Raises
+        ------
+        KinergyError
+            One line naming the flag at fault.
+        """
+        return cls(
+            columns=columns,  # type: ignore[arg-type]  # parsed on construction
+            repair=repair,
+            cutoff=cutoff,
+            accept=accept,  # type: ignore[arg-type]
+            bag=bag_options(topic, effort),
+        )
 
 
 @dataclass(frozen=True)
@@ -247,6 +300,10 @@ class CheckedLog:
     checks: LogChecks | None = None
     provenance: Provenance | None = None
     notes: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if self.reading.columns is not None:
+            check_joint_columns(self.reading.columns, self.robot.n)
 
     @property
     def path(self) -> str:

@@ -23,6 +23,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from kinergy.files import output_folder
@@ -43,8 +44,9 @@ from kinergy.trajectory.programs import paper_trajectory
 from kinergy.twin import TwinSettings, realistic_truth, simulate
 from kinergy.workflows.identify import identify_model
 from kinergy.workflows.study import run_study, write_study
+from kinergy.workflows.twin import mismatch_of
 
-__all__ = ["nominal_drives", "run_demo", "truth_tables"]
+__all__ = ["DemoRun", "nominal_drives", "run_demo", "truth_tables"]
 
 #: the realistic twin's seed
 SEED = 1
@@ -157,21 +159,13 @@ def _identify(model: Robot, data: IdentData, realistic: bool) -> IdentificationR
     return identify_sequential(nominal_drives(model), [data])
 
 
-def run_demo(
-    out: Path | None = None,
-    progress: Callable[[str], None] | None = None,
-    *,
-    mismatch: str = "realistic",
-) -> tuple[dict[str, list[Table]], Path, float]:
-    """Run the demo into folder ``out``, built beside it and renamed into place at the end
-    (:func:`kinergy.files.atomic_folder`: a failure or an interruption leaves no half-written
-    folder). ``out`` None: a new folder ``kinergy-demo-*`` in the system's temporary folder
-    (nothing is written to the current folder unless asked). ``mismatch``: ``"realistic"`` or
-    ``"none"`` (module docstring).
+@dataclass(frozen=True, eq=False)
+class DemoRun:
+    """What ``kinergy demo`` wrote.
 
-    Returns
-    -------
-    tables
+    Attributes
+    ----------
+    tables : dict of str to list of Table
         The report's tables (keyed ``"IV"``, ``"V"``, ``"VI"``, ``"VII"``, ``"VIII"``,
         ``"breakdown"``, ``"timing"``, and ``"truth"`` with the realistic twin).
     report : Path
@@ -179,10 +173,29 @@ def run_demo(
     seconds : float
         Wall time.
     """
+
+    tables: dict[str, list[Table]]
+    report: Path
+    seconds: float
+
+
+def run_demo(
+    out: Path | None = None,
+    progress: Callable[[str], None] | None = None,
+    *,
+    mismatch: str = "realistic",
+) -> DemoRun:
+    """Run the demo into folder ``out``, built beside it and renamed into place at the end
+    (:func:`kinergy.files.atomic_folder`: a failure or an interruption leaves no half-written
+    folder). ``out`` None: a new folder ``kinergy-demo-*`` in the system's temporary folder
+    (nothing is written to the current folder unless asked). ``mismatch``: ``"realistic"`` or
+    ``"none"`` (module docstring).
+    """
+    mismatch = mismatch_of(mismatch)
     begin = time.perf_counter()
     with output_folder(out, prefix="kinergy-demo") as (folder, target):
         tables = _demo(folder, progress or (lambda _msg: None), mismatch)
-    return tables, target / "report.html", time.perf_counter() - begin
+    return DemoRun(tables, target / "report.html", time.perf_counter() - begin)
 
 
 def _demo(out: Path, say: Callable[[str], None], mismatch: str) -> dict[str, list[Table]]:

@@ -12,6 +12,7 @@ import numpy as np
 from kinergy.accounting.energy import EnergyAccumulator, EnergyReport, energy
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.arrays import Array
+from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 from kinergy.io.motion import iter_motion
 from kinergy.io.urscript_reader import read_program
@@ -26,7 +27,43 @@ from kinergy.trajectory.programs import paper_trajectory
 from kinergy.trajectory.robot_program import Move
 from kinergy.workflows.twin import is_builtin
 
-__all__ = ["ENERGY_ROWS", "LogEnergy", "energy_of_log", "program_energy", "unused_payload"]
+__all__ = [
+    "ENERGY_ROWS",
+    "MOTION_SOURCES",
+    "EnergyOptions",
+    "LogEnergy",
+    "energy_of_log",
+    "program_energy",
+    "unused_payload",
+]
+
+
+#: what ``--source`` takes: the motion of a log that is accounted
+MOTION_SOURCES = ("auto", "target", "actual")
+
+
+@dataclass(frozen=True)
+class EnergyOptions:
+    """How ``kinergy energy`` accounts a log, checked on construction.
+
+    Attributes
+    ----------
+    source : {"auto", "target", "actual"}
+        Which motion of a log: commanded (``target_*``), measured (``actual_*``), or ``auto``:
+        the commanded one where the log has it.
+    recovery : bool
+        Signed integrals: braking energy returns to the bus (UR5e eqs 25-26); False clips
+        negative power.
+    """
+
+    source: str = "auto"
+    recovery: bool = True
+
+    def __post_init__(self) -> None:
+        if self.source not in MOTION_SOURCES:
+            known = ", ".join(MOTION_SOURCES)
+            raise KinergyError(f"--source: must be one of {known}, got {self.source!r}")
+        object.__setattr__(self, "recovery", bool(self.recovery))
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -170,9 +207,8 @@ def energy_of_log(
     robot: Robot,
     path: str | os.PathLike[str],
     reading: LogReading | None = None,
+    options: EnergyOptions | None = None,
     *,
-    source: str = "auto",
-    recovery: bool = True,
     rows: int = ENERGY_ROWS,
 ) -> LogEnergy:
     """The energy of the motion in a log or motion file and what the log was (what ``kinergy
@@ -186,6 +222,8 @@ def energy_of_log(
     memory bounded by the chunk. Segments (a time gap or a ``segment`` change) are never
     integrated across. A URScript program (``*.script``) is run as the controller would, with
     the loads it sets (:func:`program_energy`)."""
+    options = options or EnergyOptions()
+    source, recovery = options.source, options.recovery
     inputs = InputLogs()
     if is_builtin(path) or os.fspath(path).endswith(".script"):
         if is_builtin(path):  # test-a, test-b: the motion as planned for the robot
