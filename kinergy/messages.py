@@ -5,13 +5,48 @@ A *note* is routine: a value written into a model, a default used, how a log was
 checks only just. (Errors are :class:`kinergy.errors.KinergyError`.) The command line prints both
 on stderr (``kinergy: note: ...``, ``kinergy: warning: ...``; ``--quiet`` drops the notes) and
 ``--json`` carries both lists.
+
+A message is a :class:`Message`: its text, and a :class:`~kinergy.errors.Code` where a caller
+must pick it out (``PayloadRun.lacks`` takes the warnings coded ``PAYLOAD_MISSING``), so that no
+caller searches the text.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-__all__ = ["Messages"]
+from kinergy.errors import Code
+
+__all__ = ["Message", "Messages", "coded"]
+
+
+class Message(str):
+    """A note's or warning's text (it is a ``str``), with the code of what it reports.
+
+    Examples
+    --------
+    >>> w = Message("looks like a payload", Code.PAYLOAD_MISSING)
+    >>> w.code, w.prefixed("run.csv")
+    (<Code.PAYLOAD_MISSING: 'payload_missing'>, 'run.csv: looks like a payload')
+    >>> w.prefixed("run.csv").code
+    <Code.PAYLOAD_MISSING: 'payload_missing'>
+    """
+
+    code: Code | None
+
+    def __new__(cls, text: str, code: Code | None = None) -> Message:
+        out = super().__new__(cls, text)
+        out.code = code if code is not None else getattr(text, "code", None)
+        return out
+
+    def prefixed(self, where: str) -> Message:
+        """``where: text``, with the same code."""
+        return Message(f"{where}: {self}", self.code)
+
+
+def coded(texts: list[str] | tuple[str, ...], code: Code) -> list[str]:
+    """The messages of ``texts`` that carry ``code``."""
+    return [t for t in texts if getattr(t, "code", None) == code]
 
 
 @dataclass
@@ -25,9 +60,10 @@ class Messages:
         """Something routine the user may want to know."""
         self.notes.append(text)
 
-    def warn(self, text: str) -> None:
-        """Something that may make the result wrong."""
-        self.warnings.append(text)
+    def warn(self, text: str, code: Code | None = None) -> None:
+        """Something that may make the result wrong (``code``: what kind, for callers that pick
+        it out)."""
+        self.warnings.append(Message(text, code) if code is not None else text)
 
     def extend(self, other: Messages) -> None:
         self.notes.extend(other.notes)

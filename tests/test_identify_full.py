@@ -480,9 +480,12 @@ def test_too_few_samples_and_bad_options_are_refused(
         identify_full(ur5e, [exact_log.sliced(0, 40)], target="moment")
     with pytest.raises(kinergy.KinergyError, match="needs measured joint torques, missing in twin"):
         identify_full(ur5e, [exact_log], target="torque")
-    with pytest.raises(kinergy.KinergyError, match="unknown target"):
+    with pytest.raises(
+        kinergy.KinergyError,
+        match="target: must be one of auto, moment, current, torque, got 'power'",
+    ):
         identify_full(ur5e, [exact_log], target="power")
-    with pytest.raises(kinergy.KinergyError, match="unknown solver"):
+    with pytest.raises(kinergy.KinergyError, match="solver: must be one of"):
         identify_full(ur5e, [exact_log], solver="lasso")
     with pytest.raises(kinergy.KinergyError, match="needs ridge > 0"):
         identify_full(ur5e, [exact_log], solver="ridge")

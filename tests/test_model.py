@@ -90,7 +90,7 @@ def test_table_iii_link5_izz_as_printed_is_rejected() -> None:
         ([0.01, 0.01, -0.01, 0, 0, 0], "positive definite"),
         ([0.01, 0.01, 0.01, 0.02, 0, 0], "positive definite"),
         ([0.001, 0.001, 0.01, 0, 0, 0], "triangle inequality"),
-        ([0.01, 0.01, 0.01], "6 numbers"),
+        ([0.01, 0.01, 0.01], "6 finite numbers"),
         ([0.01, 0.01, np.nan, 0, 0, 0], "finite"),
     ],
 )
@@ -100,7 +100,7 @@ def test_link_inertia_validation(inertia: list[float], message: str) -> None:
 
 
 def test_link_mass_must_be_positive() -> None:
-    with pytest.raises(KinergyError, match="mass must be > 0"):
+    with pytest.raises(KinergyError, match="mass: must be a finite number > 0"):
         Link(mass=0.0, com=[0, 0, 0], inertia=[0.01, 0.01, 0.01, 0, 0, 0])
 
 
@@ -121,7 +121,7 @@ def test_payload_validation_and_parsing() -> None:
     assert kinergy.model.parse_payload("2.5").mass == 2.5
     p = kinergy.model.parse_payload("2.5,0,0,0.05")
     np.testing.assert_array_equal(p.com, [0, 0, 0.05])
-    with pytest.raises(KinergyError, match="payload mass must be >= 0"):
+    with pytest.raises(KinergyError, match="payload mass: must be a finite number >= 0"):
         Payload(mass=-1.0)
     with pytest.raises(KinergyError, match="--payload"):
         kinergy.model.parse_payload("1,2")
@@ -141,7 +141,7 @@ def _ur5e_dict() -> dict:
         ),
         (
             lambda d: d["joints"][0].update(mass=-3.0),
-            r"joints\[0\] \(shoulder_pan\): mass must be > 0",
+            r"joints\[0\] \(shoulder_pan\): mass: must be a finite number > 0",
         ),
         (
             lambda d: d["joints"][1]["drive"].update(gear_ratio=0.0),
@@ -172,7 +172,7 @@ def _ur5e_dict() -> dict:
             lambda d: d["sources"].update(colour={"status": "published"}),
             "unknown source categories: colour",
         ),
-        (lambda d: d["joints"][0].update(com=[0, 0]), r"com must be 3 numbers"),
+        (lambda d: d["joints"][0].update(com=[0, 0]), r"com: must be 3 finite numbers"),
     ],
 )
 def test_bad_robot_file_names_file_and_field(tmp_path: Path, edit, message: str) -> None:
@@ -299,7 +299,10 @@ def test_cli_bad_file_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[
     path.write_text(tomli_w.dumps(data))
     assert main(["robot", "show", str(path)]) == 1
     err = capsys.readouterr().err
-    assert "neg.toml: joints[1] (shoulder_lift): mass must be > 0" in err and err.count("\n") == 1
+    assert (
+        "neg.toml: joints[1] (shoulder_lift): mass: must be a finite number > 0" in err
+        and err.count("\n") == 1
+    )
 
 
 def test_saved_file_is_valid_toml_with_header(tmp_path: Path) -> None:

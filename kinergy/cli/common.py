@@ -18,6 +18,7 @@ import numpy as np
 from rich.console import Console
 from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElapsedColumn
 
+from kinergy._version import __version__
 from kinergy.checks import choice
 from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
@@ -481,8 +482,6 @@ def json_result(result: Any) -> str:
     ``options`` as given) and ``inputs`` (every input file by content: ``path``, ``sha256``,
     ``size``; a log also ``rows`` and its ``checks``, from the result's ``inputs``). A result
     that is a list is printed as it is."""
-    from kinergy import __version__
-
     inputs = getattr(result, "inputs", None)
     inputs = inputs if isinstance(inputs, InputLogs) else None
     result = result.to_dict() if hasattr(result, "to_dict") else result

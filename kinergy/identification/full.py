@@ -72,6 +72,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from kinergy import checks
 from kinergy.dynamics.regressor import BaseParameters, base_parameters, inertial_parameters
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import MODELS, get_model, linear_values, with_linear_parameters
@@ -262,24 +263,11 @@ class FullFit(Fit):
 
 def _parsed(target: Target | str, solver: Solver | str) -> tuple[Target, Solver]:
     """``target`` and ``solver`` as their types (the Python API's strings parsed)."""
-    try:
-        target = Target(target)
-    except ValueError:
-        known = ", ".join(t.value for t in Target)
-        raise KinergyError(f"unknown target {target!r} (known: {known})") from None
-    try:
-        solver = Solver(solver)
-    except ValueError:
-        known = ", ".join(s.value for s in Solver)
-        raise KinergyError(f"unknown solver {solver!r} (known: {known})") from None
-    return target, solver
+    return checks.choice(target, Target, "target"), checks.choice(solver, Solver, "solver")
 
 
 def _check_options(solver: Solver, ridge: float, friction: str | None) -> None:
-    if isinstance(ridge, bool) or not isinstance(ridge, int | float) or not np.isfinite(ridge):
-        raise KinergyError(f"ridge must be a finite number, got {ridge!r}")
-    if ridge < 0.0:
-        raise KinergyError(f"ridge must be >= 0, got {ridge:g}")
+    ridge = checks.number(ridge, "ridge", ge=0.0)
     if solver == Solver.RIDGE and ridge == 0.0:
         raise KinergyError("solver 'ridge' needs ridge > 0 (the weight of the prior, e.g. 1e-4)")
     if solver != Solver.RIDGE and ridge != 0.0:

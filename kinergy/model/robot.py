@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction.registry import check_friction
@@ -99,39 +100,16 @@ MAGNITUDES = {
 }
 
 
-def _bounded(x: Any, what: str) -> None:
-    """Refuse a number or vector larger than :data:`MAGNITUDES` allows for ``what``."""
-    most = MAGNITUDES.get(what)
-    size = float(np.max(np.abs(x))) if np.size(x) else 0.0
-    if most is not None and size > most:
-        shown = f"{x:g}" if np.ndim(x) == 0 else str(np.asarray(x).tolist())
-        raise KinergyError(f"{what} must be at most {most:g} in size, got {shown}")
-
-
 def _vector(value: Any, length: int, what: str) -> Array:
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise KinergyError(f"{what} must be {length} numbers, got {value!r}") from None
-    if arr.shape != (length,):
-        raise KinergyError(f"{what} must be {length} numbers, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise KinergyError(f"{what} must be finite, got {arr.tolist()}")
-    _bounded(arr, what)
-    arr.setflags(write=False)
-    return arr
+    """``length`` finite numbers no larger than :data:`MAGNITUDES` allows for ``what``."""
+    return checks.vector(value, what, length=length, size=MAGNITUDES.get(what))
 
 
 def _number(value: Any, what: str, *, low: float | None = None, strict: bool = True) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
-        raise KinergyError(f"{what} must be a number, got {value!r}")
-    x = float(value)
-    if not np.isfinite(x):
-        raise KinergyError(f"{what} must be finite, got {value!r}")
-    if low is not None and ((strict and x <= low) or (not strict and x < low)):
-        raise KinergyError(f"{what} must be {'>' if strict else '>='} {low:g}, got {x:g}")
-    _bounded(x, what)
-    return x
+    """A finite number above ``low`` (or at least it, not ``strict``), within
+    :data:`MAGNITUDES`."""
+    gt, ge = (low, None) if strict else (None, low)
+    return checks.number(value, what, gt=gt, ge=ge, size=MAGNITUDES.get(what))
 
 
 def inertia_matrix(inertia: Array) -> Array:

@@ -38,6 +38,7 @@ from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 from urllib.parse import quote
 
+from kinergy._version import __version__
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
 
@@ -328,10 +329,8 @@ def _context(
     if missing:
         names = ", ".join(repr(m) for m in missing)
         raise KinergyError(f"{folder}: figure file not found: {names}")
-    import kinergy
-
     return {
-        "version": kinergy.__version__,
+        "version": __version__,
         "title": title,
         "subtitle": subtitle,
         "meta": list(meta.items()),

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from kinergy._version import __version__
 from kinergy.drives.bus import supply_power
 from kinergy.drives.electrics import electrical_power, equivalent_voltage, torque_constants
 from kinergy.drives.transmission import transmission_matrix
@@ -60,8 +61,6 @@ MIN_SECONDS = 1.0
 
 
 def _header(what: str, logs: Sequence[str | os.PathLike[str]]) -> str:
-    from kinergy import __version__
-
     stamp = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
     return f"kinergy {__version__}: {what} from {', '.join(os.fspath(p) for p in logs)} on {stamp}"
 
@@ -150,8 +149,6 @@ def _record(
     accepted: Sequence[str],
 ) -> Robot:
     """``robot`` with where it was identified from (:class:`~kinergy.model.robot.Identified`)."""
-    from kinergy import __version__
-
     settings: dict[str, str | float] = options.record()
     if columns:
         settings["columns"] = columns

@@ -9,6 +9,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from kinergy._version import __version__
 from kinergy.accounting.energy import EnergyReport, energy
 from kinergy.files import output_folder
 from kinergy.identification.chunks import Segment
@@ -118,8 +119,6 @@ def write_study(
 ) -> tuple[Path, dict[str, list[Table]]]:
     """Write the study's figures and ``folder/report.html`` (with the ``extra`` sections after the
     study's first); return its path and the tables."""
-    from kinergy import __version__
-
     sections, tables = study_sections(study, Path(folder))
     path = write_report(
         Path(folder) / "report.html",
