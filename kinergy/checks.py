@@ -33,9 +33,15 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.errors import Code, KinergyError
 
-__all__ = ["choice", "integer", "known_keys", "number", "vector"]
+__all__ = ["choice", "flag", "integer", "known_keys", "number", "vector"]
 
 E = TypeVar("E", bound=enum.Enum)
+
+
+def flag(name: str) -> str:
+    """The command-line flag of an option called ``name`` in Python, as messages name it
+    (``tool_symmetry`` -> ``--tool-symmetry``)."""
+    return "--" + name.replace("_", "-")
 
 
 def _shown(value: Any) -> str:

@@ -32,8 +32,8 @@ def test_a_number_that_is_not_finite_is_refused_naming_the_flag(
     out = tmp_path / "out.csv"
     assert main([*argv, "--out", str(out)] if argv[0] != "optimize" else argv) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "a finite number" in err
-    assert flag is None or f"error: {flag}: must be" in err or f"'{flag}'" in err
+    assert err.count("\n") == 1 and "must be a finite number" in err
+    assert flag is None or f"error: {flag}: must be" in err
     assert not out.exists()
 
 
@@ -174,5 +174,5 @@ def test_a_yaw_range_is_shown_in_the_degrees_it_was_given(
 ) -> None:
     program = str(Path(__file__).parent / "programs" / "small.script")
     argv = ["place", "ur5e", program, "--x", "0:0", "--y", "0:0", "--yaw", "0:720"]
-    assert main(argv) == 1
+    assert main(argv) == 2  # the grid refuses it: a usage error
     assert "--yaw: 0:720 reaches beyond 360 deg" in capsys.readouterr().err

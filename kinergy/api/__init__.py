@@ -27,6 +27,7 @@ with the same ``inputs`` (each input log by content, with its checks), ``notes``
 ``simulate(robot, trajectory)``        ``kinergy simulate``: the twin's :class:`Simulation`
 ``optimize_program(model, prog)``      ``kinergy optimize``: a URScript program's or a task's
                                        energy-optimal version at the same cycle time
+``place(robot, program, grid)``        ``kinergy place``: :class:`PlaceRun`
 ``record(address, out)``               ``kinergy record``: :class:`Recording`
 ``monitor(address, robot)``            ``kinergy monitor``: :class:`MonitorRun`
 ``fleet_energy(logs, manifest, out)``  ``kinergy fleet energy``: :class:`FleetResult`
@@ -62,6 +63,9 @@ _API = {
     "nursing_study": "kinergy.api.twin",
     "demo": "kinergy.api.twin",
     "optimize_program": "kinergy.api.optimize",
+    "place": "kinergy.api.optimize",
+    "MAX_POINTS": "kinergy.api.optimize",
+    "TASK_POINTS": "kinergy.api.optimize",
     "record": "kinergy.api.live",
     "monitor": "kinergy.api.live",
     "fleet_energy": "kinergy.api.live",
@@ -81,6 +85,12 @@ _API = {
     "MISMATCHES": "kinergy.twin",
     "SimulateOptions": "kinergy.workflows.twin",
     "FleetOptions": "kinergy.workflows.fleet",
+    "ProgramOptions": "kinergy.optimize.options",
+    "Configurations": "kinergy.optimize.options",
+    "ToolSymmetry": "kinergy.optimize.options",
+    "ViaPoints": "kinergy.optimize.options",
+    "PlacementGrid": "kinergy.optimize.placement",
+    "Range": "kinergy.optimize.placement",
     "ExportFormat": "kinergy.workflows.robots",
     "ExciteOptions": "kinergy.workflows.excite",
     "FloorFrames": "kinergy.workflows.excite",
@@ -104,6 +114,7 @@ _API = {
     "ExciteRun": "kinergy.workflows.excite",
     "NursingStudy": "kinergy.workflows.nursing",
     "DemoRun": "kinergy.workflows.demo",
+    "PlaceRun": "kinergy.workflows.place",
     "LibraryRobot": "kinergy.workflows.robots",
     "RobotFile": "kinergy.workflows.robots",
     "UrdfRead": "kinergy.workflows.robots",
@@ -112,9 +123,12 @@ _API = {
 }
 
 __all__ = [
+    "MAX_POINTS",
     "MISMATCHES",
     "MOTION_SOURCES",
+    "TASK_POINTS",
     "CalibrationImport",
+    "Configurations",
     "CycleEnergy",
     "DemoRun",
     "EnergyOptions",
@@ -137,7 +151,11 @@ __all__ = [
     "NursingStudyOptions",
     "OptimizeRun",
     "PayloadRun",
+    "PlaceRun",
+    "PlacementGrid",
+    "ProgramOptions",
     "ProgramRun",
+    "Range",
     "RecordOptions",
     "Recording",
     "RobotFile",
@@ -147,8 +165,10 @@ __all__ = [
     "StreamOptions",
     "StudyReport",
     "Target",
+    "ToolSymmetry",
     "UrdfRead",
     "ValidationReport",
+    "ViaPoints",
     "demo",
     "energy",
     "excite",
@@ -161,6 +181,7 @@ __all__ = [
     "monitor",
     "nursing_study",
     "optimize_program",
+    "place",
     "read_log",
     "record",
     "report",
@@ -174,7 +195,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from kinergy.accounting.energy import EnergyReport
     from kinergy.api.live import fleet_energy, monitor, record
     from kinergy.api.logs import energy, identify, identify_payload, read_log, report, validate
-    from kinergy.api.optimize import optimize_program
+    from kinergy.api.optimize import MAX_POINTS, TASK_POINTS, optimize_program, place
     from kinergy.api.robots import (
         export_robot,
         import_calibration,
@@ -192,6 +213,8 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from kinergy.live.stream import RecordOptions, StreamOptions
     from kinergy.logs.reading import LogReading
     from kinergy.model.export import Export
+    from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
+    from kinergy.optimize.placement import PlacementGrid, Range
     from kinergy.twin import MISMATCHES
     from kinergy.workflows.calibration import CalibrationImport
     from kinergy.workflows.demo import DemoRun
@@ -203,6 +226,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from kinergy.workflows.nursing import NursingStudy, NursingStudyOptions
     from kinergy.workflows.optimize import OptimizeRun
     from kinergy.workflows.optimize_program import ProgramRun
+    from kinergy.workflows.place import PlaceRun
     from kinergy.workflows.robots import ExportFormat, LibraryRobot, RobotFile, UrdfRead
     from kinergy.workflows.study import StudyReport
     from kinergy.workflows.twin import SimulateOptions, Simulation

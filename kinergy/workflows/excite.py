@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from kinergy.checks import choice, integer, number
+from kinergy.checks import choice, flag, integer, number
 from kinergy.errors import KinergyError
 from kinergy.experiments.excitation_design import (
     Excitation,
@@ -72,10 +72,6 @@ class FloorFrames(enum.Enum):
 
     LINKS = "links"
     FLANGE = "flange"
-
-
-def _flag(name: str) -> str:
-    return "--" + name.replace("_", "-")
 
 
 def _angles(value: str | Sequence[float], what: str) -> tuple[float, ...]:
@@ -152,13 +148,13 @@ class ExciteOptions:
     def __post_init__(self) -> None:
         for name, (least, most) in COUNTS.items():
             object.__setattr__(
-                self, name, integer(getattr(self, name), _flag(name), ge=least, le=most)
+                self, name, integer(getattr(self, name), flag(name), ge=least, le=most)
             )
         object.__setattr__(self, "seed", integer(self.seed, "--seed", ge=0, le=MAX_SEED))
         for name, (low, high) in LIMITS.items():
             value = getattr(self, name)
             if value is not None:
-                object.__setattr__(self, name, number(value, _flag(name), ge=low, le=high))
+                object.__setattr__(self, name, number(value, flag(name), ge=low, le=high))
         if self.floor is not None:
             floor = number(self.floor, "--floor", ge=-MAX_FLOOR, le=MAX_FLOOR)
             object.__setattr__(self, "floor", floor)
