@@ -7,7 +7,6 @@ import contextlib
 import enum
 import functools
 import hashlib
-import math
 import textwrap
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
@@ -32,7 +31,6 @@ from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
     "TABLE_WIDTH",
-    "Finite",
     "as_usage",
     "choice_of",
     "flag_of",
@@ -61,24 +59,6 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 #: the widest line :func:`table` prints, characters
 TABLE_WIDTH = 120
-
-
-class Finite(click.FloatRange):
-    """A number option that must be finite (NaN and infinities refused, naming the flag), within
-    the range when one is given: ``Finite()``, ``Finite(0.0, 1.0)``, ``Finite(min=0.0)``."""
-
-    name = "number"
-
-    def _describe_range(self) -> str:
-        if self.min is None and self.max is None:
-            return "finite"
-        return super()._describe_range()
-
-    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
-        x = super().convert(value, param, ctx)
-        if not math.isfinite(x):
-            self.fail(f"{value!r} is not a finite number", param, ctx)
-        return x
 
 
 def prose(text: str, width: int = TABLE_WIDTH) -> str:

@@ -3,12 +3,11 @@ mechanical and electrical energy, and the log's measured supply energy beside th
 
 from __future__ import annotations
 
-from typing import Any
+import math
 
 import click
 
 from kinergy import api
-from kinergy.accounting.supply import MEASURED_INCLUDES, PREDICTED_INCLUDES
 from kinergy.cli.common import (
     as_usage,
     json_result,
@@ -27,59 +26,87 @@ __all__ = ["energy", "energy_text"]
 _PARTS = ("inertial", "gravity", "friction", "copper")
 
 
-def _row(name: str, e: dict[str, Any], efficiency: float | None, mean_power: float) -> list[str]:
-    eff = "-" if efficiency is None else f"{100 * efficiency:.1f}"
+def _row(
+    name: str,
+    e_mech: float,
+    e_elec: float,
+    efficiency: float,
+    mean_power: float,
+    peak_power: float,
+    parts: dict[str, float],
+) -> list[str]:
+    eff = "-" if not math.isfinite(efficiency) else f"{100 * efficiency:.1f}"
     return [
         name,
-        f"{e['e_mech']:.1f}",
-        f"{e['e_elec']:.1f}",
+        f"{e_mech:.1f}",
+        f"{e_elec:.1f}",
         eff,
         f"{mean_power:.1f}",
-        f"{e['peak_power']:.1f}",
-        *(f"{e['breakdown'][k]:.1f}" for k in _PARTS),
+        f"{peak_power:.1f}",
+        *(f"{parts[k]:.1f}" for k in _PARTS),
     ]
 
 
-def _supply_lines(report: dict[str, Any]) -> list[str]:
+def _supply_lines(result: api.LogEnergy) -> list[str]:
     """What the arm draws from its supply, predicted and (where logged) measured."""
-    sup = report["supply"]
+    sup, measured = result.supply, result.measured
     lines = [
-        f"Drawn from the arm's supply: {sup['drawn']:.1f} J predicted (motors {sup['motors']:.1f} J "
-        f"+ standby {sup['standby']:.1f} J; {sup['shunt']:.1f} J of braking burnt in the shunt), "
-        f"mean {sup['mean_power']:.1f} W, peak {sup['peak_power']:.1f} W.",
+        f"Drawn from the arm's supply: {sup.drawn:.1f} J predicted (motors {sup.motors:.1f} J "
+        f"+ standby {sup.standby:.1f} J; {sup.shunt:.1f} J of braking burnt in the shunt), "
+        f"mean {sup.mean_power:.1f} W, peak {sup.peak_power:.1f} W.",
     ]
-    measured = report.get("measured")
     if measured is not None:
-        error = measured.get("error")
+        error = result.measured_dict().get("error")
         lines.append(
-            f"Measured by the log: {measured['drawn']:.1f} J (mean {measured['mean_power']:.1f} W)"
+            f"Measured by the log: {measured.drawn:.1f} J (mean {measured.mean_power:.1f} W)"
             + ("" if error is None else f"; predicted {error:+.1f} %")
             + "."
         )
-    lines += [f"  predicted: {PREDICTED_INCLUDES}."]
+    lines += [f"  predicted: {sup.includes}."]
     if measured is not None:
-        lines.append(f"  measured: {MEASURED_INCLUDES}.")
+        lines.append(f"  measured: {measured.includes}.")
     return lines
 
 
-def energy_text(report: dict[str, Any]) -> str:
+def energy_text(result: api.LogEnergy) -> str:
     """The ``energy`` answer: what the arm draws from its supply (predicted, and measured where
     logged), then one row per joint and the total, with what each figure includes."""
-    rows = [_row(j["name"], j, j["efficiency"], j["mean_power"]) for j in report["joints"]]
-    tot = report["total"]
-    rows.append(_row("total", tot, tot["efficiency"], tot["e_elec"] / report["duration"]))
-    head = f"{report['robot']}: {report['duration']:.3f} s, {report['samples']} samples; " + (
+    r, duration = result, result.duration
+    rows = [
+        _row(
+            name,
+            r.e_mech[i],
+            r.e_elec[i],
+            r.efficiency[i],
+            r.e_elec[i] / duration,
+            r.peak_power[i],
+            {k: v[i] for k, v in r.breakdown.items()},
+        )
+        for i, name in enumerate(r.joints)
+    ]
+    rows.append(
+        _row(
+            "total",
+            r.total_e_mech,
+            r.total_e_elec,
+            r.total_efficiency,
+            r.total_e_elec / duration,
+            r.bus_peak,
+            {k: v.sum() for k, v in r.breakdown.items()},
+        )
+    )
+    head = f"{r.robot}: {duration:.3f} s, {r.samples} samples; " + (
         "signed integrals (braking energy returns to the bus)"
-        if report["recovery"]
+        if r.recovery
         else "no recovery (negative power clipped)"
     )
     headers = ["joint", "E_mech [J]", "E_elec [J]", "eta [%]", "mean P [W]", "peak P [W]"]
     headers += [f"{k} [J]" for k in _PARTS]
-    if "segments" in report:
-        head += f"\n{report['segments']} segments; gaps of {report['gaps']:.3f} s not integrated."
+    if r.segments > 1:
+        head += f"\n{r.segments} segments; gaps of {r.span - duration:.3f} s not integrated."
     lines = [
         prose(head),
-        *(prose(line) for line in _supply_lines(report)),
+        *(prose(line) for line in _supply_lines(result)),
         "",
         table(headers, rows),
         "",
@@ -127,4 +154,4 @@ def energy(
     result = api.energy(load(model, payload), motion_path, options, reading=reading)
     assert isinstance(result, api.LogEnergy)  # a file or a built-in motion, not a Motion
     tell(result.notes, result.warnings)
-    click.echo(json_result(result) if as_json else energy_text(result.to_dict()))
+    click.echo(json_result(result) if as_json else energy_text(result))

@@ -43,7 +43,6 @@ from kinergy.predict import drive_state
 from kinergy.workflows.logs import chunked_logs
 
 __all__ = [
-    "METHODS",
     "MIN_SECONDS",
     "PayloadRun",
     "identify_chunks",
@@ -54,8 +53,6 @@ __all__ = [
     "unsupported_fit",
 ]
 
-#: identification methods by the name ``--method`` takes
-METHODS = tuple(m.value for m in Method)
 #: s: the shortest logs (all together) an identification accepts
 MIN_SECONDS = 1.0
 
