@@ -34,29 +34,39 @@ The UR5e doc's test programs A and B that the twin usually runs are in
 from __future__ import annotations
 
 import dataclasses
+import enum
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
 from kinergy.drives.electrics import controller_voltage, winding_resistances
 from kinergy.drives.thermal import joint_losses, joint_temperatures
 from kinergy.errors import KinergyError
+from kinergy.friction.load_thermal_power_law import MODEL as LOAD_THERMAL_POWER_LAW
 from kinergy.friction.model import SMOOTHING
 from kinergy.friction.power_law import speed_power
-from kinergy.friction.registry import friction_torque
 from kinergy.io.log import Log
 from kinergy.model.robot import Friction, Joint, Robot, Source, Thermal
 from kinergy.predict import DriveState, drive_state
 from kinergy.trajectory.motion import Motion
 
-__all__ = ["MISMATCHES", "TwinSettings", "realistic_truth", "simulate"]
+__all__ = ["MISMATCHES", "Mismatch", "TwinSettings", "realistic_truth", "simulate"]
 
 
-#: what ``--mismatch`` takes: the model itself is the truth, or a realistic true robot
-MISMATCHES = ("none", "realistic")
+class Mismatch(enum.StrEnum):
+    """How the twin's true robot differs from the model it simulates (``--mismatch``): not at all
+    (the model is the truth) or as a real arm does (:func:`realistic_truth`)."""
+
+    NONE = "none"
+    REALISTIC = "realistic"
+
+
+#: what ``--mismatch`` takes, as text
+MISMATCHES = tuple(m.value for m in Mismatch)
 
 
 @dataclass(frozen=True)
@@ -108,9 +118,7 @@ class TwinSettings:
             "voltage_noise",
             "ripple",
         ):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0.0):
-                raise KinergyError(f"{name} must be >= 0, got {value}")
+            object.__setattr__(self, name, checks.number(getattr(self, name), name, ge=0.0))
 
     @classmethod
     def exact(cls) -> TwinSettings:
@@ -258,20 +266,18 @@ def _true_friction(joint: Joint, rng: np.random.Generator, scale: float) -> Fric
     term falling 18 % over 20 K."""
     drive = joint.drive
     wm = np.abs(drive.gear_ratio) * np.concatenate([[1e-3], _MATCH_SPEEDS])
-    model, params = drive.friction.model, dict(drive.friction.params)
+    params = dict(drive.friction.params)
     params.pop("standstill", None)
     params.pop("holding", None)
-    level = 0.5 * (
-        friction_torque(model, params, wm, np.ones_like(wm))
-        + friction_torque(model, params, wm, -np.ones_like(wm))
-    )
+    moving = Friction(drive.friction.model, params)  # without the standstill hold
+    level = 0.5 * (moving.torque(wm, np.ones_like(wm)) + moving.torque(wm, -np.ones_like(wm)))
     exponent = float(rng.uniform(0.5, 0.65))
     coulomb = max(float(level[0]), 1e-4)
     speed = speed_power(wm[1:], exponent)
     viscous = max(float(speed @ (level[1:] - coulomb) / (speed @ speed)), 1e-6)
     viscous *= 1.0 + scale * rng.uniform(-1, 1)
     return Friction(
-        "load_thermal_power_law",
+        LOAD_THERMAL_POWER_LAW,
         {
             "coulomb": coulomb * (1.0 + scale * rng.uniform(-1, 1)),
             "load": float(rng.uniform(0.01, 0.03)),

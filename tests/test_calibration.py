@@ -12,6 +12,7 @@ import pytest
 import kinergy
 from kinergy.cli import main
 from kinergy.errors import KinergyError
+from kinergy.friction.registry import get_model
 from kinergy.identification.electrics import fit_electrics
 from kinergy.identification.friction_curve import choose_model, fit_curve, points_from
 from kinergy.io.ur_calibration import read_ur_calibration
@@ -82,13 +83,13 @@ def test_a_cut_file_and_a_missing_file_are_one_line(tmp_path: Path) -> None:
 def test_friction_curve_recovers_a_power_law_and_cross_validation_prefers_it() -> None:
     wm = np.array([-320.0, -150, -50, -1, 1, 50, 150, 320])
     truth = {"coulomb": 0.05, "viscous": 0.004, "exponent": 0.58, "smoothing": 1e-3}
-    tau = kinergy.friction.friction_torque("power_law", truth, wm)
+    tau = get_model("power_law").friction_torque(truth, wm)
     points = points_from(wm, tau, tolerance=(1.0, 1e-3))
-    fit = fit_curve("power_law", points)
+    fit = fit_curve(get_model("power_law"), points)
     assert fit.params["exponent"] == pytest.approx(0.58, abs=1e-3)
     assert fit.params["coulomb"] == pytest.approx(0.05, rel=1e-3)
-    best, tried = choose_model(["viscous_coulomb", "power_law"], points)
-    assert best.model == "power_law" and len(tried) == 2
+    best, tried = choose_model([get_model("viscous_coulomb"), get_model("power_law")], points)
+    assert best.model.name == "power_law" and len(tried) == 2
     assert tried[0].cv_rms is not None and best.cv_rms is not None
     assert best.cv_rms < 0.1 * tried[0].cv_rms
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from kinergy.cli import main
-from kinergy.errors import KinergyError
+from kinergy.errors import Code, KinergyError
 from kinergy.io.columns import parse_columns
 from kinergy.io.formats import read_log
 from kinergy.io.log import Log
@@ -237,7 +237,8 @@ def test_a_payload_the_model_lacks_is_named_not_refused():
     log = simulate(loaded, paper_trajectory(ur5e, "test-a", dt=0.004), TwinSettings(seed=4))
     result = check_log(ur5e, log)
     assert "robot" in result.passed
-    (text,) = [w for w in result.warnings if "that the model lacks" in w]
+    (text,) = [w for w in result.warnings if getattr(w, "code", None) == Code.PAYLOAD_MISSING]
+    assert "that the model lacks" in text
     mass = float(text.split("carrying about ")[1].split(" kg")[0])
     assert mass == pytest.approx(3.0, rel=0.1)
 

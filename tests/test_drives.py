@@ -25,7 +25,7 @@ from kinergy.drives.transmission import (
     reflected_inertia,
 )
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import MODELS, friction_torque
+from kinergy.friction.registry import MODELS, get_model
 from kinergy.model import Drive, Friction, Joint, Limits, Link, Robot
 from kinergy.predict import drive_state
 from kinergy.trajectory.motion import Motion
@@ -76,7 +76,7 @@ def test_every_model_has_test_parameters() -> None:
 def test_friction_opposes_motion(model: str) -> None:
     wm = np.random.default_rng(0).normal(0, 100, 500)
     load = np.random.default_rng(1).normal(0, 1, 500)
-    tau = friction_torque(model, PARAMS[model], wm, load)
+    tau = get_model(model).friction_torque(PARAMS[model], wm, load)
     if model == "none":
         assert np.all(tau == 0)
     else:
@@ -92,18 +92,20 @@ def test_power_flow_picks_the_coulomb_level_by_power_direction() -> None:
     expected = p["viscous"] * wm + np.array([1, 1, -1, -1]) * np.array(
         [p["coulomb_direct"], p["coulomb_reverse"], p["coulomb_direct"], p["coulomb_reverse"]]
     )
-    np.testing.assert_allclose(friction_torque("power_flow", p, wm, load), expected, rtol=1e-12)
+    np.testing.assert_allclose(
+        get_model("power_flow").friction_torque(p, wm, load), expected, rtol=1e-12
+    )
     with pytest.raises(KinergyError, match="load torque"):
-        friction_torque("power_flow", p, wm)
+        get_model("power_flow").friction_torque(p, wm)
 
 
 def test_stribeck_and_makkar_closed_forms() -> None:
     s = PARAMS["stribeck"]
     # at zero-ish speed (tanh saturated) the level is the static friction, far out the Coulomb one
-    assert friction_torque("stribeck", s, np.array([0.05]))[0] == pytest.approx(
+    assert get_model("stribeck").friction_torque(s, np.array([0.05]))[0] == pytest.approx(
         s["static"], rel=2e-3
     )
-    far = friction_torque("stribeck", s, np.array([200.0]))[0]
+    far = get_model("stribeck").friction_torque(s, np.array([200.0]))[0]
     assert far == pytest.approx(s["coulomb"] + s["viscous"] * 200.0, rel=1e-9)
     g = PARAMS["makkar"]
     w = 0.3
@@ -112,7 +114,9 @@ def test_stribeck_and_makkar_closed_forms() -> None:
         + g["gamma4"] * np.tanh(g["gamma5"] * w)
         + g["gamma6"] * w
     )
-    assert friction_torque("makkar", g, np.array([w]))[0] == pytest.approx(expected, rel=1e-14)
+    assert get_model("makkar").friction_torque(g, np.array([w]))[0] == pytest.approx(
+        expected, rel=1e-14
+    )
 
 
 # --- transmissions -------------------------------------------------------------------------------
@@ -328,27 +332,22 @@ def test_electrical_power_formula_directly(ur5e: Robot) -> None:
 
 @pytest.mark.parametrize("model", sorted(MODELS))
 def test_friction_columns_reproduce_the_model(model: str) -> None:
-    from kinergy.friction.registry import (
-        friction_columns,
-        get_model,
-        with_linear_parameters,
-    )
 
     rng = np.random.default_rng(12)
     wm = rng.normal(0, 50, 300)
     load = rng.normal(0, 1, 300)
     params = PARAMS[model]
-    cols = friction_columns(model, params, wm, load)
+    cols = get_model(model).friction_columns(params, wm, load)
     assert cols.shape == (300, len(get_model(model).linear))
     values = np.array([params.get(n, 0.0) for n in get_model(model).linear])
     if model == "motor_reducer":
         values[1] = params["motor_coulomb"] + params["reducer_coulomb"]
     np.testing.assert_allclose(
-        cols @ values, friction_torque(model, params, wm, load), rtol=1e-12, atol=1e-15
+        cols @ values, get_model(model).friction_torque(params, wm, load), rtol=1e-12, atol=1e-15
     )
     # new linear values go back into a parameter set that evaluates to the new columns' torque
     new = values * 1.7 + 0.01
-    updated = with_linear_parameters(model, params, new)
+    updated = get_model(model).with_values(params, new)
     np.testing.assert_allclose(
-        friction_torque(model, updated, wm, load), cols @ new, rtol=1e-12, atol=1e-15
+        get_model(model).friction_torque(updated, wm, load), cols @ new, rtol=1e-12, atol=1e-15
     )

@@ -237,7 +237,7 @@ def test_d_optimality_and_bad_options(ur5e: kinergy.Robot) -> None:
     for kwargs, message in (
         ({"harmonics": 1}, "harmonics must be >= 2"),
         ({"harmonics": 0}, "harmonics must be >= 2"),
-        ({"period": 0.0}, "period must be > 0"),
+        ({"period": 0.0}, "period: must be a finite number > 0"),
         ({"criterion": "e-opt"}, "unknown criterion"),
         ({"samples": 5}, "samples must be"),
         ({"limits": excitation_limits(kinergy.load_robot("panda"))}, "limits for 7 joints"),
@@ -248,7 +248,7 @@ def test_d_optimality_and_bad_options(ur5e: kinergy.Robot) -> None:
         ({"floor": 2.0}, "not above the floor"),
         ({"start": [0.0] * 5}, "start pose"),
         ({"speed": 0.0}, "speed limit of joint 1"),
-        ({"position_range": -1.0}, "position range must be > 0"),
+        ({"position_range": -1.0}, "position range: must be finite numbers, each > 0"),
         ({"floor_frames": "tool"}, "unknown floor_frames"),
     ):
         with pytest.raises(kinergy.KinergyError, match=message):

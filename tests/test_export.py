@@ -5,9 +5,11 @@ real Fourier log with the CLI (skipped when ../shared/datasets is absent):
 
 - Pinocchio loads the URDF; its RNEA equals ``kinergy.rnea`` (rigid body, payload included) to
   1e-9 relative on seeded random states, its flange frame is ``kinergy.flange_pose``, and its
-  ``damping`` / ``friction`` are the joint-side values of this file's own fit of each motor's
-  friction (an independent least squares over the grid docs/EXPORT.md documents, referred through
-  ``kinergy.drives.transmission.transmission_matrix``);
+  ``damping`` / ``friction`` are the joint-side values of each motor's Coulomb level and viscous
+  coefficient: a Coulomb + viscous family's own parameters, read here from the robot file, any
+  other family's line by this file's own fit (an independent least squares over the grid
+  docs/EXPORT.md documents), referred through
+  ``kinergy.drives.transmission.transmission_matrix``;
 - MuJoCo loads the MJCF; with ``frictionloss`` off, ``mj_inverse``'s joint forces equal kinergy's
   rigid-body + reflected-inertia (``drives.transmission.reflected_inertia``) + viscous torques to
   1e-6 on random states away from zero speed. Coulomb friction separately, as MuJoCo's
@@ -24,6 +26,7 @@ real Fourier log with the CLI (skipped when ../shared/datasets is absent):
 from __future__ import annotations
 
 import dataclasses
+import json
 import re
 import runpy
 from pathlib import Path
@@ -38,14 +41,14 @@ from scipy.spatial.transform import Rotation
 import kinergy
 from kinergy.cli import main
 from kinergy.drives.transmission import reflected_inertia, transmission_matrix
-from kinergy.friction.registry import friction_torque
-from kinergy.model import robot_to_dict
+from kinergy.errors import Code
+from kinergy.friction.registry import get_model
+from kinergy.model import robot_from_dict, robot_to_dict
 from kinergy.model.mjcf import robot_to_mjcf
 from kinergy.model.urdf_export import robot_to_urdf
 
 pin = pytest.importorskip("pinocchio")
 mujoco = pytest.importorskip("mujoco")
-pytest.importorskip("yourdfpy")
 
 ROOT = Path(__file__).resolve().parents[1]
 DATASETS = Path(__file__).resolve().parents[2] / "shared" / "datasets"
@@ -116,8 +119,16 @@ def _nonnegative_line(columns: np.ndarray, f: np.ndarray) -> np.ndarray:
     return best
 
 
+#: the Coulomb + viscous families and where their levels are: (Coulomb, viscous) of the parameters
+OWN_LINES = {
+    "viscous_coulomb": lambda p: (p["coulomb"], p["viscous"]),
+    "motor_reducer": lambda p: (p["motor_coulomb"] + p["reducer_coulomb"], p["motor_viscous"]),
+}
+
+
 def _lines(robot: kinergy.Robot) -> tuple[np.ndarray, np.ndarray]:
-    """Coulomb ``c`` and viscous ``b`` per motor (motor side), shape (n,) each."""
+    """Coulomb ``c`` and viscous ``b`` per motor (motor side), shape (n,) each: a Coulomb +
+    viscous family's own, any other's fitted over the grid."""
     n_mat = transmission_matrix(robot)
     speed = np.abs(n_mat) @ np.array([j.limits.speed for j in robot.joints])
     load = np.abs(np.linalg.inv(n_mat.T)) @ np.array([j.limits.torque for j in robot.joints])
@@ -129,7 +140,14 @@ def _lines(robot: kinergy.Robot) -> tuple[np.ndarray, np.ndarray]:
         )
         w, tau = w.ravel(), tau.ravel()
         friction = joint.drive.friction
-        f = friction_torque(friction.model, friction.params, w[:, None], tau[:, None]).ravel()
+        if friction.name in OWN_LINES:
+            c[k], b[k] = OWN_LINES[friction.name](friction.params)
+            continue
+        f = (
+            get_model(friction.model)
+            .friction_torque(friction.params, w[:, None], tau[:, None])
+            .ravel()
+        )
         c[k], b[k] = _nonnegative_line(np.column_stack([np.sign(w), w]), f)
     return c, b
 
@@ -593,7 +611,15 @@ BAD_IMPORTS: dict[str, tuple[Any, str]] = {
                 '<origin xyz="0.0 0.0 0.0996" rpy="0.0 0.0 0.1"',
             ),
         ),
-        "link 'flange'",
+        "joint 'flange_joint' <origin>",
+    ),
+    "edited-inertia": (
+        lambda f: (_exported(f), _edit(f, '<inertia ixx="', '<inertia ixx="1')),
+        "link 'shoulder_pan_link' <inertial> inertia",
+    ),
+    "added-link": (
+        lambda f: (_exported(f), _edit(f, "</robot>", '<link name="camera"/></robot>')),
+        "link 'camera' is not in it",
     ),
     "edited-dynamics": (
         lambda f: (_exported(f), _edit(f, '<dynamics damping="', '<dynamics damping="1')),
@@ -604,14 +630,26 @@ BAD_IMPORTS: dict[str, tuple[Any, str]] = {
         "version",
     ),
     "kinergy-number": (
-        lambda f: (_exported(f), _edit(f, 'torque_constant="', 'torque_constant="x')),
-        "torque_constant",
+        lambda f: (_exported(f), _edit(f, '"kt_over_kb": ', '"kt_over_kb": -')),
+        "joints[0] (shoulder_pan).drive: kt_over_kb: must be a finite number > 0",
     ),
     "kinergy-friction-unknown": (
-        lambda f: (_exported(f), _edit(f, 'model="power_flow"', 'model="magic"')),
+        lambda f: (_exported(f), _edit(f, '"model": "power_flow"', '"model": "magic"')),
         "magic",
     ),
-    "transmission-dropped": (lambda f: (_exported(f), _drop_transmission(f)), "gear ratio"),
+    "kinergy-json": (lambda f: (_exported(f), _edit(f, '"joints": [', '"joints": [[')), "JSON"),
+    "kinergy-earlier-export": (
+        lambda f: (
+            _exported(f),
+            _edit(f, "<kinergy:robot ", "<kinergy:model "),
+            _edit(f, "</kinergy:robot>", "</kinergy:model>"),
+        ),
+        "earlier kinergy",
+    ),
+    "transmission-dropped": (
+        lambda f: (_exported(f), _drop_transmission(f)),
+        "joint 'elbow' <transmission>",
+    ),
 }
 
 
@@ -623,6 +661,55 @@ def test_bad_urdf_import_is_one_line(case: str, tmp_path: Path) -> None:
         ["robot", "import-urdf", "robot.urdf", "--out", "m.toml"], tmp_path, refuse=True
     )
     assert named in outcome.err
+
+
+def test_a_hand_edited_inertia_is_named_with_both_values(tmp_path: Path) -> None:
+    """The standard elements are checked against the robot the file embeds: a link's inertia
+    changed by hand is refused, naming the link, the value found and the one embedded, with the
+    code a caller can test."""
+    _exported(tmp_path)
+    path = tmp_path / "robot.urdf"
+    text = path.read_text(encoding="utf-8")
+    link = re.search(r'<link name="elbow_link">.*?<inertia ixx="([^"]+)"', text, re.S)
+    assert link is not None
+    ixx = float(link.group(1))
+    edited = text.replace(f'ixx="{link.group(1)}"', f'ixx="{2 * ixx!r}"', 1)
+    path.write_text(edited, encoding="utf-8")
+    with pytest.raises(kinergy.KinergyError) as err:
+        kinergy.load_robot(path)
+    message = str(err.value)
+    assert err.value.code == Code.DISAGREES and "\n" not in message
+    assert message.startswith(f"{path}: link 'elbow_link' <inertial> inertia is ")
+    assert "remove the <kinergy:robot> element" in message
+    # without the element the edited standard elements are imported as they are
+    path.write_text(
+        re.sub(r"\s*<kinergy:robot version.*?</kinergy:robot>", "", edited, flags=re.S),
+        encoding="utf-8",
+    )
+    robot = kinergy.load_robot(path)
+    assert robot.convention == "mdh" and robot.n == 6
+
+
+@pytest.mark.parametrize("name", kinergy.library_names())
+def test_every_built_in_robot_comes_back_exactly_from_urdf_json_and_toml(
+    name: str, tmp_path: Path
+) -> None:
+    """One schema: TOML -> URDF -> TOML and TOML -> JSON -> TOML give the robot file's
+    dictionary back exactly (every string and float equal, not to a tolerance)."""
+    robot = kinergy.load_robot(name)
+    original = robot_to_dict(robot)
+    urdf = _write(tmp_path, robot_to_urdf(robot).text, "robot.urdf")
+    from_urdf = kinergy.load_robot(urdf)
+    kinergy.save_robot(from_urdf, tmp_path / "again.toml")
+    assert robot_to_dict(kinergy.load_robot(tmp_path / "again.toml")) == original
+    from_json = robot_from_dict(json.loads(json.dumps(original)))
+    kinergy.save_robot(from_json, tmp_path / "json.toml")
+    assert robot_to_dict(kinergy.load_robot(tmp_path / "json.toml")) == original
+    # the URDF embeds that very dictionary
+    embedded = re.search(
+        r"<kinergy:robot version=\"1\">(.*?)</kinergy:robot>", urdf.read_text(), re.S
+    )
+    assert embedded is not None and json.loads(embedded.group(1)) == original
 
 
 @pytest.mark.parametrize(
@@ -644,7 +731,7 @@ def test_foreign_urdf_gives_its_transmissions_and_dynamics(tmp_path: Path) -> No
     friction from <dynamics> referred to the motor; the geometry as modified DH."""
     robot = kinergy.load_robot("ur10e")
     text = robot_to_urdf(robot).text
-    text = re.sub(r"\s*<kinergy:model version.*?</kinergy:model>", "", text, flags=re.S)
+    text = re.sub(r"\s*<kinergy:robot version.*?</kinergy:robot>", "", text, flags=re.S)
     (tmp_path / "robot.urdf").write_text(text, encoding="utf-8")
     outcome = run_case(
         ["robot", "import-urdf", "robot.urdf", "--out", "m.toml"],
@@ -659,7 +746,7 @@ def test_foreign_urdf_gives_its_transmissions_and_dynamics(tmp_path: Path) -> No
     c, b = _lines(robot)
     for joint, ck, bk in zip(back.joints, c, b, strict=True):
         assert joint.drive.gear_ratio == 100.0
-        assert joint.drive.friction.model == "viscous_coulomb"
+        assert joint.drive.friction.name == "viscous_coulomb"
         assert joint.drive.friction.params["coulomb"] == pytest.approx(ck, rel=1e-12)
         assert joint.drive.friction.params["viscous"] == pytest.approx(bk, rel=1e-12)
     q, qd, qdd = random_state(robot, 20, seed=3)

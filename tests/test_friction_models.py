@@ -13,14 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import (
-    MODELS,
-    friction_columns,
-    friction_torque,
-    get_model,
-    linear_values,
-    with_linear_parameters,
-)
+from kinergy.friction.registry import MODELS, get_model
 
 #: test parameters of the models issue 13 adds (tests/test_drives.py covers the others)
 NEW_MODELS: dict[str, dict[str, float]] = {
@@ -71,10 +64,10 @@ def test_columns_times_values_is_the_torque(model: str, seed: int, scale: float)
     load = rng.normal(0, 1, 200)
     temperature = rng.uniform(15, 60, 200)
     params = _params(model)
-    values = linear_values(model, params) * scale
-    updated = with_linear_parameters(model, params, values)
-    cols = friction_columns(model, updated, wm, load, temperature=temperature)
-    torque = friction_torque(model, updated, wm, load, temperature=temperature)
+    values = get_model(model).values_of(params) * scale
+    updated = get_model(model).with_values(params, values)
+    cols = get_model(model).friction_columns(updated, wm, load, temperature=temperature)
+    torque = get_model(model).friction_torque(updated, wm, load, temperature=temperature)
     np.testing.assert_allclose(cols @ values, torque, rtol=1e-10, atol=1e-14)
 
 
@@ -95,8 +88,8 @@ def test_friction_dissipates_for_physical_parameters(
         # falling with temperature, but still >= 0 up to 80 deg C (the physical range)
         params["viscous_temperature"] = -params["viscous"] / 55.0 * rng.uniform(0, 1)
     wm = rng.normal(0, 200, 300)
-    tau = friction_torque(
-        model, params, wm, rng.normal(0, 2, 300), temperature=rng.uniform(-10, 80, 300)
+    tau = get_model(model).friction_torque(
+        params, wm, rng.normal(0, 2, 300), temperature=rng.uniform(-10, 80, 300)
     )
     assert np.all(tau * wm >= -1e-15)
 
@@ -105,37 +98,40 @@ def test_power_law_closed_form_and_its_exponent_one_is_viscous_coulomb() -> None
     p = NEW_MODELS["power_law"]
     wm = np.array([-300.0, -1.0, 50.0, 320.0])
     want = (0.05 + 4e-3 * np.abs(wm) ** 0.6) * np.tanh(wm / 1e-3)
-    np.testing.assert_allclose(friction_torque("power_law", p, wm), want, rtol=1e-12)
+    np.testing.assert_allclose(get_model("power_law").friction_torque(p, wm), want, rtol=1e-12)
     linear = {**p, "exponent": 1.0}
     vc = {"coulomb": 0.05, "viscous": 4e-3, "smoothing": 1e-3}
     np.testing.assert_allclose(
-        friction_torque("power_law", linear, wm), friction_torque("viscous_coulomb", vc, wm)
+        get_model("power_law").friction_torque(linear, wm),
+        get_model("viscous_coulomb").friction_torque(vc, wm),
     )
 
 
 def test_load_coulomb_rises_with_the_load_either_way() -> None:
     p = NEW_MODELS["load_coulomb"]
     wm = np.array([100.0, 100.0, 100.0])
-    tau = friction_torque("load_coulomb", p, wm, np.array([0.0, 1.0, -1.0]))
+    tau = get_model("load_coulomb").friction_torque(p, wm, np.array([0.0, 1.0, -1.0]))
     assert tau[1] == pytest.approx(tau[0] + 0.03) and tau[2] == pytest.approx(tau[1])
     with pytest.raises(KinergyError, match="load_coulomb.*needs the load torque"):
-        friction_torque("load_coulomb", p, wm)
+        get_model("load_coulomb").friction_torque(p, wm)
 
 
 def test_thermal_viscous_falls_as_the_joint_warms_and_needs_no_temperature() -> None:
     p = NEW_MODELS["thermal_viscous"]
     wm = np.full(3, 200.0)
-    warm = friction_torque("thermal_viscous", p, wm, temperature=np.array([25.0, 45.0, 65.0]))
+    warm = get_model("thermal_viscous").friction_torque(
+        p, wm, temperature=np.array([25.0, 45.0, 65.0])
+    )
     assert warm[0] > warm[1] > warm[2]
     # 20 K warmer: the viscous part falls by 20 * 4e-6 / 5e-4 = 16 %
     assert (warm[0] - warm[1]) / (5e-4 * 200.0) == pytest.approx(0.16)
     # no temperature: the reference temperature
-    assert friction_torque("thermal_viscous", p, wm)[0] == pytest.approx(warm[0])
+    assert get_model("thermal_viscous").friction_torque(p, wm)[0] == pytest.approx(warm[0])
 
 
 def test_directional_power_law_takes_each_directions_levels() -> None:
     p = NEW_MODELS["directional_power_law"]
-    tau = friction_torque("directional_power_law", p, np.array([100.0, -100.0]))
+    tau = get_model("directional_power_law").friction_torque(p, np.array([100.0, -100.0]))
     assert tau[0] == pytest.approx(0.05 + 4e-3 * 100**0.55)
     assert tau[1] == pytest.approx(-(0.06 + 5e-3 * 100**0.55))
 
@@ -147,11 +143,9 @@ def test_every_new_model_names_its_citation_and_search() -> None:
 
 
 def test_a_filter_overshoot_at_a_stop_does_not_set_the_held_friction() -> None:
-    from kinergy.friction.registry import friction_columns
-
     params = {"coulomb": 1.0, "viscous": 0.0, "smoothing": 0.01, "standstill": 0.5}
     wm = np.concatenate([np.full(20, -5.0), [0.6, 0.55], np.zeros(10)])  # ringing: 2 samples
-    cols = friction_columns("viscous_coulomb", params, wm, dwm=np.zeros_like(wm))
+    cols = get_model("viscous_coulomb").friction_columns(params, wm, dwm=np.zeros_like(wm))
     held = cols[-10:, 1]  # the Coulomb column
     assert np.allclose(held, -1.0)
 
@@ -163,6 +157,6 @@ def test_the_standstill_hold_does_not_cross_from_one_log_into_the_next() -> None
     z = np.zeros_like(wm)
     piece = np.repeat([0, 1], 20)
     params = {"coulomb": 1.0, "viscous": 0.0, "smoothing": 0.01, "standstill": 0.5}
-    cols = _columns("viscous_coulomb", params, _Signals(z, wm, z, z, None, piece))
+    cols = _columns(get_model("viscous_coulomb"), params, _Signals(z, wm, z, z, None, piece))
     assert np.allclose(cols[10:20, 2], 1.0)  # the first log's stop holds its last motion
     assert np.allclose(cols[20:30, 2], 0.0)  # the second log starts at rest: nothing to hold

@@ -26,8 +26,6 @@ from hypothesis import strategies as st
 from kinergy.model import load_robot, robot_to_dict
 from kinergy.model.urdf_export import robot_to_urdf
 
-pytest.importorskip("yourdfpy")
-
 FUZZ = settings(
     derandomize=True,
     deadline=None,

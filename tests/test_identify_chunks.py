@@ -59,7 +59,7 @@ def _written(robot: Robot) -> dict[str, float]:
                 out[f"{j}.{f.name}"] = float(value)
         for name, value in joint.drive.friction.params.items():
             out[f"{j}.friction.{name}"] = float(value)
-        out[f"{j}.friction.model={joint.drive.friction.model}"] = 0.0
+        out[f"{j}.friction.model={joint.drive.friction.name}"] = 0.0
     return out
 
 

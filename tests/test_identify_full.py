@@ -19,7 +19,9 @@ import pytest
 
 import kinergy
 import kinergy.identification.writeback as writeback
+from kinergy.errors import Code
 from kinergy.identification.full import identify_full
+from kinergy.identification.options import IdentifyOptions, Method
 from kinergy.identification.physical import (
     inertia_vector,
     link_consistency,
@@ -205,12 +207,12 @@ def test_current_with_friction_reproduces_the_currents(
     current = result.fit.current
     assert min(c.r2 for c in current) > 0.9999
     for entry, joint in zip(result.joints, ur5e.joints, strict=True):  # power-flow friction
-        assert entry.friction["model"] == "power_flow"
+        assert entry.friction.name == "power_flow"
         for name in ("viscous", "coulomb_direct", "coulomb_reverse"):
-            assert entry.friction[name] == pytest.approx(
+            assert entry.friction.params[name] == pytest.approx(
                 joint.drive.friction.params[name], rel=1e-6
             )
-        assert entry.friction["smoothing"] == joint.drive.friction.params["smoothing"]
+        assert entry.friction.params["smoothing"] == joint.drive.friction.params["smoothing"]
         assert entry.torque_constant == joint.drive.torque_constant
     assert result.fit.power_flow_mismatch == 0
     assert result.robot.sources["friction"].status == "identified"
@@ -241,9 +243,9 @@ def test_load_proportional_friction_is_fitted_on_the_load_it_sees(
     values, _ = identified_base(result)
     np.testing.assert_allclose(values, expected_base(result, truth), rtol=1e-6, atol=1e-9)
     for entry, joint in zip(result.joints, truth.joints, strict=True):
-        assert entry.friction["model"] == "load_coulomb"
+        assert entry.friction.name == "load_coulomb"
         for name in ("coulomb", "load", "viscous"):
-            assert entry.friction[name] == pytest.approx(
+            assert entry.friction.params[name] == pytest.approx(
                 joint.drive.friction.params[name], rel=1e-6
             )
 
@@ -491,10 +493,33 @@ def test_too_few_samples_and_bad_options_are_refused(
         identify_full(ur5e, [exact_log], solver="ridge")
     with pytest.raises(kinergy.KinergyError, match="only used by solver 'ridge'"):
         identify_full(ur5e, [exact_log], ridge=0.1)
-    with pytest.raises(kinergy.KinergyError, match="unknown friction model"):
+    with pytest.raises(kinergy.KinergyError, match="friction: must be one of .*, got 'dahl'"):
         identify_full(ur5e, [exact_log], target="current", friction="dahl")
     with pytest.raises(kinergy.KinergyError, match="no log"):
         identify_full(ur5e, [])
+
+
+def test_friction_auto_works_with_the_full_method_or_says_what_it_needs(
+    ur5e_vc: kinergy.Robot, noisy_vc_log: IdentData
+) -> None:
+    # with currents in the logs the regression takes each joint's own family and the currents
+    # choose each joint's, as the sequential method does
+    result = identify_full(ur5e_vc, [noisy_vc_log], target="moment", friction="auto")
+    choices = result.fit.friction_choice
+    assert choices is not None and len(choices) == ur5e_vc.n
+    assert all(c is not None and c.model.name in c.cv_rms for c in choices)
+    # each joint has the family chosen for it (or keeps its own where that fit is not physical)
+    for joint, start, c in zip(result.joints, ur5e_vc.joints, choices, strict=True):
+        assert c is not None and joint.friction.model in (c.model, start.drive.friction.model)
+    # without currents nothing can choose: refused, saying what it needs, with its code
+    no_current = dataclasses.replace(noisy_vc_log, current=None)
+    with pytest.raises(kinergy.KinergyError, match="--friction auto .* actual_current") as err:
+        identify_full(ur5e_vc, [no_current], target="moment", friction="auto")
+    assert err.value.code == Code.UNSUPPORTED
+    # the nursing method fits its own friction: any --friction is refused, naming the methods
+    with pytest.raises(kinergy.KinergyError, match="sequential and full methods") as err:
+        IdentifyOptions(method=Method.NURSING, friction="auto")
+    assert err.value.code == Code.UNSUPPORTED
 
 
 def test_an_unexcited_regression_is_refused(ur5e: kinergy.Robot) -> None:

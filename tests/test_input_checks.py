@@ -106,3 +106,22 @@ def test_warnings_are_picked_by_code_not_text() -> None:
         Message(w).prefixed("run.csv") if isinstance(w, Message) else w for w in said.warnings
     ]
     assert coded(prefixed, Code.PAYLOAD_MISSING) == ["run.csv: a payload the model lacks"]
+
+
+def test_an_identified_payload_takes_the_payload_warning_by_its_code() -> None:
+    """``identify --payload-only``: the logs' "payload the model lacks" is what it identifies,
+    so it is routine there (a note); a warning of other words is left a warning, whatever it
+    says."""
+    import kinergy
+    from kinergy.logs.checks import LogChecks
+    from kinergy.logs.reading import InputLogs
+    from kinergy.workflows.identify import PayloadRun
+
+    lacks = Message(
+        "fits the arm carrying 2 kg at [0, 0, 0.05] m that the model lacks", Code.PAYLOAD_MISSING
+    )
+    other = "a warning that mentions that the model lacks something else"
+    checks = LogChecks(log="run.csv", warnings=(lacks.prefixed("run.csv"), other))
+    run = PayloadRun(kinergy.load_robot("ur5e"), None, InputLogs(checks=[checks]))  # type: ignore[arg-type]
+    assert run.lacks == [f"run.csv: {lacks}"]
+    assert run.warnings == [other]

@@ -32,7 +32,7 @@ def test_the_truth_is_seeded_and_differs_from_the_model_within_its_spreads(
     for tj, mj in zip(truth.joints, ur5e.joints, strict=True):
         assert abs(tj.drive.motor_inertia / mj.drive.motor_inertia - 1) <= 0.08
         assert abs(tj.link.mass / mj.link.mass - 1) <= 0.01
-        assert tj.drive.friction.model == "load_thermal_power_law"
+        assert tj.drive.friction.name == "load_thermal_power_law"
         p = tj.drive.friction.params
         assert 0.5 <= p["exponent"] <= 0.65 and 0.01 <= p["load"] <= 0.03
         assert p["viscous_temperature"] < 0  # friction falls as the joint warms
@@ -85,7 +85,9 @@ def test_identification_recovers_the_truth_not_the_model(
     choices = result.fit.friction_choice
     assert choices is not None and all(c is not None for c in choices)
     # the concave truth beats a straight line on every joint
-    assert all(c.model != "viscous_coulomb" and c.gain_over_viscous_coulomb > 0 for c in choices)
+    assert all(
+        c.model.name != "viscous_coulomb" and c.gain_over_viscous_coulomb > 0 for c in choices
+    )
     assert any("written into the model" in n for n in result.notes)
 
 
@@ -97,7 +99,7 @@ def test_cli_simulate_mismatch_writes_the_truth(
     assert main([*argv, "--mismatch", "realistic", "--truth", str(truth)]) == 0
     assert "mismatch realistic" in capsys.readouterr().out
     robot = kinergy.load_robot(truth)
-    assert robot.joints[0].drive.friction.model == "load_thermal_power_law"
+    assert robot.joints[0].drive.friction.name == "load_thermal_power_law"
     assert main([*argv, "--truth", str(out)]) == 1  # --truth may not overwrite --out
     assert main([*argv[:-2], "--out", str(tmp_path / "b.csv")]) == 0
     assert "mismatch none" in capsys.readouterr().out

@@ -113,7 +113,9 @@ def test_friction_validation() -> None:
         Friction(
             "viscous_coulomb", {"viscous": 1e-3, "coulomb": 0.1, "smoothing": 1e-3, "stiction": 1}
         )
-    with pytest.raises(KinergyError, match="'smoothing' must be > 0"):
+    with pytest.raises(
+        KinergyError, match="friction parameter 'smoothing': must be a finite number > 0, got 0"
+    ):
         Friction("viscous_coulomb", {"viscous": 1e-3, "coulomb": 0.1, "smoothing": 0.0})
 
 
@@ -159,7 +161,7 @@ def _ur5e_dict() -> dict:
             lambda d: d["joints"][3].update(colour="blue"),
             r"joints\[3\] \(wrist_1\): unknown field\(s\) 'colour'",
         ),
-        (lambda d: d.update(convention="euler"), "convention must be one of dh, mdh"),
+        (lambda d: d.update(convention="euler"), "convention: must be one of dh, mdh, got 'euler'"),
         (
             lambda d: d["joints"][5]["limits"].update(position=[1.0, -1.0]),
             r"limits.position must be \[lower, upper\]",
@@ -324,7 +326,7 @@ def _rz_ry_rx(roll: float, pitch: float, yaw: float) -> np.ndarray:
 
 
 def test_rpy_is_urdfs_fixed_axis_convention_and_round_trips() -> None:
-    from kinergy.model.toml import matrix_rpy, rpy_matrix
+    from kinergy.model.frames import matrix_rpy, rpy_matrix
 
     rng = np.random.default_rng(4)
     angles = rng.uniform(-np.pi, np.pi, (200, 3)) * np.array([1.0, 0.5, 1.0])

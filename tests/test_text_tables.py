@@ -10,7 +10,7 @@ import pytest
 
 import kinergy
 from kinergy.cli.common import TABLE_WIDTH, table
-from kinergy.friction.registry import MODELS, parameter_units
+from kinergy.friction.registry import MODELS, get_model
 from kinergy.model.robot import Friction
 from kinergy.report.tables import parameter_tables
 
@@ -50,7 +50,7 @@ def test_a_cell_wider_than_the_line_wraps_within_its_row() -> None:
 
 @pytest.mark.parametrize("name", sorted(MODELS))
 def test_every_friction_parameter_has_a_unit(name: str) -> None:
-    units = parameter_units(name)
+    units = get_model(name).parameter_units()
     spec = MODELS[name]
     assert set(spec.units) == set(spec.parameters)
     assert list(units)[: len(spec.parameters)] == list(spec.parameters)
@@ -132,12 +132,10 @@ def test_identify_prints_one_friction_table_per_model_within_the_width(
     )
     text = capsys.readouterr().out
     assert max(len(line) for line in text.splitlines()) <= TABLE_WIDTH
-    from kinergy.friction.registry import get_model
-
     models = {j.drive.friction.model for j in kinergy.load_robot(out).joints}
     for model in models:
         assert f"Friction, {model} (motor side)" in text
-        units = parameter_units(model)
+        units = get_model(model).parameter_units()
         for name in get_model(model).parameters:  # each parameter a column, with its unit
             assert (f"{name} [{units[name]}]" if units[name] else name) in text
     assert "friction (motor side)" not in text  # no longer one run-on column

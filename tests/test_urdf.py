@@ -26,7 +26,6 @@ import kinergy
 from kinergy.cli import main
 from kinergy.model.urdf import robot_from_urdf
 
-pytest.importorskip("yourdfpy")
 pin = pytest.importorskip("pinocchio")
 
 TOL = 1e-9
@@ -424,10 +423,13 @@ def test_unknown_root_or_tip(tmp_path: Path) -> None:
         robot_from_urdf(path, root="lower", tip="upper")
 
 
-def test_missing_yourdfpy_is_a_clear_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_urdf_needs_no_extra_package(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The standard library reads URDF: with yourdfpy (or any URDF parser) unimportable the
+    import works the same."""
     monkeypatch.setitem(sys.modules, "yourdfpy", None)
-    with pytest.raises(kinergy.KinergyError, match=r"pip install kinergy\[urdf\]"):
-        robot_from_urdf(_write(tmp_path, "two.urdf", _two_joint()))
+    monkeypatch.setitem(sys.modules, "urdf_parser_py", None)
+    robot = robot_from_urdf(_write(tmp_path, "two.urdf", _two_joint()))
+    assert robot.joint_names == ["shoulder", "elbow"]
 
 
 @pytest.mark.parametrize("case", ["malformed", "prismatic", "no_limit"])

@@ -81,8 +81,8 @@ _API = {
     "Target": "kinergy.identification.options",
     "Solver": "kinergy.identification.options",
     "EnergyOptions": "kinergy.workflows.energy",
-    "MOTION_SOURCES": "kinergy.workflows.energy",
-    "MISMATCHES": "kinergy.twin",
+    "MotionSource": "kinergy.trajectory.motion",
+    "Mismatch": "kinergy.twin",
     "SimulateOptions": "kinergy.workflows.twin",
     "FleetOptions": "kinergy.workflows.fleet",
     "ProgramOptions": "kinergy.optimize.options",
@@ -117,15 +117,13 @@ _API = {
     "PlaceRun": "kinergy.workflows.place",
     "LibraryRobot": "kinergy.workflows.robots",
     "RobotFile": "kinergy.workflows.robots",
-    "UrdfRead": "kinergy.workflows.robots",
+    "UrdfImport": "kinergy.model.urdf",
     "CalibrationImport": "kinergy.workflows.calibration",
     "Export": "kinergy.model.export",
 }
 
 __all__ = [
     "MAX_POINTS",
-    "MISMATCHES",
-    "MOTION_SOURCES",
     "TASK_POINTS",
     "CalibrationImport",
     "Configurations",
@@ -146,7 +144,9 @@ __all__ = [
     "LogEnergy",
     "LogReading",
     "Method",
+    "Mismatch",
     "MonitorRun",
+    "MotionSource",
     "NursingStudy",
     "NursingStudyOptions",
     "OptimizeRun",
@@ -166,7 +166,7 @@ __all__ = [
     "StudyReport",
     "Target",
     "ToolSymmetry",
-    "UrdfRead",
+    "UrdfImport",
     "ValidationReport",
     "ViaPoints",
     "demo",
@@ -213,12 +213,14 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from kinergy.live.stream import RecordOptions, StreamOptions
     from kinergy.logs.reading import LogReading
     from kinergy.model.export import Export
+    from kinergy.model.urdf import UrdfImport
     from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
     from kinergy.optimize.placement import PlacementGrid, Range
-    from kinergy.twin import MISMATCHES
+    from kinergy.trajectory.motion import MotionSource
+    from kinergy.twin import Mismatch
     from kinergy.workflows.calibration import CalibrationImport
     from kinergy.workflows.demo import DemoRun
-    from kinergy.workflows.energy import MOTION_SOURCES, EnergyOptions, LogEnergy
+    from kinergy.workflows.energy import EnergyOptions, LogEnergy
     from kinergy.workflows.excite import ExciteOptions, ExciteRun, FloorFrames
     from kinergy.workflows.fleet import FleetOptions
     from kinergy.workflows.identify import PayloadRun
@@ -227,7 +229,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from kinergy.workflows.optimize import OptimizeRun
     from kinergy.workflows.optimize_program import ProgramRun
     from kinergy.workflows.place import PlaceRun
-    from kinergy.workflows.robots import ExportFormat, LibraryRobot, RobotFile, UrdfRead
+    from kinergy.workflows.robots import ExportFormat, LibraryRobot, RobotFile
     from kinergy.workflows.study import StudyReport
     from kinergy.workflows.twin import SimulateOptions, Simulation
 

@@ -10,13 +10,13 @@ from kinergy.checks import choice
 from kinergy.files import check_outputs, check_replaceable
 from kinergy.model.export import Export
 from kinergy.model.library import load_robot
+from kinergy.model.urdf import UrdfImport
 from kinergy.workflows.calibration import CalibrationImport
 from kinergy.workflows.calibration import import_calibration as run_import
 from kinergy.workflows.robots import (
     ExportFormat,
     LibraryRobot,
     RobotFile,
-    UrdfRead,
     library,
     read_urdf,
 )
@@ -79,9 +79,8 @@ def import_urdf(
     root: str | None = None,
     tip: str | None = None,
     name: str | None = None,
-) -> UrdfRead:
+) -> UrdfImport:
     """``kinergy robot import-urdf``: a URDF's serial chain from ``root`` to ``tip`` as a robot
-    file (TOML) at ``out``; a URDF written by :func:`export_robot` gives back its model. Needs
-    the urdf extra."""
+    file (TOML) at ``out``; a URDF written by :func:`export_robot` gives back its model."""
     check_replaceable(out)
     return read_urdf(urdf, out, root=root, tip=tip, name=name)

@@ -10,6 +10,7 @@ from kinergy.files import atomic_write, check_replaceable
 from kinergy.jsonable import dumps
 from kinergy.logs.reading import LogReading
 from kinergy.trajectory.motion import Motion
+from kinergy.twin import Mismatch
 from kinergy.workflows.demo import DemoRun, run_demo
 from kinergy.workflows.excite import ExciteOptions, ExciteRun, run_excite
 from kinergy.workflows.nursing import NursingStudy, NursingStudyOptions
@@ -87,7 +88,10 @@ def nursing_study(
 
 
 def demo(
-    out: PathLike | None = None, *, mismatch: str = "realistic", progress: Progress | None = None
+    out: PathLike | None = None,
+    *,
+    mismatch: Mismatch | str = Mismatch.REALISTIC,
+    progress: Progress | None = None,
 ) -> DemoRun:
     """``kinergy demo``: the UR5e study on the built-in twin (simulate tests A and B, identify
     on A, validate on A and B, the energy, UR5e Tables IV-VIII and the twin's truth against the

@@ -10,6 +10,7 @@ import click
 from kinergy import api
 from kinergy.cli.common import (
     as_usage,
+    choice_of,
     json_result,
     load,
     payload_option,
@@ -125,8 +126,8 @@ def energy_text(result: api.LogEnergy) -> str:
 )
 @click.option(
     "--source",
-    type=click.Choice(api.MOTION_SOURCES),
-    default="auto",
+    type=choice_of(api.MotionSource),
+    default=api.MotionSource.AUTO.value,
     show_default=True,
     help="Which motion of a log: commanded (target_*) or measured (actual_*).",
 )
@@ -138,7 +139,7 @@ def energy(
     motion_path: str,
     as_json: bool,
     no_recovery: bool,
-    source: str,
+    source: api.MotionSource,
     payload: str | None,
     reading: LogReading,
 ) -> None:

@@ -17,9 +17,17 @@ from kinergy.cli.common import (
     writes,
 )
 from kinergy.cli.validate import validation_text
-from kinergy.friction.registry import MODELS, parameter_units
+from kinergy.friction.registry import MODELS
 from kinergy.identification.full import FullFit
-from kinergy.identification.options import AUTO, MAX_RIDGE, IdentifyOptions, Method, Solver, Target
+from kinergy.identification.options import (
+    AUTO,
+    MAX_RIDGE,
+    IdentifyOptions,
+    Method,
+    Solver,
+    Target,
+    friction_option,
+)
 from kinergy.identification.payload import PayloadEstimate
 from kinergy.identification.result import FLAGS, IDENTIFIED, DriveEstimate, IdentificationResult
 from kinergy.logs.reading import LogReading
@@ -99,8 +107,8 @@ def _choice_text(result: IdentificationResult) -> list[str]:
         rows.append(
             [
                 name,
-                c.model,
-                f"{c.cv_rms[c.model]:.4f}",
+                c.model.name,
+                f"{c.cv_rms[c.model.name]:.4f}",
                 "-" if gain is None else f"{gain:.1f}",
                 "-" if margin is None else f"{margin:.1f}",
             ]
@@ -114,21 +122,21 @@ def _friction_tables(result: IdentificationResult) -> list[str]:
     """One table per friction model in the result: a column per parameter with its unit (motor
     side), each value with its standard error and flag."""
     lines: list[str] = []
-    models = dict.fromkeys(str(j.friction["model"]) for j in result.joints)
+    models = dict.fromkeys(j.friction.model for j in result.joints)
     for model in models:
-        units = parameter_units(model)
-        names = [k for k in units if any(k in j.friction for j in result.joints)]
+        units = model.parameter_units()
+        names = [k for k in units if any(k in j.friction.params for j in result.joints)]
         headers = ["joint", *(f"{k} [{units[k]}]" if units[k] else k for k in names)]
         rows = [
             [
                 j.name,
                 *(
-                    _with_std(j, k, float(j.friction[k]), ".4g") if k in j.friction else "-"
+                    _with_std(j, k, j.friction.params[k], ".4g") if k in j.friction.params else "-"
                     for k in names
                 ),
             ]
             for j in result.joints
-            if j.friction["model"] == model
+            if j.friction.model is model
         ]
         lines += [f"\nFriction, {model} (motor side)", table(headers, rows)]
     return lines
@@ -186,11 +194,12 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 @click.option(
     "--friction",
     "friction",
-    type=click.Choice([*sorted(MODELS), AUTO]),
+    type=click.Choice([*sorted(MODELS), AUTO.value]),
     default=None,
     help="Friction model for every joint (default: the model's own), e.g. power_law, "
     "load_coulomb, thermal_viscous; auto: per joint, the model with the lowest "
-    "cross-validated current RMS (sequential method).",
+    "cross-validated current RMS (sequential and full methods; the logs need actual_current). "
+    "The nursing method fits its own (Makkar) friction and takes none.",
 )
 @click.option(
     "--target",
@@ -242,7 +251,11 @@ def identify(
     """
     with as_usage():
         options = IdentifyOptions(
-            method=method, friction=friction, target=target, solver=solver, ridge=ridge
+            method=method,
+            friction=friction_option(friction),
+            target=target,
+            solver=solver,
+            ridge=ridge,
         )
     r = load_robot(robot_name)
     with progress() as say:

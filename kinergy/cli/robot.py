@@ -127,7 +127,7 @@ def _drives(r: Robot) -> str:
                 fmt(d.torque_constant),
                 fmt(d.motor_constant),
                 fmt(d.kt_over_kb),
-                f"{d.friction.model} {friction}",
+                f"{d.friction.name} {friction}",
             ]
         )
     return table(headers, rows)
@@ -198,7 +198,7 @@ def _calibration_text(result: api.CalibrationImport, out: str, points: bool) -> 
             [
                 j.name,
                 f"{j.torque_constant:.4f}",
-                f"{j.friction.model} {params}",
+                f"{j.friction.model.name} {params}",
                 f"{100 * np.max(np.abs(model / measured - 1)):.1f}",
                 "yes" if np.all(np.abs(model - measured) <= tol) else "NO",
                 f"{100 * np.max(np.abs(contrast / measured - 1)):.1f}",
@@ -282,8 +282,8 @@ def _source(model: str) -> str:
     "format_name",
     type=choice_of(api.ExportFormat),
     required=True,
-    help="urdf: kinematics, link inertials, limits and joint-side friction, with the drives in a "
-    "<kinergy:model> element (robot import-urdf reads it back); mjcf: a MuJoCo model with the "
+    help="urdf: kinematics, link inertials, limits and joint-side friction, with the robot file "
+    "itself in a <kinergy:robot> element (robot import-urdf reads it back); mjcf: a MuJoCo model with the "
     "reflected rotor inertia as armature, the friction as damping and frictionloss, torque "
     "actuators.",
 )
@@ -316,14 +316,18 @@ def robot_import_urdf(
 ) -> None:
     """Read a URDF serial chain into a robot file (TOML).
 
-    A URDF written by `kinergy robot export` gives back the model it was written from (its
-    <kinergy:model> element holds the drives and what else URDF cannot). Any other URDF gives
-    modified-DH kinematics, the link inertials and limits, gear ratios from ROS
-    SimpleTransmissions and Coulomb + viscous friction from <dynamics>; the rest of the drives
+    A URDF written by `kinergy robot export` gives back the robot file it was written from (its
+    <kinergy:robot> element holds it), after checking the standard elements against it. Any other
+    URDF, as published (meshes and the like are skipped), gives modified-DH kinematics, the link
+    inertials and limits, gear ratios from <transmission> (ROS or ros2_control
+    SimpleTransmission; Drake's drake:gear_ratio), rotor inertias where a transmission gives them
+    (drake:rotor_inertia) and Coulomb + viscous friction from <dynamics>; the rest of the drives
     is nominal: identify it from logs before trusting energy predictions.
     """
     result = api.import_urdf(urdf, out, root=root, tip=tip, name=name)
     r = result.robot
+    for text in result.notes:
+        note(text)
     if not result.restored:
         note(
             "the drives not in the URDF are nominal (marked so in the robot file): identify them "

@@ -7,6 +7,7 @@ import click
 from kinergy import api
 from kinergy.cli.common import (
     as_usage,
+    choice_of,
     load,
     log_output,
     output_file_option,
@@ -35,8 +36,8 @@ __all__ = ["simulate"]
 @output_file_option("--out", "Log to write.", required=True)
 @click.option(
     "--mismatch",
-    type=click.Choice(api.MISMATCHES),
-    default="none",
+    type=choice_of(api.Mismatch),
+    default=api.Mismatch.NONE.value,
     show_default=True,
     help="none: ROBOT itself is the truth; realistic: a true robot that differs from ROBOT "
     "(inertias, k_t, electrics, concave load- and temperature-dependent friction) with a real "
@@ -68,7 +69,7 @@ def simulate(
     robot_name: str,
     trajectory: str,
     out: str,
-    mismatch: str,
+    mismatch: api.Mismatch,
     truth_out: str | None,
     exact: bool,
     lag: float | None,

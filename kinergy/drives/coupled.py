@@ -41,6 +41,7 @@ from kinergy.arrays import Array
 from kinergy.drives.electrics import friction_torques, torque_constants
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.errors import KinergyError
+from kinergy.friction.makkar import MODEL as MAKKAR
 from kinergy.friction.makkar import PARAMETERS as MAKKAR_PARAMETERS
 from kinergy.model.robot import Robot
 
@@ -262,7 +263,7 @@ def joint_side_makkar(robot: Robot, joint: int) -> Array | None:
     except KinergyError:
         return None
     frictions = [robot.joints[m].drive.friction for m in motors]
-    if any(f.model != "makkar" for f in frictions):
+    if any(f.model is not MAKKAR for f in frictions):
         return None
     g = np.array([frictions[0].params[name] for name in MAKKAR_PARAMETERS])
     if any(

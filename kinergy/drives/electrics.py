@@ -34,7 +34,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kinergy.arrays import Array
-from kinergy.friction.registry import friction_torque
 from kinergy.model.robot import Robot
 
 __all__ = [
@@ -114,10 +113,7 @@ def friction_torques(
     """
     out = np.empty_like(wm)
     for i, joint in enumerate(robot.joints):
-        fr = joint.drive.friction
         acc = None if dwm is None else dwm[:, i]
         temp = None if temperature is None else temperature[:, i]
-        out[:, i] = friction_torque(
-            fr.model, fr.params, wm[:, i], tau_load[:, i], acc, temperature=temp
-        )
+        out[:, i] = joint.drive.friction.torque(wm[:, i], tau_load[:, i], acc, temperature=temp)
     return out

@@ -21,6 +21,7 @@ from typing import TypeGuard
 import numpy as np
 from numpy.typing import ArrayLike
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.model.frames import robot_transforms
@@ -352,7 +353,5 @@ def gravity_in_frame0(robot: Robot, gravity: ArrayLike | None) -> Array | None:
     """
     if gravity is None:
         return None
-    g = np.asarray(gravity, dtype=float)
-    if g.shape != (3,) or not np.all(np.isfinite(g)):
-        raise KinergyError(f"gravity: expected 3 finite numbers, got {g.tolist()}")
+    g = checks.vector(gravity, "gravity", length=3)
     return np.ascontiguousarray(robot.base[:3, :3].T @ g)

@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.dynamics.chain import kernel_data
 from kinergy.dynamics.kinematics import joint_axes
@@ -174,9 +175,9 @@ def _position_bounds(
     limits = np.array([j.limits.position for j in robot.joints])
     lower, upper = limits[:, 0].copy(), limits[:, 1].copy()
     if position_range is not None:
-        half = _as_vector(position_range, robot.n, "position range")
-        if np.any(half <= 0):
-            raise KinergyError(f"position range must be > 0 rad, got {half.tolist()}")
+        half = checks.vector(
+            _as_vector(position_range, robot.n, "position range"), "position range", gt=0.0
+        )
         lower = np.maximum(lower, q_start - half)
         upper = np.minimum(upper, q_start + half)
     if np.any(upper - lower <= 0):
@@ -217,8 +218,7 @@ def _check_floor(robot: Robot, q_start: Array, floor: float | None, floor_frames
         )
     if floor is None:
         return
-    if not np.isfinite(floor):
-        raise KinergyError(f"floor must be a finite height in m, got {floor}")
+    floor = checks.number(floor, "floor")
     heights, _ = frame_heights(robot, q_start[None, :], floor_frames, jacobian=False)
     if np.min(heights) <= floor:
         raise KinergyError(

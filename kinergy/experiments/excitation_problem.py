@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.experiments.excitation_limits import (
@@ -215,8 +216,7 @@ def _check_options(harmonics: int, period: float, dt: float, criterion: str, sam
             f"harmonics must be >= 2, got {harmonics}: with zero speed and acceleration at both "
             "ends a single harmonic cannot move"
         )
-    if not (np.isfinite(period) and period > 0):
-        raise KinergyError(f"period must be > 0 s, got {period}")
+    period = checks.number(period, "period", gt=0.0)
     if not (np.isfinite(dt) and 0 < dt < period):
         raise KinergyError(f"dt must be in (0, period), got {dt}")
     if criterion not in CRITERIA:

@@ -8,8 +8,8 @@ The regression the full identification solves (:mod:`kinergy.identification.full
 stacked over a grid of samples gives ``W`` (samples x n rows). Its columns are the link base
 columns ``Y_b`` (:func:`kinergy.dynamics.regressor.base_parameters`) and, with the drives, every
 motor's rotor-inertia column (``N[m, j] (N qdd)_m``, UR5e eq 2; ``N`` and ``wm = N qd`` from
-:mod:`kinergy.drives.transmission`) and its friction columns: the registry's
-``viscous_coulomb`` columns (:func:`kinergy.friction.registry.friction_columns`; viscous ``wm``,
+:mod:`kinergy.drives.transmission`) and its friction columns: the
+``viscous_coulomb`` columns (:meth:`kinergy.friction.model.FrictionModel.friction_columns`; viscous ``wm``,
 Coulomb ``tanh(wm / (|i| * 0.05 rad/s))``, a smooth sign), reflected to the joints by ``N^T``.
 A drive column that is a combination of the link base columns for every motion (on a UR arm
 ``J_1`` multiplies the same ``qdd_1`` on joint 1 as the ``Iyy1`` group) is left out: no trajectory
@@ -46,7 +46,7 @@ from kinergy.dynamics.regressor import (
     regressor,
     regressor_gradient,
 )
-from kinergy.friction.registry import friction_columns
+from kinergy.friction.viscous_coulomb import MODEL as VISCOUS_COULOMB
 from kinergy.linalg import column_scale, pivoted_rank
 from kinergy.model.robot import Robot
 
@@ -64,8 +64,6 @@ __all__ = [
 CRITERIA = ("cond", "dopt")
 #: joint-side speed (rad/s) of the tanh that stands in for the Coulomb column's sign
 COULOMB_SMOOTHING = 0.05
-#: the friction model whose columns stand for every motor's friction (viscous and Coulomb)
-_FRICTION = "viscous_coulomb"
 #: a drive column whose part independent of the link base columns is below this is dependent
 _DEPENDENT_TOL = 1e-8
 #: central-difference step of the friction columns' derivative in qd, rad/s
@@ -74,9 +72,9 @@ _FD_STEP = 1e-6
 
 def _motor_columns(smoothing: Array, wm: Array, dwm: Array) -> Array:
     """Rotor-inertia, viscous and Coulomb columns of every motor, motor side, (N, 3, n):
-    ``dwm``, then the registry's viscous and Coulomb columns of ``wm`` at ``smoothing[m]``."""
+    ``dwm``, then the ``viscous_coulomb`` model's viscous and Coulomb columns of ``wm`` at ``smoothing[m]``."""
     friction = [
-        friction_columns(_FRICTION, {"viscous": 0.0, "coulomb": 0.0, "smoothing": s}, wm[:, m])
+        VISCOUS_COULOMB.friction_columns({"viscous": 0.0, "coulomb": 0.0, "smoothing": s}, wm[:, m])
         for m, s in enumerate(smoothing)
     ]  # each (N, 2): viscous, Coulomb
     return np.concatenate([dwm[:, None, :], np.stack(friction, axis=2)], axis=1)

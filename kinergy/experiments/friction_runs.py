@@ -21,6 +21,7 @@ import numpy as np
 import scipy.optimize
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.dynamics.chain import make_chain
 from kinergy.dynamics.kinematics import joint_axes
@@ -162,10 +163,7 @@ def _check_options(robot: Robot, joint: int, **options: float) -> None:
     if not 0 <= joint < robot.n:
         raise KinergyError(f"joint index {joint} out of range for {robot.name} ({robot.n} joints)")
     for name, value in options.items():
-        if name != "dwell" and not (np.isfinite(value) and value > 0):
-            raise KinergyError(f"{name} must be > 0, got {value}")
-    if not (np.isfinite(options["dwell"]) and options["dwell"] >= 0):
-        raise KinergyError(f"dwell must be >= 0, got {options['dwell']}")
+        checks.number(value, name, **({"ge": 0.0} if name == "dwell" else {"gt": 0.0}))
 
 
 def _speed_levels(robot: Robot, joint: int, speeds: ArrayLike | None) -> Array:

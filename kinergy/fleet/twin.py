@@ -23,10 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from kinergy.friction.registry import linear_values, with_linear_parameters
 from kinergy.io.rtde import write_log
 from kinergy.model.library import load_robot
-from kinergy.model.robot import Friction, Payload, Robot
+from kinergy.model.robot import Payload, Robot
 from kinergy.trajectory.motion import CONTROLLER_DT, Motion
 from kinergy.trajectory.movej import movej
 from kinergy.trajectory.programs import UR_HOME, pad_rest, paper_trajectory
@@ -60,8 +59,7 @@ def with_friction_scaled(robot: Robot, scale: float) -> Robot:
     joints = []
     for joint in robot.joints:
         f = joint.drive.friction
-        params = with_linear_parameters(f.model, f.params, linear_values(f.model, f.params) * scale)
-        drive = dataclasses.replace(joint.drive, friction=Friction(f.model, params))
+        drive = dataclasses.replace(joint.drive, friction=f.with_values(f.values * scale))
         joints.append(dataclasses.replace(joint, drive=drive))
     return robot.with_joints(joints)
 

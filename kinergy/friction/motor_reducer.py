@@ -56,4 +56,5 @@ MODEL = FrictionModel(
     },
     linear_values=_linear_values,
     with_linear=_with_linear,
+    line=lambda p: (p["motor_coulomb"] + p["reducer_coulomb"], p["motor_viscous"]),
 )

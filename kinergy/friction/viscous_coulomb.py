@@ -37,4 +37,5 @@ MODEL = FrictionModel(
     columns=columns,
     citation="framework Table 1",
     units={"viscous": "N m s/rad", "coulomb": "N m", "smoothing": "rad/s"},
+    line=lambda p: (p["coulomb"], p["viscous"]),
 )

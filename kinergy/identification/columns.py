@@ -7,7 +7,7 @@ columns, in this order:
 - reflected rotor inertias: motor ``m``'s column on joint ``j`` is ``N[m, j] (N qdd)_m``
   (UR5e eq 2, ``i^2 qdd`` for a UR joint);
 - friction: ``N^T F(wm)``, ``F`` each motor's friction columns
-  (:func:`kinergy.friction.registry.friction_columns`) at the motor speeds ``wm = N qd``.
+  (:meth:`kinergy.friction.model.FrictionModel.friction_columns`) at the motor speeds ``wm = N qd``.
 
 Against currents alone a common scale of every parameter and of the torque constants cannot be
 told apart; :func:`scale_row` measures it against the model's published masses.
@@ -29,12 +29,9 @@ from numpy.typing import NDArray
 from kinergy.arrays import Array
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.dynamics.regressor import BaseParameters, inertial_parameters, regressor
-from kinergy.friction.registry import (
-    friction_columns,
-    get_model,
-    linear_values,
-    start_parameters,
-)
+from kinergy.friction.model import FrictionModel
+from kinergy.friction.none import MODEL as NO_FRICTION
+from kinergy.friction.power_flow import MODEL as POWER_FLOW
 from kinergy.identification.chunks import History, LogChunks
 from kinergy.identification.drive_steps import _Signals, rotor_columns, signal_history
 from kinergy.identification.options import Target
@@ -56,7 +53,7 @@ __all__ = [
 
 
 #: friction models whose columns depend on the load torque (the direction of power flow)
-LOAD_DEPENDENT = ("power_flow",)
+LOAD_DEPENDENT = (POWER_FLOW,)
 #: samples whose rows are made at a time (a chunk is cut into pieces of at most this many): the
 #: rows of 8192 samples of a 6-joint arm with 60 columns take 24 MB
 ROWS = 8192
@@ -92,47 +89,46 @@ class Columns:
 
 
 def joint_frictions(
-    robot: Robot, friction: str | None, commanded: bool
-) -> tuple[list[str], list[dict[str, float]]]:
+    robot: Robot, friction: FrictionModel | None, commanded: bool
+) -> tuple[list[FrictionModel], list[dict[str, float]]]:
     """Each motor's friction model in the regression and its starting parameters.
 
     ``friction`` replaces every joint's model (shape parameters from defaults unless the model is
     the joint's own); against the commanded motion (``target_moment``, no friction) the models are
-    ``"none"`` and the parameters the model's, kept.
+    ``none`` and the parameters the model's, kept.
     """
+    models = [friction or j.drive.friction.model for j in robot.joints]
     params = [
-        start_parameters(
-            friction or j.drive.friction.model, j.drive.friction.model, j.drive.friction.params
-        )
-        for j in robot.joints
+        model.start(j.drive.friction.model, j.drive.friction.params)
+        for model, j in zip(models, robot.joints, strict=True)
     ]
     if commanded:
-        return ["none"] * robot.n, params
-    return [friction or j.drive.friction.model for j in robot.joints], params
+        return [NO_FRICTION] * robot.n, params
+    return models, params
 
 
 def columns(
     robot: Robot,
     base: BaseParameters,
-    models: list[str],
+    models: list[FrictionModel],
     params: list[dict[str, float]],
 ) -> Columns:
     """Name, group and prior of every column: base parameters, rotor inertias, friction levels."""
     n = robot.n
-    widths = [len(get_model(m).linear) for m in models]
+    widths = [len(m.linear) for m in models]
     short = [base.names[k] for k in base.independent]
     joint = [f"joint {m + 1} ({j.name})" for m, j in enumerate(robot.joints)]
     prior = np.concatenate(
         [
             base.project(inertial_parameters(robot)),
             [j.drive.rotor_inertia for j in robot.joints],
-            *[linear_values(models[m], params[m]) for m in range(n)],
+            *[models[m].values_of(params[m]) for m in range(n)],
         ]
     )
     return Columns(
         names=[f"base parameter {s}" for s in short]
         + [f"rotor inertia of {joint[m]}" for m in range(n)]
-        + [f"friction {p} of {joint[m]}" for m in range(n) for p in get_model(models[m]).linear],
+        + [f"friction {p} of {joint[m]}" for m in range(n) for p in models[m].linear],
         group=["link"] * base.size + ["rotor"] * n + ["friction"] * sum(widths),
         prior=prior,
         n_link=base.size,
@@ -156,7 +152,7 @@ def scale_row(robot: Robot, base: BaseParameters, q: Array) -> Array:
 
 
 def power_flow_load(
-    model: str,
+    model: FrictionModel,
     params: dict[str, float],
     values: Array,
     signals: _Signals,
@@ -188,8 +184,8 @@ def power_flow_load(
     """
     w, acc = signals.wm, signals.dwm
     direction = np.sign(w)
-    f_dir = friction_columns(model, params, w, direction, acc)[skip:] @ values
-    f_rev = friction_columns(model, params, w, -direction, acc)[skip:] @ values
+    f_dir = model.friction_columns(params, w, direction, acc)[skip:] @ values
+    f_rev = model.friction_columns(params, w, -direction, acc)[skip:] @ values
     w, meas = w[skip:], signals.current[skip:]
     load_dir, load_rev = meas - f_dir, meas - f_rev
     is_dir, is_rev = w * load_dir > 0.0, w * load_rev < 0.0
@@ -235,7 +231,7 @@ class Regression:
     robot: Robot
     base: BaseParameters
     cols: Columns
-    models: list[str]
+    models: list[FrictionModel]
     params: list[dict[str, float]]
     target: Target
     temperature: bool
@@ -251,8 +247,8 @@ class Regression:
 
     @property
     def needs_load(self) -> bool:
-        """Whether any friction model takes the load torque (``needs_load`` in the registry)."""
-        return any(get_model(m).needs_load for m in self.models)
+        """Whether any friction model takes the load torque (``needs_load``)."""
+        return any(m.needs_load for m in self.models)
 
     @property
     def needs_flow(self) -> bool:
@@ -266,8 +262,8 @@ class Regression:
         not change)."""
         return [
             m
-            for m, name in enumerate(self.models)
-            if name not in LOAD_DEPENDENT and get_model(name).needs_load
+            for m, model in enumerate(self.models)
+            if model not in LOAD_DEPENDENT and model.needs_load
         ]
 
     def motion(self, chunk: IdentData) -> tuple[Array, Array, Array]:
@@ -343,10 +339,9 @@ class Regression:
                     held = dataclasses.replace(
                         held, tau_load=np.concatenate([held.tau_load[:skip], load[:, m]])
                     )
-                    width = len(get_model(model).linear)
+                    width = len(model.linear)
                     if width:
-                        f = friction_columns(
-                            model,
+                        f = model.friction_columns(
                             self.params[m],
                             held.wm,
                             held.tau_load,

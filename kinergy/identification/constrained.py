@@ -34,7 +34,7 @@ import numpy as np
 
 from kinergy.arrays import Array
 from kinergy.dynamics.regressor import BaseParameters
-from kinergy.friction.registry import get_model
+from kinergy.friction.model import FrictionModel
 from kinergy.identification.columns import Columns
 from kinergy.identification.physical import (
     LENGTH_SCALE,
@@ -57,7 +57,7 @@ _EPS_DROPPED = 1e-4
 _ROUND_OFF = 1e-12
 
 
-def bounds(cols: Columns, models: Sequence[str]) -> tuple[Array, Array]:
+def bounds(cols: Columns, models: Sequence[FrictionModel]) -> tuple[Array, Array]:
     """Lower and upper bounds of every non-link column (p - b,), in the unknowns' own units:
     rotor inertias >= 0, each friction level within its model's ``bounds``
     (:class:`kinergy.friction.model.FrictionModel`)."""
@@ -66,9 +66,8 @@ def bounds(cols: Columns, models: Sequence[str]) -> tuple[Array, Array]:
     n = len(models)
     lo[:n] = 0.0
     for m, model in enumerate(models):
-        spec = get_model(model)
-        for k, name in enumerate(spec.linear):
-            low, high = spec.bounds.get(name, (-np.inf, np.inf))
+        for k, name in enumerate(model.linear):
+            low, high = model.bounds.get(name, (-np.inf, np.inf))
             at = int(cols.fric_at[m]) + k - cols.n_link
             lo[at], hi[at] = low, high
     return lo, hi
@@ -250,7 +249,7 @@ def physical_fit(
     problem: Solved,
     base: BaseParameters,
     cols: Columns,
-    models: Sequence[str],
+    models: Sequence[FrictionModel],
     pi0: Array,
     scale: Array,
     payload: Array,

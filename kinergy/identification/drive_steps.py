@@ -37,12 +37,8 @@ from kinergy.arrays import Array
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.dynamics.rnea import rnea
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import (
-    friction_columns,
-    get_model,
-    start_parameters,
-    with_linear_parameters,
-)
+from kinergy.friction.model import FrictionModel
+from kinergy.friction.registry import MODELS
 from kinergy.identification.chunks import (
     STILL_SPEED,
     Asks,
@@ -55,7 +51,7 @@ from kinergy.identification.chunks import (
 )
 from kinergy.identification.friction_curve import shape_search
 from kinergy.identification.options import CurrentOptions, Hold
-from kinergy.identification.result import IDENTIFIED, KEPT
+from kinergy.identification.result import IDENTIFIED, KEPT, Flag
 from kinergy.jsonable import OPTIONAL
 from kinergy.linalg import Reduced, scaled_solution
 from kinergy.logs.prepare import IdentData
@@ -95,16 +91,21 @@ MIN_GAIN = 0.005
 #: relative standard deviation of 1/k_t above which the torque constant counts as unidentified
 MAX_KT_SPREAD = 0.1
 #: the models ``friction="auto"`` tries (those the logs support, :func:`candidates`)
-AUTO_CANDIDATES = (
-    "viscous_coulomb",
-    "power_flow",
-    "power_law",
-    "directional_power_law",
-    "stribeck",
-    "load_coulomb",
-    "thermal_viscous",
-    "load_thermal_power_law",
+AUTO_CANDIDATES = tuple(
+    MODELS[name]
+    for name in (
+        "viscous_coulomb",
+        "power_flow",
+        "power_law",
+        "directional_power_law",
+        "stribeck",
+        "load_coulomb",
+        "thermal_viscous",
+        "load_thermal_power_law",
+    )
 )
+#: the family ``friction="auto"`` keeps unless another beats it by more than the standard error
+BASELINE = MODELS["viscous_coulomb"]
 #: temperature-dependent models are tried on a joint whose temperature spans this much, K
 MIN_TEMPERATURE_SPAN = 3.0
 #: contiguous blocks of the cross-validation that chooses a friction model
@@ -236,7 +237,7 @@ class _Signals:
     piece: NDArray[np.int64] | None = None
 
 
-def _columns(model: str, params: dict[str, float], signals: _Signals) -> Array:
+def _columns(model: FrictionModel, params: dict[str, float], signals: _Signals) -> Array:
     """Eq 18's regressor ``[tau_load, friction columns]`` (N, 1 + k)."""
     s = signals
     bounds = [0, s.wm.size]
@@ -246,7 +247,7 @@ def _columns(model: str, params: dict[str, float], signals: _Signals) -> Array:
     for lo, hi in itertools.pairwise(bounds):
         t = None if s.temperature is None else s.temperature[lo:hi]
         w, load, dw = s.wm[lo:hi], s.tau_load[lo:hi], s.dwm[lo:hi]
-        parts.append(friction_columns(model, params, w, load, dw, temperature=t))
+        parts.append(model.friction_columns(params, w, load, dw, temperature=t))
     return np.column_stack([s.tau_load, np.vstack(parts)])
 
 
@@ -307,7 +308,7 @@ class _CurrentFit:
     """Eq 18 for one motor: ``x = [1/k_t, values/k_t]`` with standard errors, the condition
     number, the squared current error, and whether ``k_t`` was held at the model's."""
 
-    model: str
+    model: FrictionModel
     params: dict[str, float]
     x: Array
     std: Array
@@ -317,7 +318,7 @@ class _CurrentFit:
 
 
 def solve_current(
-    model: str, params: dict[str, float], problem: Reduced, kt_prior: float
+    model: FrictionModel, params: dict[str, float], problem: Reduced, kt_prior: float
 ) -> _CurrentFit:
     """Eq 18 for one motor, ``I = [tau_load, friction columns] @ [1/k_t, values/k_t]``, the
     model's shape parameters held, from its triangle (:class:`Reduced`, unit column scale).
@@ -339,9 +340,11 @@ def solve_current(
     return _CurrentFit(model, params, x, std, cond, problem.norm2(np.append(-x, 1.0)), fixed)
 
 
-def start_params(joint: Joint, model: str, standstill: float, holding: float) -> dict[str, float]:
+def start_params(
+    joint: Joint, model: FrictionModel, standstill: float, holding: float
+) -> dict[str, float]:
     """Parameters to fit ``model`` from, holding ``holding`` of the friction through standstill."""
-    params = start_parameters(model, joint.drive.friction.model, joint.drive.friction.params)
+    params = model.start(joint.drive.friction.model, joint.drive.friction.params)
     params.pop("standstill", None)
     params.pop("holding", None)
     if holding > 0.0:
@@ -360,11 +363,11 @@ class _Trial:
     """One fit of eq 18 tried: a motor, a friction model and all its parameters."""
 
     motor: int
-    model: str
+    model: FrictionModel
     params: tuple[tuple[str, float], ...]
 
     @classmethod
-    def of(cls, motor: int, model: str, params: dict[str, float]) -> _Trial:
+    def of(cls, motor: int, model: FrictionModel, params: dict[str, float]) -> _Trial:
         return cls(motor, model, tuple(params.items()))
 
 
@@ -421,7 +424,7 @@ class _Passes:
 
     def _fold(self, trials: list[_Trial]) -> dict[_Trial, _Blocks]:
         """One pass: every trial's triangles."""
-        widths = {t: 1 + len(get_model(t.model).linear) for t in trials}
+        widths = {t: 1 + len(t.model.linear) for t in trials}
         out = {t: _Blocks([Reduced.empty(widths[t]) for _ in self.edges[1:]]) for t in trials}
         motors = sorted({t.motor for t in trials})
         history = {m: signal_history(self.still[m]) for m in motors}
@@ -450,12 +453,12 @@ def _solved(trial: _Trial, blocks: _Blocks, kt: float) -> _CurrentFit:
 
 
 def _fit_hold(
-    m: int, joint: Joint, model: str, params: dict[str, float]
+    m: int, joint: Joint, model: FrictionModel, params: dict[str, float]
 ) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, _Blocks]]:
     """Eq 18 for motor ``m`` from ``params``, their shape searched first where the model does
     (:func:`~kinergy.identification.friction_curve.shape_search`, on the squared current error)."""
     kt = joint.drive.torque_constant
-    if get_model(model).search:
+    if model.search:
         params = yield from translated(
             shape_search(model, params),
             lambda p: _Trial.of(m, model, p),
@@ -467,7 +470,7 @@ def _fit_hold(
 
 
 def _fit_model(
-    m: int, joint: Joint, model: str, holdings: Sequence[float]
+    m: int, joint: Joint, model: FrictionModel, holdings: Sequence[float]
 ) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, _Blocks]]:
     """Eq 18 with each fraction of ``holdings`` of the friction held through standstill: the
     first fit whose squared current error no later one cuts by :data:`MIN_GAIN`."""
@@ -490,19 +493,19 @@ class FrictionChoice:
     from the spread of the per-block differences). A model other than Coulomb + viscous wins
     only if it beats it by more than that standard error (the one-standard-error rule)."""
 
-    model: str
+    model: FrictionModel = field(metadata={"json": lambda m: m.name})
     cv_rms: dict[str, float]
     gain_over_viscous_coulomb: float | None
     margin: float | None
     gain_std: float | None = field(default=None, metadata=OPTIONAL)
 
 
-def candidates(summary: Summary, m: int) -> list[str]:
+def candidates(summary: Summary, m: int) -> list[FrictionModel]:
     """The models of :data:`AUTO_CANDIDATES` motor ``m``'s logs (``summary``) can support:
     temperature-dependent ones only where its temperature spans :data:`MIN_TEMPERATURE_SPAN`."""
     cold, warm = summary.cold, summary.warm
     spans = cold is not None and warm is not None and warm[m] - cold[m] >= MIN_TEMPERATURE_SPAN
-    return [c for c in AUTO_CANDIDATES if spans or not get_model(c).needs_temperature]
+    return [c for c in AUTO_CANDIDATES if spans or not c.needs_temperature]
 
 
 def _cv_errors(fit: _CurrentFit, blocks: _Blocks, kt_prior: float) -> Array:
@@ -516,7 +519,9 @@ def _cv_errors(fit: _CurrentFit, blocks: _Blocks, kt_prior: float) -> Array:
     return np.array(errors)
 
 
-def _gain(errors: dict[str, Array], model: str, other: str) -> tuple[float, float]:
+def _gain(
+    errors: dict[FrictionModel, Array], model: FrictionModel, other: FrictionModel
+) -> tuple[float, float]:
     """How much lower ``model``'s cross-validated RMS is than ``other``'s (%), and the standard
     error of that gain from the per-block differences of the squared error (%)."""
     a, b = errors[model], errors[other]
@@ -527,7 +532,7 @@ def _gain(errors: dict[str, Array], model: str, other: str) -> tuple[float, floa
 
 
 def _auto_fit(
-    m: int, joint: Joint, models: list[str], holdings: Sequence[float], samples: int
+    m: int, joint: Joint, models: list[FrictionModel], holdings: Sequence[float], samples: int
 ) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, FrictionChoice | None]]:
     """``friction="auto"``: every candidate model fitted with its own standstill hold and scored
     by cross-validation; the lowest held-out RMS wins unless it beats Coulomb + viscous by no
@@ -535,7 +540,8 @@ def _auto_fit(
     logs are left out."""
     kt = joint.drive.torque_constant
     tried = yield from together([_fit_model(m, joint, model, holdings) for model in models])
-    fits, errors = {}, {}
+    fits: dict[FrictionModel, _CurrentFit] = {}
+    errors: dict[FrictionModel, Array] = {}
     for model, (fit, blocks) in zip(models, tried, strict=True):
         if fit.cond <= MAX_CONDITION:
             fits[model], errors[model] = fit, _cv_errors(fit, blocks, kt)
@@ -544,15 +550,15 @@ def _auto_fit(
     scores = {c: float(np.sqrt(e.sum() / samples)) for c, e in errors.items()}
     ranked = sorted(scores, key=scores.__getitem__)
     best, gain, std = ranked[0], None, None
-    if "viscous_coulomb" in scores:
-        gain, std = _gain(errors, best, "viscous_coulomb")
+    if BASELINE in scores:
+        gain, std = _gain(errors, best, BASELINE)
         if gain <= std:
-            best = "viscous_coulomb"
+            best = BASELINE
             gain, std = 0.0, None
     others = [c for c in ranked if c != best]
     choice = FrictionChoice(
         model=best,
-        cv_rms=scores,
+        cv_rms={c.name: score for c, score in scores.items()},
         gain_over_viscous_coulomb=gain,
         margin=100.0 * (1.0 - scores[best] / scores[others[0]]) if others else None,
         gain_std=std,
@@ -561,7 +567,7 @@ def _auto_fit(
 
 
 def _fixed_fit(
-    m: int, joint: Joint, model: str, holdings: Sequence[float]
+    m: int, joint: Joint, model: FrictionModel, holdings: Sequence[float]
 ) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, FrictionChoice | None]]:
     fit, _ = yield from _fit_model(m, joint, model, holdings)
     return fit, None
@@ -575,17 +581,16 @@ class CurrentStats:
     torque_constant_std: float | None = None
     friction_std: dict[str, float] | None = None
     condition_current: float | None = None
-    flags: dict[str, str] = field(default_factory=dict)
+    flags: dict[str, Flag] = field(default_factory=dict)
 
 
-def _unsupported(model: str, values: Array, kt: float) -> str | None:
+def _unsupported(model: FrictionModel, values: Array, kt: float) -> str | None:
     """Why a current fit's torque constant ``kt`` and friction levels ``values`` are not a
     physical drive (a friction level outside its model's bounds), or None."""
     if not kt > 0:
         return f"torque constant {kt:.3g} N m/A is not positive"
-    spec = get_model(model)
-    for name, value in zip(spec.linear, values, strict=True):
-        low, high = spec.bounds.get(name, (-np.inf, np.inf))
+    for name, value in zip(model.linear, values, strict=True):
+        low, high = model.bounds.get(name, (-np.inf, np.inf))
         if not low <= value <= high:
             return f"friction {name} = {value:.3g} is outside [{low:.3g}, {high:.3g}]"
     return None
@@ -599,16 +604,16 @@ def _apply_current_fit(
     if fit.cond > MAX_CONDITION:
         raise KinergyError(
             f"joint {m + 1} ({joint.name}): the current regression is singular (condition "
-            f"{fit.cond:.3g}): the log does not excite every friction term of model {fit.model!r}"
+            f"{fit.cond:.3g}): the log does not excite every friction term of model {fit.model.name!r}"
         )
-    x, std, names = fit.x, fit.std, get_model(fit.model).linear
+    x, std, names = fit.x, fit.std, fit.model.linear
     kt = 1.0 / x[0]
     values = x[1:] * kt
     problem = _unsupported(fit.model, values, kt)
     if problem is not None:
         said.warn(
             f"joint {m + 1} ({joint.name}): {problem}, not a physical drive (the currents do "
-            f"not support friction model {fit.model!r} here): kept the model's torque constant "
+            f"not support friction model {fit.model.name!r} here): kept the model's torque constant "
             "and friction"
         )
         kept = {name: KEPT for name in ("torque_constant", *names)}
@@ -621,7 +626,7 @@ def _apply_current_fit(
         )
     kt_std = std[0] / x[0] ** 2
     value_std = np.sqrt((std[1:] * kt) ** 2 + (x[1:] * kt_std * kt) ** 2)
-    friction = Friction(fit.model, with_linear_parameters(fit.model, fit.params, values))
+    friction = Friction(fit.model, fit.model.with_values(fit.params, values))
     drive = dataclasses.replace(joint.drive, torque_constant=float(kt), friction=friction)
     flags = {"torque_constant": KEPT if fit.fixed else IDENTIFIED}
     flags.update({name: IDENTIFIED for name in names})
@@ -658,9 +663,11 @@ def current_step(
     (None where not fitted)."""
     holdings = holdings_of(options.hold)
     active = [m for m in range(staged.n) if m not in problems]
-    models = [options.friction or j.drive.friction.model for j in staged.joints]
+    models = [options.family or j.drive.friction.model for j in staged.joints]
     summary = logs.summary("current")
     edges = _folds(logs) if options.auto else [0, summary.samples]
+    several = options.auto or any(models[m].search for m in active)  # passes: keep the signals
+    passes = _Passes(logs, staged, rotor, edges, several)
     if options.auto:
         asks = [
             _auto_fit(m, staged.joints[m], candidates(summary, m), holdings, summary.samples)
@@ -668,8 +675,6 @@ def current_step(
         ]
     else:
         asks = [_fixed_fit(m, staged.joints[m], models[m], holdings) for m in active]
-    several = options.auto or any(get_model(models[m]).search for m in active)
-    passes = _Passes(logs, staged, rotor, edges, several)
     fits = dict(zip(active, answer(together(asks), passes), strict=True))
     joints: list[Joint] = []
     stats: list[CurrentStats] = []

@@ -2,7 +2,7 @@
 
 Friction points are what a friction run or a joint calibration measures: at motor speeds ``wm``
 (rad/s) the friction torque ``tau`` (N m, motor side), and where known the load torque the
-joint carried and its temperature. Any model of the registry (:mod:`kinergy.friction`) that is
+joint carried and its temperature. Any friction model (:mod:`kinergy.friction`) that is
 linear in some parameters fits them by weighted least squares; shape parameters the model names
 in its ``search`` bounds (``power_law``'s exponent) are found by a 1-D search around that least
 squares (:func:`search_shape`, shared with the sequential method's current fit).
@@ -15,20 +15,14 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import (
-    friction_columns,
-    friction_torque,
-    get_model,
-    start_parameters,
-    with_linear_parameters,
-)
+from kinergy.friction.model import FrictionModel
 from kinergy.identification.chunks import Asks, answer, translated
 from kinergy.linalg import scaled_lstsq
 
@@ -92,7 +86,7 @@ class CurveFit:
 
     Attributes
     ----------
-    model : str
+    model : FrictionModel
     params : dict of str to float
         All its parameters (the robot-file form), motor side.
     rms : float
@@ -101,15 +95,15 @@ class CurveFit:
         The same on held-out blocks (:func:`choose_model`); None when not cross-validated.
     """
 
-    model: str
+    model: FrictionModel = field(metadata={"json": lambda m: m.name})
     params: dict[str, float]
     rms: float
     cv_rms: float | None = None
 
     def torque(self, points: FrictionPoints) -> Array:
         """The fitted friction at ``points``' speeds (and loads, temperatures), N m."""
-        return friction_torque(
-            self.model, self.params, points.wm, points.load, temperature=points.temperature
+        return self.model.friction_torque(
+            self.params, points.wm, points.load, temperature=points.temperature
         )
 
 
@@ -118,13 +112,13 @@ class CurveFit:
 Search = Asks[dict[str, float], float, dict[str, float]]
 
 
-def shape_search(model: str, params: Mapping[str, float]) -> Search:
+def shape_search(model: FrictionModel, params: Mapping[str, float]) -> Search:
     """``params`` with each shape parameter the model searches (``FrictionModel.search``) set to
     the value in its bounds that minimises a cost it asks for (:data:`Search`): a grid of
     :data:`SEARCH_GRID` values in one batch, then a bounded 1-D refinement around the best
     (:func:`bounded_minimum`); ``params`` unchanged for models without one."""
     best = dict(params)
-    for name, (low, high) in get_model(model).search.items():
+    for name, (low, high) in model.search.items():
         grid = np.linspace(low, high, SEARCH_GRID)
         costs = yield [{**best, name: float(v)} for v in grid]
         k = int(np.argmin(costs))
@@ -143,7 +137,7 @@ def _same(_: float, cost: float) -> float:
 
 
 def search_shape(
-    model: str, params: Mapping[str, float], cost: Callable[[dict[str, float]], float]
+    model: FrictionModel, params: Mapping[str, float], cost: Callable[[dict[str, float]], float]
 ) -> dict[str, float]:
     """:func:`shape_search` with each parameter set's cost from ``cost``."""
     return answer(shape_search(model, params), lambda batch: [cost(p) for p in batch])
@@ -185,25 +179,27 @@ def bounded_minimum(
             return float(found.x), float(found.fun)
 
 
-def _linear_fit(model: str, params: Mapping[str, float], points: FrictionPoints) -> CurveFit:
+def _linear_fit(
+    model: FrictionModel, params: Mapping[str, float], points: FrictionPoints
+) -> CurveFit:
     """The model's linear parameters by weighted least squares, its shape parameters held."""
-    cols = friction_columns(model, params, points.wm, points.load, temperature=points.temperature)
+    cols = model.friction_columns(params, points.wm, points.load, temperature=points.temperature)
     w = np.ones(len(points)) if points.weights is None else points.weights
     values, _, _ = scaled_lstsq(cols * w[:, None], points.tau * w)
-    fitted = with_linear_parameters(model, params, values)
+    fitted = model.with_values(params, values)
     rms = float(np.sqrt(np.mean((w * (cols @ values - points.tau)) ** 2)))
     return CurveFit(model, fitted, rms)
 
 
 def fit_curve(
-    model: str, points: FrictionPoints, params: Mapping[str, float] | None = None
+    model: FrictionModel, points: FrictionPoints, params: Mapping[str, float] | None = None
 ) -> CurveFit:
     """Fit ``model`` to ``points`` (module docstring).
 
     Parameters
     ----------
-    model : str
-        A registry model linear in some parameters.
+    model : FrictionModel
+        A model linear in some parameters.
     points : FrictionPoints
     params : mapping, optional
         Starting parameters (their shape parameters are kept unless searched); default the
@@ -215,13 +211,12 @@ def fit_curve(
         Fewer points than the model has linear parameters; a model the points cannot evaluate
         (one that needs the load torque, given none).
     """
-    spec = get_model(model)
-    if len(points) < len(spec.linear):
+    if len(points) < len(model.linear):
         raise KinergyError(
-            f"friction model {model!r} has {len(spec.linear)} linear parameters; "
+            f"friction model {model.name!r} has {len(model.linear)} linear parameters; "
             f"{len(points)} points cannot fit it"
         )
-    start = dict(params) if params is not None else start_parameters(model, "", {})
+    start = dict(params) if params is not None else model.start()
     shaped = search_shape(model, start, lambda p: _linear_fit(model, p, points).rms)
     return _linear_fit(model, shaped, points)
 
@@ -233,7 +228,7 @@ def _blocks(count: int, folds: int) -> list[NDArray[np.bool_]]:
     return [(index >= a) & (index < b) for a, b in itertools.pairwise(edges)]
 
 
-def _cv_rms(model: str, points: FrictionPoints, folds: int) -> float:
+def _cv_rms(model: FrictionModel, points: FrictionPoints, folds: int) -> float:
     """Weighted RMS of ``model`` on each block left out, fitted on the others."""
     errors = []
     for held in _blocks(len(points), folds):
@@ -245,13 +240,13 @@ def _cv_rms(model: str, points: FrictionPoints, folds: int) -> float:
 
 
 def choose_model(
-    candidates: Sequence[str], points: FrictionPoints, *, folds: int | None = None
+    candidates: Sequence[FrictionModel], points: FrictionPoints, *, folds: int | None = None
 ) -> tuple[CurveFit, tuple[CurveFit, ...]]:
     """The candidate with the lowest cross-validated RMS, fitted on all points.
 
     Parameters
     ----------
-    candidates : sequence of str
+    candidates : sequence of FrictionModel
         Registry models to try (those the points cannot fit are skipped).
     points : FrictionPoints
         In an order whose contiguous blocks make fair held-out sets (speed order for a
@@ -269,15 +264,15 @@ def choose_model(
     folds = len(points) if folds is None else folds
     tried = []
     for model in candidates:
-        spec = get_model(model)
-        if (spec.needs_load and points.load is None) or len(points) - max(
+        if (model.needs_load and points.load is None) or len(points) - max(
             1, len(points) // folds
-        ) < len(spec.linear):
+        ) < len(model.linear):
             continue
         fit = fit_curve(model, points)
         tried.append(CurveFit(fit.model, fit.params, fit.rms, _cv_rms(model, points, folds)))
     if not tried:
-        raise KinergyError(f"no friction model of {', '.join(candidates)} fits these points")
+        names = ", ".join(c.name for c in candidates)
+        raise KinergyError(f"no friction model of {names} fits these points")
     best = min(tried, key=lambda f: f.cv_rms if f.cv_rms is not None else np.inf)
     return best, tuple(tried)
 

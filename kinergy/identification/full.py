@@ -12,7 +12,7 @@ paper's ridge regression)::
 - ``N^T diag(J) N qdd``: motor plus reducer inertias ``J = J_m + J_r`` (motor side, kg m^2)
   reflected through the transmission ``N`` (UR5e eq 2, ``i^2 (J_m + J_r) qdd`` for a UR joint);
 - ``N^T F(wm) phi``: motor-side friction, ``F`` the columns of each joint's friction model
-  (:func:`kinergy.friction.registry.friction_columns`) at the motor speeds ``wm = N qd`` and ``phi``
+  (:meth:`kinergy.friction.model.FrictionModel.friction_columns`) at the motor speeds ``wm = N qd`` and ``phi``
   its linear parameters; shape parameters (smoothing, Stribeck speed, ...) stay the model's.
 
 ``tau`` is the signal chosen by ``target``:
@@ -74,8 +74,8 @@ import numpy as np
 
 from kinergy import checks
 from kinergy.dynamics.regressor import BaseParameters, base_parameters, inertial_parameters
-from kinergy.errors import KinergyError
-from kinergy.friction.registry import MODELS, get_model, linear_values, with_linear_parameters
+from kinergy.errors import Code, KinergyError
+from kinergy.friction.model import FrictionModel
 from kinergy.identification.chunks import LogChunks, Summary, one_blas_thread
 from kinergy.identification.columns import (
     LOAD_DEPENDENT,
@@ -84,8 +84,17 @@ from kinergy.identification.columns import (
     joint_frictions,
     scale_row,
 )
+from kinergy.identification.drive_steps import FrictionChoice
 from kinergy.identification.metrics import JointMetrics, MetricSums
-from kinergy.identification.options import CurrentOptions, IdentifyOptions, Method, Solver, Target
+from kinergy.identification.options import (
+    CurrentOptions,
+    FrictionOption,
+    IdentifyOptions,
+    Method,
+    Solver,
+    Target,
+    friction_option,
+)
 from kinergy.identification.regression import (
     MAX_CONDITION,
     FlowFit,
@@ -101,6 +110,7 @@ from kinergy.identification.result import (
     KEPT,
     DriveEstimate,
     Fit,
+    Flag,
     IdentificationResult,
     drive_fields,
     fit_fields,
@@ -159,7 +169,7 @@ class Parameter:
     std: float | None
     rel_std: float | None
     group: str | None = field(default=None, metadata=OPTIONAL)
-    flag: str | None = field(default=None, metadata=OPTIONAL)
+    flag: Flag | None = field(default=None, metadata=OPTIONAL)
 
 
 @dataclass(frozen=True)
@@ -229,6 +239,8 @@ class FullFit(Fit):
         Against currents alone: where the common scale comes from.
     friction_holding : tuple of float or None
         With drives from the currents: the friction fraction held through standstill per joint.
+    friction_choice : tuple of FrictionChoice or None
+        With ``friction="auto"``: how each joint's family was chosen on the currents.
     links_not_physical_closest, links_physical, standard_parameters :
         Links (1-based) whose closest standard parameters are not physical; per link whether
         the returned robot's is the identified one; the written standard parameters by name.
@@ -252,6 +264,9 @@ class FullFit(Fit):
     drives: str = "model"
     scale: str | None = field(default=None, metadata=OPTIONAL)
     friction_holding: tuple[float | None, ...] | None = field(default=None, metadata=OPTIONAL)
+    friction_choice: tuple[FrictionChoice | None, ...] | None = field(
+        default=None, metadata=OPTIONAL
+    )
     links_not_physical_closest: tuple[int, ...] = ()
     links_physical: tuple[bool, ...] = ()
     standard_parameters: dict[str, float] = field(default_factory=dict)
@@ -264,20 +279,6 @@ class FullFit(Fit):
 def _parsed(target: Target | str, solver: Solver | str) -> tuple[Target, Solver]:
     """``target`` and ``solver`` as their types (the Python API's strings parsed)."""
     return checks.choice(target, Target, "target"), checks.choice(solver, Solver, "solver")
-
-
-def _check_options(solver: Solver, ridge: float, friction: str | None) -> None:
-    ridge = checks.number(ridge, "ridge", ge=0.0)
-    if solver == Solver.RIDGE and ridge == 0.0:
-        raise KinergyError("solver 'ridge' needs ridge > 0 (the weight of the prior, e.g. 1e-4)")
-    if solver != Solver.RIDGE and ridge != 0.0:
-        raise KinergyError(
-            f"ridge = {ridge:g} is only used by solver 'ridge', not {solver.value!r}"
-        )
-    if friction is not None and friction not in MODELS:
-        raise KinergyError(
-            f"unknown friction model {friction!r} (known: {', '.join(sorted(MODELS))})"
-        )
 
 
 def _pick_target(logs: LogChunks, target: Target) -> Target:
@@ -324,7 +325,11 @@ def _diagnose(robot: Robot, summary: Summary, commanded: bool, n_params: int) ->
 
 
 def _regression(
-    robot: Robot, base: BaseParameters, logs: LogChunks, target: Target, friction: str | None
+    robot: Robot,
+    base: BaseParameters,
+    logs: LogChunks,
+    target: Target,
+    friction: FrictionModel | None,
 ) -> Regression:
     """Eq (1) over ``logs`` (:class:`kinergy.identification.columns.Regression`), after checking the
     logs can identify its columns (:func:`_diagnose`)."""
@@ -423,7 +428,7 @@ def _parameters(
     std: np.ndarray,
     names: Sequence[str],
     groups: Sequence[str | None],
-    flags: Sequence[str | None],
+    flags: Sequence[Flag | None],
 ) -> tuple[Parameter, ...]:
     """The first ``len(names)`` unknowns ``x`` with their standard errors ``std``."""
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -436,14 +441,14 @@ def _parameters(
 
 def _regression_drive(
     m: int, written: WriteBack, solved: Solved, reg: Regression, commanded: bool
-) -> tuple[dict[str, str], dict[str, float | None]]:
+) -> tuple[dict[str, Flag], dict[str, float | None]]:
     """Flags and standard errors of motor ``m``'s rotor inertia, torque constant and friction as
     the regression gave them."""
     cols = reg.cols
     col = cols.n_link + m
     flags = {"rotor_inertia": written.flags[col], "torque_constant": KEPT}
     std: dict[str, float | None] = {"rotor_inertia": _optional(solved.std[col])}
-    names = get_model(reg.models[m]).linear
+    names = reg.models[m].linear
     for k, name in enumerate(names):
         at = int(cols.fric_at[m]) + k
         flags[name] = KEPT if commanded else written.flags[at]
@@ -469,7 +474,7 @@ def _joints(
             flags = {"rotor_inertia": flags["rotor_inertia"], **drives.flags[m]}
             std = {"rotor_inertia": std["rotor_inertia"], **drives.std[m]}
         fields = drive_fields(joint, rotor_inertia=float(written.x[col]))
-        names = get_model(joint.drive.friction.model).linear
+        names = joint.drive.friction.model.linear
         out.append(
             FullJoint(
                 **fields,
@@ -510,6 +515,7 @@ class _Steps:
     evaluation: _Evaluation
     drives: DrivesFromCurrents | None
     robot: Robot
+    choice: tuple[FrictionChoice | None, ...] | None
 
 
 def _fit(logs: LogChunks, steps: _Steps, *, solver: Solver, ridge: float) -> FullFit:
@@ -553,6 +559,7 @@ def _fit(logs: LogChunks, steps: _Steps, *, solver: Solver, ridge: float) -> Ful
         else ("regression" if target != Target.MOMENT else "model"),
         scale=SCALE_NOTE if target == Target.CURRENT and steps.drives else None,
         friction_holding=steps.drives.holding if steps.drives else None,
+        friction_choice=steps.choice,
         links_not_physical_closest=written.links_not_physical_closest,
         links_physical=written.links_physical,
         standard_parameters=written.standard_parameters,
@@ -567,14 +574,14 @@ def rescaled(robot: Robot, s: float) -> Robot:
     for j in robot.joints:
         link = dataclasses.replace(j.link, mass=j.link.mass * s, inertia=j.link.inertia * s)
         fr = j.drive.friction
-        levels = linear_values(fr.model, fr.params) * s
+        levels = fr.model.values_of(fr.params) * s
         drive = dataclasses.replace(
             j.drive,
             motor_inertia=j.drive.motor_inertia * s,
             reducer_inertia=j.drive.reducer_inertia * s,
             torque_constant=j.drive.torque_constant * s,
             motor_constant=j.drive.motor_constant * s,
-            friction=Friction(fr.model, with_linear_parameters(fr.model, fr.params, levels)),
+            friction=Friction(fr.model, fr.model.with_values(fr.params, levels)),
         )
         joints.append(dataclasses.replace(j, link=link, drive=drive))
     return robot.with_joints(joints)
@@ -587,7 +594,7 @@ def identify_full(
     target: Target | str = Target.AUTO,
     solver: Solver | str = Solver.OLS,
     ridge: float = 0.0,
-    friction: str | None = None,
+    friction: FrictionOption | str = None,
     currents: bool = True,
 ) -> IdentificationResult:
     """Identify link base parameters, rotor inertias and friction in one regression:
@@ -620,9 +627,12 @@ def identify_full(
     ridge : float
         The ridge weight ``lambda`` on unit-norm columns (``solver="ridge"`` only, > 0; module
         docstring): 1e-6 to 1e-2 are typical.
-    friction : str, optional
-        Friction model for every joint (default: each joint's own). Its shape parameters are the
-        joint's when the model is the same, else defaults (smoothing 1e-3 rad/s, ...).
+    friction : FrictionModel or str, optional
+        Friction model for every joint, or its name (default: each joint's own). Its shape
+        parameters are the joint's when the model is the same, else defaults (smoothing 1e-3
+        rad/s, ...). ``"auto"``: the regression takes each joint's own family and the currents
+        then choose each joint's (as the sequential method does; the logs need
+        ``actual_current``).
     currents : bool
         Fit the torque constants and friction on the currents (UR5e eqs 17-18) when every log
         has them (default), after the regression; False keeps the model's torque constants
@@ -649,8 +659,8 @@ def identify_full(
     if not datas:
         raise KinergyError("no log to identify from")
     parsed_target, parsed_solver = _parsed(target, solver)
-    _check_options(parsed_solver, ridge, friction)
-    options = IdentifyOptions(Method.FULL, friction, parsed_target, parsed_solver, ridge)
+    family = friction_option(friction, "friction")
+    options = IdentifyOptions(Method.FULL, family, parsed_target, parsed_solver, ridge)
     return full(robot, LogChunks.of(datas), options, currents=currents)
 
 
@@ -668,16 +678,22 @@ def full(
     :func:`identify_full` with its ``target``, ``solver``, ``ridge`` and ``friction`` from
     ``options``."""
     options = options or IdentifyOptions(Method.FULL)
-    friction = options.friction
-    _check_options(options.solver, options.ridge, friction)
     target = _pick_target(logs, options.target)
     with_currents = currents and logs.every("current")
-    start = robot
+    current = CurrentOptions(options.friction)
+    if current.auto and not with_currents:
+        raise KinergyError(
+            "--friction auto chooses each joint's family by its cross-validated current RMS: "
+            f"these logs are regressed against {_SIGNAL[target]} with no actual_current in "
+            "every log; name a family (--friction viscous_coulomb, ...)",
+            Code.UNSUPPORTED,
+        )
+    start, choice = robot, None
     if with_currents and target == Target.CURRENT:  # drives from the model's links first
-        start = drives_from_currents(robot, logs, CurrentOptions(friction)).robot
-        friction = None
+        first = drives_from_currents(robot, logs, current)
+        start, choice, current = first.robot, first.choice, CurrentOptions()
     base = base_parameters(start)
-    reg = _regression(start, base, logs, target, friction)
+    reg = _regression(start, base, logs, target, current.family)
     flow = fit_power_flow(reg, logs, base.expressions())
     solved = solve(flow.ols, reg.cols.prior, options.solver, options.ridge)
     merging = merged_columns(flow.ols, reg.cols)
@@ -685,12 +701,13 @@ def full(
     evaluation = _evaluate(reg, logs, flow, solved, written)
     drives = None
     if with_currents:
-        drives = drives_from_currents(written.robot, logs, CurrentOptions(friction))
+        drives = drives_from_currents(written.robot, logs, current)
+        choice = drives.choice or choice
     out = drives.robot if drives is not None else written.robot
     if with_currents and target == Target.CURRENT:  # the common scale from the published masses
         gravity = scale_row(robot, base, evaluation.q) @ base.project(inertial_parameters(out))
         out = rescaled(out, 1.0 / float(gravity))
-    steps = _Steps(reg, flow, solved, merging, written, evaluation, drives, out)
+    steps = _Steps(reg, flow, solved, merging, written, evaluation, drives, out, choice)
     fit = _fit(logs, steps, solver=options.solver, ridge=options.ridge)
     joints = _joints(out, written, solved, reg, drives)
     return IdentificationResult(out, "full", joints, fit)

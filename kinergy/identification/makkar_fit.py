@@ -24,9 +24,9 @@ from scipy.ndimage import minimum_filter
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
+from kinergy.friction.makkar import MODEL as MAKKAR
 from kinergy.friction.makkar import PARAMETERS as _MAKKAR
 from kinergy.friction.makkar import makkar, makkar_columns
-from kinergy.friction.registry import get_model
 from kinergy.identification.metrics import r_squared, rmse
 from kinergy.identification.pso import SwarmResult, particle_swarm
 
@@ -35,7 +35,7 @@ __all__ = ["MakkarFit", "fit_makkar_lsq", "fit_makkar_pso"]
 Seed = np.random.Generator | int | None
 
 #: gamma1, gamma4, gamma6: the parameters the model is linear in
-_GAINS = tuple(_MAKKAR.index(name) for name in get_model("makkar").linear)
+_GAINS = tuple(_MAKKAR.index(name) for name in MAKKAR.linear)
 #: gamma2, gamma3, gamma5: the rates, which it is not linear in
 _RATES = tuple(k for k in range(len(_MAKKAR)) if k not in _GAINS)
 

@@ -58,6 +58,7 @@ from kinergy.drives.coupled import (
 from kinergy.drives.transmission import reflected_inertia, transmission_matrix
 from kinergy.dynamics.regressor import inertial_parameters
 from kinergy.errors import KinergyError
+from kinergy.friction.makkar import MODEL as MAKKAR
 from kinergy.friction.makkar import PARAMETERS as MAKKAR_PARAMETERS
 from kinergy.identification.chunks import LogChunks, one_blas_thread, windowed
 from kinergy.identification.cycles import CycleAverage, find_period
@@ -307,7 +308,7 @@ def _motor_friction(motor: Joint, gamma_motor: Array) -> Friction:
     old = motor.drive.friction.params
     params = {name: float(x) for name, x in zip(MAKKAR_PARAMETERS, gamma_motor, strict=True)}
     params.update({key: old[key] for key in ("standstill", "holding") if key in old})
-    return Friction("makkar", params)
+    return Friction(MAKKAR, params)
 
 
 def _motor_fits(

@@ -3,8 +3,8 @@
 
 Examples
 --------
->>> IdentifyOptions(method=Method.FULL, target="current").target
-<Target.CURRENT: 'current'>
+>>> IdentifyOptions(method=Method("full"), target=Target("current")).method
+<Method.FULL: 'full'>
 """
 
 from __future__ import annotations
@@ -12,8 +12,9 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
-from kinergy.checks import choice, number
-from kinergy.errors import KinergyError
+from kinergy import checks
+from kinergy.errors import Code, KinergyError
+from kinergy.friction.model import FrictionModel
 from kinergy.friction.registry import MODELS
 
 __all__ = [
@@ -21,6 +22,8 @@ __all__ = [
     "FILTER_CUTOFF",
     "MAX_RIDGE",
     "CurrentOptions",
+    "FrictionOption",
+    "FrictionSearch",
     "Hold",
     "IdentifyOptions",
     "MakkarMethod",
@@ -28,12 +31,8 @@ __all__ = [
     "NursingOptions",
     "Solver",
     "Target",
+    "friction_option",
 ]
-
-#: ``friction``: per joint, the model with the lowest cross-validated current RMS
-AUTO = "auto"
-#: the largest ridge weight taken
-MAX_RIDGE = 1e12
 
 
 class Method(enum.StrEnum):
@@ -75,10 +74,38 @@ class Hold(enum.Enum):
     FULL = "full"
 
 
-def _check_friction(friction: str | None) -> None:
-    if friction is not None and friction != AUTO and friction not in MODELS:
-        known = ", ".join([*sorted(MODELS), AUTO])
-        raise KinergyError(f"--friction: unknown model {friction!r}; known: {known}")
+class FrictionSearch(enum.StrEnum):
+    """``--friction auto``: per joint, the family with the lowest cross-validated current RMS
+    (the sequential method's current fit, UR5e eq 18; the full method's too)."""
+
+    AUTO = "auto"
+
+
+AUTO = FrictionSearch.AUTO
+#: the largest ridge weight taken
+MAX_RIDGE = 1e12
+
+#: what ``--friction`` resolves to: one family for every joint, the search among families, or
+#: None (each joint keeps its own family)
+FrictionOption = FrictionModel | FrictionSearch | None
+
+
+def friction_option(value: FrictionModel | str | None, what: str = "--friction") -> FrictionOption:
+    """``--friction``'s text (a family's name or ``auto``) resolved, once, into its type.
+
+    Raises
+    ------
+    KinergyError
+        ``--friction: must be one of ..., auto, got 'dahl'`` (code ``UNKNOWN_CHOICE``).
+    """
+    if value is None or isinstance(value, FrictionModel | FrictionSearch):
+        return value
+    if value == AUTO.value:
+        return AUTO
+    if isinstance(value, str) and value in MODELS:
+        return MODELS[value]
+    known = ", ".join([*sorted(MODELS), AUTO.value])
+    raise KinergyError(f"{what}: must be one of {known}, got {value!r}", Code.UNKNOWN_CHOICE)
 
 
 @dataclass(frozen=True)
@@ -87,34 +114,42 @@ class CurrentOptions:
 
     Attributes
     ----------
-    friction : str or None
-        A friction model of the registry for every joint, :data:`AUTO` (per joint, the model
-        with the lowest cross-validated current RMS) or None (each joint's own model).
+    friction : FrictionOption
+        One family for every joint, :data:`AUTO` (per joint, the family with the lowest
+        cross-validated current RMS) or None (each joint's own family); given by name, it is
+        resolved here (:func:`friction_option`).
     hold : Hold
     """
 
-    friction: str | None = None
+    friction: FrictionOption = None
     hold: Hold = Hold.SEARCH
 
     def __post_init__(self) -> None:
-        _check_friction(self.friction)
+        object.__setattr__(self, "friction", friction_option(self.friction))
 
     @property
     def auto(self) -> bool:
-        return self.friction == AUTO
+        """Whether each joint's family is chosen by cross-validation."""
+        return self.friction is AUTO
+
+    @property
+    def family(self) -> FrictionModel | None:
+        """The one family every joint is fitted with, or None."""
+        return self.friction if isinstance(self.friction, FrictionModel) else None
 
 
 @dataclass(frozen=True)
 class IdentifyOptions:
-    """The options of an identification, checked on construction (a name given for an enum is
-    parsed into it): one line naming the option.
+    """The options of an identification.
 
     Attributes
     ----------
     method : Method
-    friction : str or None
-        A friction model of the registry (:data:`kinergy.friction.registry.MODELS`) for every
-        joint, :data:`AUTO`, or None: each joint's own model.
+    friction : FrictionOption
+        One family (:data:`kinergy.friction.registry.MODELS`) for every joint, :data:`AUTO`, or
+        None: each joint's own family; given by name, it is resolved here
+        (:func:`friction_option`). The nursing method takes none (it fits Makkar's friction,
+        nursing eq 13).
     target : Target
         Full method only.
     solver : Solver
@@ -124,7 +159,7 @@ class IdentifyOptions:
     """
 
     method: Method = Method.SEQUENTIAL
-    friction: str | None = None
+    friction: FrictionOption = None
     target: Target = Target.AUTO
     solver: Solver = Solver.OLS
     ridge: float = 0.0
@@ -133,16 +168,34 @@ class IdentifyOptions:
         """The options as a model file records them (``friction`` only when given)."""
         out: dict[str, str | float] = {"method": self.method.value}
         if self.friction is not None:
-            out["friction"] = self.friction
+            out["friction"] = str(self.friction)
         out.update(target=self.target.value, solver=self.solver.value, ridge=self.ridge)
         return out
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "method", choice(self.method, Method, "--method"))
-        object.__setattr__(self, "target", choice(self.target, Target, "--target"))
-        object.__setattr__(self, "solver", choice(self.solver, Solver, "--solver"))
-        _check_friction(self.friction)
-        object.__setattr__(self, "ridge", number(self.ridge, "--ridge", ge=0.0, le=MAX_RIDGE))
+        object.__setattr__(self, "method", checks.choice(self.method, Method, "--method"))
+        object.__setattr__(self, "target", checks.choice(self.target, Target, "--target"))
+        object.__setattr__(self, "solver", checks.choice(self.solver, Solver, "--solver"))
+        object.__setattr__(self, "friction", friction_option(self.friction))
+        if self.method == Method.NURSING and self.friction is not None:
+            raise KinergyError(
+                f"--friction {self.friction}: the nursing method fits Makkar's friction (nursing "
+                "eq 13) to its friction runs; --friction is taken by the sequential and full "
+                "methods",
+                Code.UNSUPPORTED,
+            )
+        ridge = checks.number(self.ridge, "--ridge", ge=0.0, le=MAX_RIDGE)
+        object.__setattr__(self, "ridge", ridge)
+        if self.method != Method.FULL:
+            return
+        if self.solver == Solver.RIDGE and ridge == 0.0:
+            raise KinergyError(
+                "solver 'ridge' needs ridge > 0 (the weight of the prior, e.g. 1e-4)"
+            )
+        if self.solver != Solver.RIDGE and ridge != 0.0:
+            raise KinergyError(
+                f"ridge = {ridge:g} is only used by solver 'ridge', not {self.solver.value!r}"
+            )
 
 
 #: the nursing doc's low-pass cutoff for the motor currents, Hz

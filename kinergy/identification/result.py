@@ -14,6 +14,7 @@ Results are frozen dataclasses, written as JSON by :mod:`kinergy.jsonable`:
 
 from __future__ import annotations
 
+import enum
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypedDict
@@ -26,7 +27,7 @@ from kinergy.jsonable import to_jsonable
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs
 from kinergy.messages import Messages
-from kinergy.model.robot import Joint, Robot
+from kinergy.model.robot import Friction, Joint, Robot
 from kinergy.predict import drive_state
 
 __all__ = [
@@ -37,6 +38,7 @@ __all__ = [
     "DriveEstimate",
     "DriveFields",
     "Fit",
+    "Flag",
     "IdentificationResult",
     "Prediction",
     "Validation",
@@ -51,12 +53,19 @@ __all__ = [
 #: a per-joint metrics field: one entry per joint, or None when no log has the signal
 Metrics = tuple[JointMetrics, ...] | None
 
-#: what the data did with a parameter: fitted, left at the starting model's value, or held at a
-#: physical bound by the constrained fit
-IDENTIFIED = "identified"
-KEPT = "kept from prior"
-AT_BOUND = "at bound"
-FLAGS = (IDENTIFIED, KEPT, AT_BOUND)
+
+class Flag(enum.StrEnum):
+    """What the data did with a parameter: fitted, left at the starting model's value, or held at
+    a physical bound by the constrained fit (``--json`` writes the value)."""
+
+    IDENTIFIED = "identified"
+    KEPT = "kept from prior"
+    AT_BOUND = "at bound"
+
+
+IDENTIFIED, KEPT, AT_BOUND = Flag.IDENTIFIED, Flag.KEPT, Flag.AT_BOUND
+#: every flag, in the order tables count them
+FLAGS = tuple(Flag)
 
 
 @dataclass(frozen=True)
@@ -83,11 +92,6 @@ class Fit(Validation):
     notes: tuple[str, ...] = ()
 
 
-def friction_entry(joint: Joint) -> dict[str, str | float]:
-    """``{"model": name, **parameters}`` of a joint's friction, as results report it."""
-    return {"model": joint.drive.friction.model, **joint.drive.friction.params}
-
-
 class DriveFields(TypedDict):
     """The fields every method's per-joint result starts from (:func:`drive_fields`)."""
 
@@ -95,7 +99,7 @@ class DriveFields(TypedDict):
     rotor_inertia: float
     motor_inertia: float
     torque_constant: float
-    friction: dict[str, str | float]
+    friction: Friction
 
 
 def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> DriveFields:
@@ -109,7 +113,7 @@ def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> DriveField
         rotor_inertia=drive.rotor_inertia if rotor_inertia is None else rotor_inertia,
         motor_inertia=drive.motor_inertia,
         torque_constant=drive.torque_constant,
-        friction=friction_entry(joint),
+        friction=drive.friction,
     )
 
 
@@ -117,7 +121,7 @@ def drive_fields(joint: Joint, rotor_inertia: float | None = None) -> DriveField
 class DriveEstimate:
     """One joint's identified drive, motor side: ``rotor_inertia`` = J_m + J_r and
     ``motor_inertia`` J_m (kg m^2), ``torque_constant`` k_t (N m/A), ``friction``
-    (:func:`friction_entry`); per parameter (``rotor_inertia``, ``torque_constant`` and the
+    (its model and parameters; ``--json`` writes ``{"model": name, **parameters}``); per parameter (``rotor_inertia``, ``torque_constant`` and the
     friction's linear parameters by name) its flag (:data:`FLAGS`) and its standard error from the
     residuals (None where not estimated: a parameter kept from the prior)."""
 
@@ -125,8 +129,8 @@ class DriveEstimate:
     rotor_inertia: float
     motor_inertia: float
     torque_constant: float
-    friction: Mapping[str, Any]
-    flags: Mapping[str, str] = field(default_factory=dict)
+    friction: Friction = field(metadata={"json": Friction.as_dict})
+    flags: Mapping[str, Flag] = field(default_factory=dict)
     std: Mapping[str, float | None] = field(default_factory=dict)
 
 

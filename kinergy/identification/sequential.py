@@ -32,7 +32,6 @@ import numpy as np
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import get_model
 from kinergy.identification.chunks import STILL_SPEED, LogChunks, Summary, one_blas_thread
 from kinergy.identification.drive_steps import (
     AUTO_CANDIDATES,
@@ -43,13 +42,14 @@ from kinergy.identification.drive_steps import (
     rotor_step,
     with_rotor_inertias,
 )
-from kinergy.identification.options import CurrentOptions, Hold
+from kinergy.identification.options import CurrentOptions, FrictionOption, Hold, friction_option
 from kinergy.identification.result import (
     AT_BOUND,
     IDENTIFIED,
     KEPT,
     DriveEstimate,
     Fit,
+    Flag,
     IdentificationResult,
     drive_fields,
     fit_fields,
@@ -143,7 +143,7 @@ def _sources(robot: Robot, has_ref: bool, has_current: bool) -> dict[str, Source
 
 def _drive_flags(
     joint: Joint, identified_rotor: float, rotor_std: float, stats: CurrentStats
-) -> tuple[dict[str, str], dict[str, float | None]]:
+) -> tuple[dict[str, Flag], dict[str, float | None]]:
     """Flags and standard errors of one joint's rotor inertia, torque constant and friction."""
     if np.isnan(rotor_std):
         rotor_flag = KEPT
@@ -151,7 +151,7 @@ def _drive_flags(
         rotor_flag = AT_BOUND  # motor inertia held at 0
     else:
         rotor_flag = IDENTIFIED
-    names = get_model(joint.drive.friction.model).linear
+    names = joint.drive.friction.model.linear
     flags = {"rotor_inertia": rotor_flag, "torque_constant": KEPT, **dict.fromkeys(names, KEPT)}
     flags.update(stats.flags)
     fitted = stats.flags.get("torque_constant") == IDENTIFIED
@@ -193,7 +193,7 @@ def identify_sequential(
     robot: Robot,
     datas: Sequence[IdentData],
     *,
-    friction: str | None = None,
+    friction: FrictionOption | str = None,
     hold: Hold = Hold.SEARCH,
 ) -> IdentificationResult:
     """Identify rotor inertias, torque constants and friction with the UR5e doc's procedure:
@@ -206,10 +206,10 @@ def identify_sequential(
     datas : sequence of IdentData
         Prepared logs (:func:`kinergy.logs.prepare.prepare`). Rotor inertias need
         ``target_moment``; torque constants and friction need ``actual_current``.
-    friction : str, optional
-        Friction model for every joint (default: each joint's model in ``robot``); it must be
-        linear in its parameters (all of kinergy's are, given their shape parameters).
-        ``"auto"``: per joint, the model of :data:`AUTO_CANDIDATES` the logs support with the
+    friction : FrictionModel or str, optional
+        Friction model for every joint, or its name (default: each joint's model in ``robot``);
+        it must be linear in its parameters (all of kinergy's are, given their shape parameters).
+        ``"auto"`` (:data:`~kinergy.identification.options.AUTO`): per joint, the model of :data:`AUTO_CANDIDATES` the logs support with the
         lowest cross-validated current RMS (``fit.friction_choice`` says which won, by how much).
     hold : Hold
         Hold friction through standstill (see the module docstring).
@@ -226,7 +226,8 @@ def identify_sequential(
         Logs that cannot identify a parameter (a joint that never moves or never reverses, too few
         samples, a singular regression), naming the joints.
     """
-    return sequential(robot, LogChunks.of(datas), CurrentOptions(friction, hold))
+    options = CurrentOptions(friction_option(friction), hold)  # the family resolved, once
+    return sequential(robot, LogChunks.of(datas), options)
 
 
 @one_blas_thread
@@ -279,13 +280,15 @@ class DrivesFromCurrents:
     """Step 3 on its own (:func:`drives_from_currents`): the robot with the torque constants and
     friction the currents give, per joint the flags and standard errors of those parameters
     (:class:`~kinergy.identification.result.DriveEstimate`), the friction fraction held through
-    standstill (None where not fitted) and what the fit said (:class:`~kinergy.messages.Messages`)."""
+    standstill (None where not fitted), what the fit said (:class:`~kinergy.messages.Messages`)
+    and, with ``friction="auto"``, how each joint's family was chosen."""
 
     robot: Robot
-    flags: tuple[dict[str, str], ...]
+    flags: tuple[dict[str, Flag], ...]
     std: tuple[dict[str, float | None], ...]
     holding: tuple[float | None, ...]
     said: Messages
+    choice: tuple[FrictionChoice | None, ...] | None = None
 
 
 @one_blas_thread
@@ -307,10 +310,11 @@ def drives_from_currents(
     )
     rotor = np.array([j.drive.rotor_inertia for j in robot.joints])
     options = options or CurrentOptions()
-    out, stats, held, _ = current_step(robot, rotor, logs, problems, options, said)
+    out, stats, held, chosen = current_step(robot, rotor, logs, problems, options, said)
     flags, std = [], []
     for joint, stat in zip(out.joints, stats, strict=True):
         f, s = _drive_flags(joint, float(joint.drive.rotor_inertia), np.nan, stat)
         flags.append({k: v for k, v in f.items() if k != "rotor_inertia"})
         std.append({k: v for k, v in s.items() if k != "rotor_inertia"})
-    return DrivesFromCurrents(out, tuple(flags), tuple(std), held, said)
+    choice = chosen if options.auto else None
+    return DrivesFromCurrents(out, tuple(flags), tuple(std), held, said, choice)

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from kinergy.arrays import Array
 from kinergy.dynamics.regressor import BaseParameters, inertial_parameters, parameter_names
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import get_model, with_linear_parameters
+from kinergy.friction.model import FrictionModel
 from kinergy.identification.columns import Columns, Regression
 from kinergy.identification.constrained import ConstrainedFit, bounds, physical_fit
 from kinergy.identification.physical import (
@@ -36,7 +36,7 @@ from kinergy.identification.physical import (
     standard_from_base,
 )
 from kinergy.identification.regression import Solved
-from kinergy.identification.result import AT_BOUND, IDENTIFIED, KEPT
+from kinergy.identification.result import AT_BOUND, IDENTIFIED, KEPT, Flag
 from kinergy.messages import Messages
 from kinergy.model.robot import Drive, Friction, Joint, Link, Robot, Source
 
@@ -67,7 +67,7 @@ class WriteBack:
         The constraints the constrained fit sits on.
     solver : str or None
         The constrained fit's solver.
-    flags : tuple of str
+    flags : tuple of Flag
         Per column of the regression: ``identified``, ``kept from prior`` or ``at bound``.
     links_not_physical_closest : tuple of int
         Links (1-based) whose closest standard parameters are not physical.
@@ -85,7 +85,7 @@ class WriteBack:
     chi2: float | None
     active: tuple[str, ...]
     solver: str | None
-    flags: tuple[str, ...]
+    flags: tuple[Flag, ...]
     links_not_physical_closest: tuple[int, ...]
     links_physical: tuple[bool, ...]
     standard_parameters: dict[str, float]
@@ -204,15 +204,19 @@ def _with_rotor(m: int, joint: Joint, rotor: float, said: Messages) -> Drive:
 
 
 def _with_friction(
-    m: int, joint: Joint, friction: tuple[str, dict[str, float]], values: Array, said: Messages
+    m: int,
+    joint: Joint,
+    friction: tuple[FrictionModel, dict[str, float]],
+    values: Array,
+    said: Messages,
 ) -> Drive:
     """``joint``'s drive with friction ``(model, parameters)`` at the levels ``values`` (motor
     side)."""
     model, params = friction
-    for name, value in zip(get_model(model).linear, values, strict=True):
+    for name, value in zip(model.linear, values, strict=True):
         if value < 0.0 and name != "gamma1":
             said.warn(f"joint {m + 1} ({joint.name}): friction {name} = {value:.3g} is negative")
-    new = with_linear_parameters(model, params, values)
+    new = model.with_values(params, values)
     return dataclasses.replace(joint.drive, friction=Friction(model, new))
 
 
@@ -233,7 +237,7 @@ def _sources(robot: Robot, method: str, physical: list[bool], commanded: bool) -
     return sources
 
 
-def _flags(cols: Columns, problem: Solved, written: _Links) -> tuple[str, ...]:
+def _flags(cols: Columns, problem: Solved, written: _Links) -> tuple[Flag, ...]:
     """Each column's flag: at a bound of the constrained fit, kept from the prior (a column the
     logs cannot tell apart, or one the fit could not make physical), else identified."""
     at_bound = set(written.refit.at_bound) if written.refit is not None else set()

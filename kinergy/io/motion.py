@@ -21,11 +21,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 from kinergy.io.segments import segment_bounds
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import Motion, MotionSource
 
 __all__ = ["HALO", "MotionChunk", "iter_motion", "motion_from_log"]
 
@@ -40,7 +41,9 @@ def _derivatives(t: Array, x: Array, order: int, bounds: list[tuple[int, int]]) 
     return out
 
 
-def motion_from_log(log: Log, *, n_joints: int | None = None, source: str = "auto") -> Motion:
+def motion_from_log(
+    log: Log, *, n_joints: int | None = None, source: MotionSource | str = MotionSource.AUTO
+) -> Motion:
     """The joint motion recorded in a log.
 
     Parameters
@@ -48,7 +51,7 @@ def motion_from_log(log: Log, *, n_joints: int | None = None, source: str = "aut
     log : Log
     n_joints : int, optional
         The robot's joint count, checked against the log's vectors.
-    source : {'auto', 'target', 'actual'}
+    source : MotionSource
         ``target`` uses the commanded ``target_q/qd/qdd`` (noise-free, what the program asked
         for); ``actual`` the measured ``actual_q/qd`` with accelerations from a spline of the speed;
         ``auto`` takes target signals when the log has them, else actual ones.
@@ -58,10 +61,9 @@ def motion_from_log(log: Log, *, n_joints: int | None = None, source: str = "aut
     KinergyError
         No joint positions, a joint count that does not match the robot.
     """
-    if source not in ("auto", "target", "actual"):
-        raise KinergyError(f"source must be auto, target or actual, got {source!r}")
-    if source == "auto":
-        source = "target" if "target_q" in log else "actual"
+    source = checks.choice(source, MotionSource, "source")
+    if source == MotionSource.AUTO:
+        source = MotionSource.TARGET if "target_q" in log else MotionSource.ACTUAL
     q_name, qd_name, qdd_name = (f"{source}_q", f"{source}_qd", f"{source}_qdd")
     if q_name not in log:
         log.require(q_name, purpose="a motion")
@@ -119,7 +121,11 @@ def _rows(log: Log, a: int, b: int) -> Log:
 
 
 def _chunk(
-    tail: Log | None, log: Log, head: Log | None, n_joints: int | None, source: str
+    tail: Log | None,
+    log: Log,
+    head: Log | None,
+    n_joints: int | None,
+    source: MotionSource | str,
 ) -> MotionChunk:
     """``log`` with ``tail`` (the samples before it) and ``head`` (after it) as context."""
     parts = [p for p in (tail, log, head) if p is not None and len(p)]
@@ -141,7 +147,7 @@ def iter_motion(
     chunks: Iterable[Log],
     *,
     n_joints: int | None = None,
-    source: str = "auto",
+    source: MotionSource | str = MotionSource.AUTO,
     halo: int = HALO,
 ) -> Iterator[MotionChunk]:
     """The motion of a log read in ``chunks`` (consecutive, as :func:`kinergy.io.formats.iter_log`

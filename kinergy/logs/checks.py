@@ -46,9 +46,10 @@ from numpy.typing import NDArray
 from kinergy.arrays import Array
 from kinergy.drives.transmission import joint_torque, transmission_matrix
 from kinergy.dynamics.regressor import regressor
-from kinergy.errors import KinergyError
+from kinergy.errors import Code, KinergyError
 from kinergy.io.fields import FIELDS, JOINTS
 from kinergy.io.log import Log
+from kinergy.messages import Message
 from kinergy.model.library import library_names, load_robot
 from kinergy.model.robot import Payload, Robot
 from kinergy.predict import drive_state
@@ -490,7 +491,7 @@ class LogCheck:
             passed=tuple(c.value for c in found.passed),
             accepted=tuple(accepted),
             not_checked=tuple(f"{c.value}: {why}" for c, why in found.skipped.items()),
-            warnings=tuple(f"{self.path}: {w}" for w in found.warnings),
+            warnings=tuple(Message(w).prefixed(self.path) for w in found.warnings),
         )
 
     def _check_magnitudes(self) -> None:
@@ -718,7 +719,7 @@ class LogCheck:
         if match.failures or match.off or match.warnings:
             payload = payload_explains(self.robot, rows)
             if payload:
-                found.warnings.append(payload)
+                found.warnings.append(Message(payload, Code.PAYLOAD_MISSING))
                 found.verdict(Check.ROBOT, True)
                 return
         if match.failures or match.off:

@@ -34,10 +34,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinergy.arrays import Array
-from kinergy.model.frames import joint_transforms
+from kinergy.model.frames import joint_transforms, matrix_rpy
 from kinergy.model.friction_line import LOADS, SPEED_FLOOR, SPEEDS, JointSide
 from kinergy.model.robot import Robot
-from kinergy.model.toml import matrix_rpy
 
 __all__ = [
     "COMPLETION_NOTE",
@@ -48,6 +47,7 @@ __all__ = [
     "coupling_comment",
     "friction_comments",
     "layout",
+    "line_note",
     "number",
     "numbers",
     "reflected_comment",
@@ -147,7 +147,7 @@ def friction_comments(robot: Robot, side: JointSide) -> list[tuple[int, str]]:
         out.append(
             (
                 k,
-                f"motor of joint {joint.name}: friction model {joint.drive.friction.model!r} is "
+                f"motor of joint {joint.name}: friction model {joint.drive.friction.name!r} is "
                 f"not Coulomb + viscous; exported as its best line, Coulomb "
                 f"{_fmt(line.coulomb)} N m and viscous {_fmt(line.viscous)} N m s/rad motor side"
                 f"{joint_part}; RMS error {_fmt(line.rms_error)} N m motor side "
@@ -160,6 +160,22 @@ def friction_comments(robot: Robot, side: JointSide) -> list[tuple[int, str]]:
             )
         )
     return out
+
+
+def line_note(robot: Robot, side: JointSide) -> str | None:
+    """The note of an export whose friction families are not all Coulomb + viscous: each fitted
+    line's RMS error as a share of the model's RMS friction (None when every line is exact)."""
+    fitted = [k for k, line in enumerate(side.lines) if not line.exact]
+    if not fitted:
+        return None
+    return (
+        "friction exported as the best Coulomb + viscous line (RMS error, % of the model's RMS "
+        "friction): "
+        + ", ".join(
+            f"{robot.joints[k].name} {100 * side.lines[k].relative_error:.1f} %" for k in fitted
+        )
+        + "; the file's comments give each line and the speeds and loads it was fitted over"
+    )
 
 
 #: the note of an export whose link inertials were identified (base parameters)

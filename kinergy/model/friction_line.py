@@ -27,10 +27,14 @@ by non-negative least squares over a fixed grid (the same on every host):
 - the optional standstill hold (``standstill``, ``holding``) is not part of a line: MuJoCo's
   ``frictionloss`` holds a stopped joint by itself.
 
-Where the family is a line over that grid (``viscous_coulomb``, ``motor_reducer``, ``power_flow``
-with equal levels, ``power_law`` with exponent 1, ...) the line is exact (to rounding) and
-:attr:`FrictionLine.exact` is True; otherwise its RMS and largest error over the grid say how far
-the line is from the model.
+A family that is a Coulomb level plus a viscous term (``viscous_coulomb``, ``motor_reducer``: its
+:attr:`~kinergy.friction.model.FrictionModel.line`) is not fitted: its line is its own Coulomb
+level and viscous coefficient, exactly, whatever its ``tanh(wm / smoothing)`` does near zero speed
+(URDF's ``friction`` and MuJoCo's ``frictionloss`` are a Coulomb level that each tool regularises
+in its own way). Any other family is fitted; where it is a line over that grid (``power_flow``
+with equal levels, ``power_law`` with exponent 1, ...) the fit is exact (to rounding). Either way
+:attr:`FrictionLine.exact` is True; otherwise the fit's RMS and largest error over the grid say
+how far the line is from the model.
 
 Referred to the joints through ``N = diag(gear_ratio) @ coupling`` (the transmission matrix of
 :mod:`kinergy.drives.transmission`; ``wm = N qd``, ``tau = N^T tau_m``), the motors' lines give the
@@ -47,7 +51,6 @@ import numpy as np
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import get_model
 from kinergy.model.robot import Friction, Robot, transmission_matrix
 
 __all__ = [
@@ -90,12 +93,13 @@ class FrictionLine:
     load : float
         ``L_max``, N m: the grid's largest motor load.
     rms_error, max_error : float
-        RMS and largest ``|f - line|`` over the grid, N m.
+        RMS and largest ``|f - line|`` over the grid, N m (for a Coulomb + viscous family, what
+        its ``tanh`` smoothing takes off the Coulomb level there).
     rms_friction : float
         RMS of the model's friction over the grid, N m.
     exact : bool
-        Whether the family is this line over the grid (largest error below 1e-9 of the largest
-        friction).
+        Whether the line is the family's own (a Coulomb + viscous family), or the fit's largest
+        error is below 1e-9 of the largest friction.
     """
 
     coulomb: float
@@ -163,20 +167,35 @@ def friction_line(friction: Friction, speed: float, load: float) -> FrictionLine
     from scipy.optimize import nnls  # heavy (0.2 s): imported on first use
 
     u, tau_load = _grid(load)
-    spec = get_model(friction.model)
+    if friction.model.line is not None:  # Coulomb + viscous: its own levels, not a fit
+        coulomb, viscous = friction.model.line(friction.params)
+        f = np.asarray(friction.model.torque(friction.params, u * speed, tau_load, None))
+        residual = f - (coulomb * np.sign(u) + viscous * speed * u)  # the smoothing's alone
+        return FrictionLine(
+            coulomb=float(coulomb),
+            viscous=float(viscous),
+            speed=float(speed),
+            load=float(load),
+            rms_error=float(np.sqrt(np.mean(residual**2))),
+            max_error=float(np.max(np.abs(residual))),
+            rms_friction=float(np.sqrt(np.mean(f**2))),
+            exact=True,
+        )
     with np.errstate(all="ignore"):  # a non-finite torque is refused below
-        f = np.asarray(spec.torque(friction.params, u * speed, tau_load, None), dtype=float)
+        f = np.asarray(
+            friction.model.torque(friction.params, u * speed, tau_load, None), dtype=float
+        )
     columns = np.column_stack([np.sign(u), u])  # unknowns c and b w_max: both columns O(1)
     if not np.all(np.isfinite(f)) or float(np.max(np.abs(f))) > MAGNITUDE:
         raise KinergyError(
-            f"friction model {friction.model!r} has no finite Coulomb + viscous line over motor "
+            f"friction model {friction.name!r} has no finite Coulomb + viscous line over motor "
             f"speeds up to {speed:g} rad/s and loads up to {load:g} N m"
         )
     solution, _ = nnls(columns, f)
     coulomb, viscous = float(solution[0]), float(solution[1] / speed)
     if not np.isfinite(viscous):
         raise KinergyError(
-            f"friction model {friction.model!r}: a motor speed range of {speed:g} rad/s is too "
+            f"friction model {friction.name!r}: a motor speed range of {speed:g} rad/s is too "
             "small for a viscous coefficient"
         )
     residual = f - columns @ solution

@@ -1,4 +1,5 @@
-"""The built-in robot library: the robot files shipped in ``kinergy/model/library/``, by name."""
+"""The built-in robot library (the robot files shipped in ``kinergy/model/library/``, by name),
+and any robot file by path: TOML, or URDF by its ``.urdf`` suffix."""
 
 from __future__ import annotations
 
@@ -9,9 +10,10 @@ from typing import Any
 
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Payload, Robot
-from kinergy.model.toml import read_robot_file
+from kinergy.model.toml import read_robot_toml
+from kinergy.model.urdf import robot_from_urdf
 
-__all__ = ["library_names", "load_robot"]
+__all__ = ["library_names", "load_robot", "read_robot_file"]
 
 
 def _library_dir() -> Any:
@@ -23,6 +25,21 @@ def library_names() -> list[str]:
     return sorted(
         p.name.removesuffix(".toml") for p in _library_dir().iterdir() if p.name.endswith(".toml")
     )
+
+
+def read_robot_file(path: str | os.PathLike[str]) -> Robot:
+    """Read a robot file: TOML (:func:`kinergy.model.toml.read_robot_toml`), or URDF by its
+    ``.urdf`` suffix (:func:`kinergy.model.urdf.robot_from_urdf`).
+
+    Raises
+    ------
+    KinergyError
+        ``FILE: problem`` for unreadable files, syntax errors (with line and column) and any
+        invalid field.
+    """
+    if Path(path).suffix.lower() == ".urdf":
+        return robot_from_urdf(path)
+    return read_robot_toml(path)
 
 
 def load_robot(name_or_path: str | os.PathLike[str], *, payload: Payload | None = None) -> Robot:

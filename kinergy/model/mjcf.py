@@ -12,8 +12,9 @@ The drives, referred to the joints (:class:`~kinergy.model.friction_line.JointSi
 
 - joints with their own motor: ``armature = n^2 (J_m + J_r)`` (the reflected rotor and reducer
   inertia, UR5e eq 2), ``damping = n^2 b`` and ``frictionloss = |n| c`` from the motor's friction
-  line (:mod:`kinergy.model.friction_line`: exact for Coulomb + viscous families, else the best
-  line with its error in a comment and a note);
+  line (:mod:`kinergy.model.friction_line`: a Coulomb + viscous family's own Coulomb level ``c``
+  and viscous coefficient ``b``, exactly, its ``tanh`` smoothing left to MuJoCo's regularised
+  friction; any other family's best line, with its error in a comment and a note);
 - coupled joints: each motor is a ``<fixed>`` tendon whose length is the motor angle
   (``coef = N_kj``) with ``armature = J_m + J_r``, ``damping = b`` and ``frictionloss = c``, motor
   side, so that MuJoCo adds ``N^T diag(J) N`` to the mass matrix, ``N^T diag(b) N qd`` and the
@@ -41,10 +42,11 @@ from kinergy.model.export import (
     coupling_comment,
     friction_comments,
     layout,
+    line_note,
     number,
     numbers,
 )
-from kinergy.model.friction_line import joint_side
+from kinergy.model.friction_line import JointSide, joint_side
 from kinergy.model.robot import Robot, inertia_matrix
 
 __all__ = ["robot_to_mjcf"]
@@ -103,58 +105,11 @@ def _capsule(body: ET.Element, end: Array) -> None:
         )
 
 
-def robot_to_mjcf(robot: Robot, *, source: str = "") -> Export:
-    """``robot`` as MJCF text (see the module docstring) and the notes for the user.
-
-    Parameters
-    ----------
-    robot : Robot
-    source : str
-        What the robot was read from, for the file's first comment.
-
-    Returns
-    -------
-    Export
-        The MJCF and one note per thing it could not hold exactly (a friction line's error, link
-        inertials completed from base parameters).
-    """
-    side = joint_side(robot)
+def _bodies(world: ET.Element, robot: Robot, side: JointSide) -> None:
+    """The chain of bodies, each with its hinge (its drive's armature, damping and frictionloss
+    unless the joints are coupled), the flange site and the payload."""
     place = layout(robot)
-    root = ET.Element("mujoco", model=robot.name)
-    notes: list[str] = []
-    root.append(
-        ET.Comment(
-            comment(
-                f"{robot.name}, written by kinergy robot export"
-                + (f" from {source}" if source else "")
-                + ". World = the robot's base frame. Joints: armature = reflected rotor and "
-                "reducer inertia, damping and frictionloss = the drives' friction line, joint "
-                "side; actuators: joint torque (N m) within the torque limits. Not in MJCF: speed "
-                "and acceleration limits, motor electrics (the robot file keeps them)."
-            )
-        )
-    )
-    completion = completion_comment(robot)
-    for text in filter(None, [completion, coupling_comment(robot, side, tendons=True)]):
-        root.append(ET.Comment(comment(text)))
-    if completion is not None:
-        notes.append(COMPLETION_NOTE)
-    ET.SubElement(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="false")
-    ET.SubElement(root, "option", gravity=numbers(robot.gravity), integrator="implicitfast")
-    default = ET.SubElement(root, "default")
-    ET.SubElement(default, "geom", contype="0", conaffinity="0", rgba="0.7 0.7 0.75 1")
-    world = ET.SubElement(root, "worldbody")
     line_comments = dict(friction_comments(robot, side))
-    if line_comments:
-        notes.append(
-            "friction exported as the best Coulomb + viscous line (RMS error, % of the model's "
-            "RMS friction): "
-            + ", ".join(
-                f"{robot.joints[k].name} {100 * side.lines[k].relative_error:.1f} %"
-                for k in line_comments
-            )
-            + "; the file's comments give each line and the speeds and loads it was fitted over"
-        )
     parent = world
     for i, joint in enumerate(robot.joints):
         if i in line_comments:
@@ -162,13 +117,8 @@ def robot_to_mjcf(robot: Robot, *, source: str = "") -> Export:
         body = ET.SubElement(parent, "body", name=f"{joint.name}_link")
         _placed(body, place.joints[i])
         post = place.links[i]
-        _inertial(
-            body,
-            joint.link.mass,
-            post[:3, :3] @ joint.link.com + post[:3, 3],
-            joint.link.inertia,
-            post[:3, :3],
-        )
+        com = post[:3, :3] @ joint.link.com + post[:3, 3]
+        _inertial(body, joint.link.mass, com, joint.link.inertia, post[:3, :3])
         hinge = ET.SubElement(
             body,
             "joint",
@@ -191,20 +141,66 @@ def robot_to_mjcf(robot: Robot, *, source: str = "") -> Export:
         body = ET.SubElement(parent, "body", name="payload")
         _placed(body, place.flange)
         _inertial(body, p.mass, p.com, p.inertia, np.eye(3))
+
+
+def _tendons(root: ET.Element, robot: Robot, side: JointSide) -> None:
+    """Coupled joints: each motor a fixed tendon (module docstring)."""
+    tendon = ET.SubElement(root, "tendon")
+    for k, (joint, line) in enumerate(zip(robot.joints, side.lines, strict=True)):
+        fixed = ET.SubElement(
+            tendon,
+            "fixed",
+            name=f"{joint.name}_motor",
+            armature=number(joint.drive.rotor_inertia),
+            damping=number(line.viscous),
+            frictionloss=number(line.coulomb),
+        )
+        for j, coef in enumerate(side.transmission[k]):
+            if coef != 0.0:
+                ET.SubElement(fixed, "joint", joint=robot.joints[j].name, coef=number(coef))
+
+
+def robot_to_mjcf(robot: Robot, *, source: str = "") -> Export:
+    """``robot`` as MJCF text (see the module docstring) and the notes for the user.
+
+    Parameters
+    ----------
+    robot : Robot
+    source : str
+        What the robot was read from, for the file's first comment.
+
+    Returns
+    -------
+    Export
+        The MJCF and one note per thing it could not hold exactly (a friction line's error, link
+        inertials completed from base parameters).
+    """
+    side = joint_side(robot)
+    root = ET.Element("mujoco", model=robot.name)
+    completion = completion_comment(robot)
+    texts = [
+        f"{robot.name}, written by kinergy robot export"
+        + (f" from {source}" if source else "")
+        + ". World = the robot's base frame. Joints: armature = reflected rotor and reducer "
+        "inertia, damping and frictionloss = the drives' viscous coefficient and Coulomb level, "
+        "joint side; actuators: joint torque (N m) within the torque limits. Not in MJCF: speed "
+        "and acceleration limits, motor electrics (the robot file keeps them).",
+        completion,
+        coupling_comment(robot, side, tendons=True),
+    ]
+    for text in filter(None, texts):
+        root.append(ET.Comment(comment(text)))
+    notes = [COMPLETION_NOTE] if completion is not None else []
+    line = line_note(robot, side)
+    if line is not None:
+        notes.append(line)
+    ET.SubElement(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="false")
+    ET.SubElement(root, "option", gravity=numbers(robot.gravity), integrator="implicitfast")
+    default = ET.SubElement(root, "default")
+    ET.SubElement(default, "geom", contype="0", conaffinity="0", rgba="0.7 0.7 0.75 1")
+    _bodies(ET.SubElement(root, "worldbody"), robot, side)
     if side.coupled:
-        tendon = ET.SubElement(root, "tendon")
-        for k, (joint, line) in enumerate(zip(robot.joints, side.lines, strict=True)):
-            fixed = ET.SubElement(
-                tendon,
-                "fixed",
-                name=f"{joint.name}_motor",
-                armature=number(joint.drive.rotor_inertia),
-                damping=number(line.viscous),
-                frictionloss=number(line.coulomb),
-            )
-            for j, coef in enumerate(side.transmission[k]):
-                if coef != 0.0:
-                    ET.SubElement(fixed, "joint", joint=robot.joints[j].name, coef=number(coef))
+        _tendons(root, robot, side)
     actuator = ET.SubElement(root, "actuator")
     for joint in robot.joints:
         limit = joint.limits.torque

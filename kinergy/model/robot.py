@@ -14,6 +14,7 @@ Units are SI throughout (m, rad, kg, kg m^2, N m, A). Inertia 6-vectors are
 from __future__ import annotations
 
 import dataclasses
+import enum
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -23,13 +24,15 @@ import numpy as np
 from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.friction.registry import check_friction
+from kinergy.friction.model import FrictionModel
+from kinergy.friction.registry import get_model
 
 __all__ = [
     "CONVENTIONS",
     "MAGNITUDES",
     "SOURCE_CATEGORIES",
     "SOURCE_STATUSES",
+    "Convention",
     "Drive",
     "Friction",
     "Identified",
@@ -46,10 +49,20 @@ __all__ = [
 ]
 
 
-#: ``dh``: frame i = frame i-1 · Rz(q_i + offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i).
-#: ``mdh`` (Craig): frame i = frame i-1 · Rx(alpha_{i-1}) · Tx(a_{i-1}) · Rz(q_i + offset_i) · Tz(d_i),
-#: with joint i storing ``a`` = a_{i-1} and ``alpha`` = alpha_{i-1}.
-CONVENTIONS = ("dh", "mdh")
+class Convention(enum.StrEnum):
+    """How a robot's joints give its link frames.
+
+    ``DH``: frame i = frame i-1 · Rz(q_i + offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i).
+    ``MDH`` (Craig): frame i = frame i-1 · Rx(alpha_{i-1}) · Tx(a_{i-1}) · Rz(q_i + offset_i) ·
+    Tz(d_i), with joint i storing ``a`` = a_{i-1} and ``alpha`` = alpha_{i-1}.
+    """
+
+    DH = "dh"
+    MDH = "mdh"
+
+
+#: the conventions' names, as files write them
+CONVENTIONS = tuple(c.value for c in Convention)
 
 #: Groups of parameters whose provenance a robot file records.
 SOURCE_CATEGORIES = (
@@ -211,13 +224,54 @@ class Payload:
 
 @dataclass(frozen=True, eq=False)
 class Friction:
-    """A friction model (see :mod:`kinergy.friction.registry`) and its motor-side parameters."""
+    """A joint's friction: its model (family) and motor-side parameters.
 
-    model: str
+    Attributes
+    ----------
+    model : FrictionModel
+        The family (:mod:`kinergy.friction`); given by name (``"power_flow"``), it is resolved
+        here, once.
+    params : mapping of str to float
+        Its parameters, motor side (checked against the family's).
+    """
+
+    model: FrictionModel
     params: Mapping[str, float]
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "params", check_friction(self.model, dict(self.params)))
+        model = get_model(self.model)
+        object.__setattr__(self, "model", model)
+        object.__setattr__(self, "params", model.check(dict(self.params)))
+
+    @property
+    def name(self) -> str:
+        """The family's name, as robot files write it."""
+        return self.model.name
+
+    def torque(
+        self,
+        wm: Array,
+        tau_load: Array | None = None,
+        dwm: Array | None = None,
+        *,
+        temperature: Array | None = None,
+    ) -> Array:
+        """Friction torque, motor side, N m, like ``wm`` (rad/s; see
+        :meth:`~kinergy.friction.model.FrictionModel.friction_torque`)."""
+        return self.model.friction_torque(self.params, wm, tau_load, dwm, temperature=temperature)
+
+    @property
+    def values(self) -> Array:
+        """The values of the family's linear parameters, shape (k,)."""
+        return self.model.values_of(self.params)
+
+    def with_values(self, values: Array) -> Friction:
+        """This friction with its linear parameters replaced by ``values`` (k,)."""
+        return Friction(self.model, self.model.with_values(self.params, values))
+
+    def as_dict(self) -> dict[str, str | float]:
+        """``{"model": name, **parameters}``: a robot file's ``[joints.drive.friction]`` table."""
+        return {"model": self.model.name, **self.params}
 
 
 @dataclass(frozen=True, eq=False)
@@ -435,7 +489,8 @@ class Robot:
     Attributes
     ----------
     name : str
-    convention : {'dh', 'mdh'}
+    convention : Convention
+        Given as a Convention or its name (``"dh"``, ``"mdh"``).
     joints : tuple of Joint, length n
     gravity : ndarray, shape (3,)
         Gravitational acceleration in the base frame, m/s^2 (default ``[0, 0, -9.81]``).
@@ -464,7 +519,7 @@ class Robot:
     """
 
     name: str
-    convention: str
+    convention: Convention
     joints: tuple[Joint, ...]
     gravity: Array = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
     payload: Payload | None = None
@@ -480,10 +535,9 @@ class Robot:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise KinergyError(f"robot name must be a non-empty string, got {self.name!r}")
-        if self.convention not in CONVENTIONS:
-            raise KinergyError(
-                f"convention must be one of {', '.join(CONVENTIONS)}, got {self.convention!r}"
-            )
+        object.__setattr__(
+            self, "convention", checks.choice(self.convention, Convention, "convention")
+        )
         joints = tuple(self.joints)
         if not joints:
             raise KinergyError("a robot needs at least one joint")

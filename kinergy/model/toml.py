@@ -1,7 +1,8 @@
 """Robot files: TOML in and out, and the plain-dict form used for JSON.
 
-A robot file is TOML with the same structure as :func:`robot_to_dict` (which is also the
-``robot show --json`` shape)::
+One schema: a robot file is TOML with the same structure as :func:`robot_to_dict`, which is also
+the ``robot show --json`` shape and what the URDF export embeds (its ``<kinergy:robot>`` element,
+version :data:`ROBOT_SCHEMA`); :func:`robot_from_dict` reads it back from any of them::
 
     name = "ur5e"
     convention = "dh"                 # or "mdh"
@@ -53,16 +54,16 @@ Every error names the file and the field, e.g.
 from __future__ import annotations
 
 import os
-import warnings
 from collections.abc import Callable, Collection, Mapping, Sequence
-from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
 import tomli_w
 
+from kinergy import checks
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write, read_toml
+from kinergy.model.frames import matrix_rpy, rpy_matrix
 from kinergy.model.robot import (
     SOURCE_CATEGORIES,
     Drive,
@@ -79,15 +80,20 @@ from kinergy.model.robot import (
 )
 
 __all__ = [
+    "ROBOT_SCHEMA",
     "identified_to_dict",
     "parse_payload",
-    "read_robot_file",
+    "read_robot_toml",
     "robot_from_dict",
     "robot_to_dict",
     "save_robot",
 ]
 
 T = TypeVar("T")
+
+#: the version of the robot-file schema (the dictionary of :func:`robot_to_dict`), written where
+#: the dictionary travels inside another format (the URDF export's ``<kinergy:robot version>``)
+ROBOT_SCHEMA = 1
 
 _ROBOT_KEYS = {
     "identified",
@@ -185,16 +191,8 @@ def _fields(
 def _check_friction_values(params: Mapping[str, Any], where: str) -> None:
     """Signs and sizes a friction model's numbers may have in a robot file (names the field)."""
     for name, value in params.items():
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            continue  # Friction() names the wrong type
-        if name in _NON_NEGATIVE_FRICTION and value < 0.0:
-            raise KinergyError(
-                f"{where}.{name}: must be >= 0 (friction opposes motion), got {value:g}"
-            )
-        if abs(value) > _FRICTION_MAX:
-            raise KinergyError(
-                f"{where}.{name}: must be at most {_FRICTION_MAX:g} in size, got {value:g}"
-            )
+        sign = {"ge": 0.0} if name in _NON_NEGATIVE_FRICTION else {}  # friction opposes motion
+        checks.number(value, f"{where}.{name}", size=_FRICTION_MAX, **sign)
 
 
 def _joint_from_dict(data: Any, index: int) -> Joint:
@@ -234,24 +232,6 @@ def _thermal_from_dict(data: Any, where: str) -> Thermal | None:
     data = _known(data, _THERMAL_KEYS, where)
     fields = _fields(data, where, _THERMAL_KEYS)
     return _at(where, lambda: Thermal(**fields))
-
-
-def rpy_matrix(rpy: Any) -> np.ndarray:
-    """Rotation (3, 3) from fixed-axis roll, pitch, yaw in rad (URDF's ``rpy``): ``Rz(y) Ry(p) Rx(r)``."""
-    from scipy.spatial.transform import Rotation  # heavy (0.2 s): imported on first use
-
-    return np.asarray(Rotation.from_euler("xyz", [float(v) for v in rpy]).as_matrix())
-
-
-def matrix_rpy(rot: np.ndarray) -> np.ndarray:
-    """Roll, pitch, yaw (rad, shape (3,)) of a rotation matrix, the inverse of :func:`rpy_matrix`
-    (pitch in [-pi/2, pi/2]; at the gimbal lock one of the angles is set to 0, and the angles
-    still give back ``rot``)."""
-    from scipy.spatial.transform import Rotation  # heavy (0.2 s): imported on first use
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)  # scipy's gimbal-lock notice
-        return np.asarray(Rotation.from_matrix(rot).as_euler("xyz"))
 
 
 def _pose_from_dict(data: Any, where: str) -> np.ndarray:
@@ -409,7 +389,7 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         drive: dict[str, Any] = {key: getattr(j.drive, key) for key in _DRIVE_NUMBERS}
         if j.drive.winding_resistance is not None:
             drive["winding_resistance"] = j.drive.winding_resistance
-        drive["friction"] = {"model": j.drive.friction.model, **j.drive.friction.params}
+        drive["friction"] = j.drive.friction.as_dict()
         if j.drive.thermal is not None:
             drive["thermal"] = {key: getattr(j.drive.thermal, key) for key in _THERMAL_KEYS}
         limits: dict[str, Any] = {
@@ -437,8 +417,8 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
     return out
 
 
-def read_robot_file(path: str | os.PathLike[str]) -> Robot:
-    """Read a robot file (TOML, or URDF by its ``.urdf`` suffix).
+def read_robot_toml(path: str | os.PathLike[str]) -> Robot:
+    """Read a TOML robot file.
 
     Raises
     ------
@@ -446,11 +426,6 @@ def read_robot_file(path: str | os.PathLike[str]) -> Robot:
         ``FILE: problem`` for unreadable files, TOML syntax errors (with line and column) and any
         invalid field.
     """
-    path = Path(path)
-    if path.suffix.lower() == ".urdf":
-        from kinergy.model.urdf import robot_from_urdf  # needs the urdf extra (yourdfpy)
-
-        return robot_from_urdf(path)
     data = read_toml(path, "robot file")
     try:
         return robot_from_dict(data)

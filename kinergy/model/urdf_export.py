@@ -21,21 +21,21 @@ What the standard elements hold (read by Pinocchio, MuJoCo, ROS, ...):
 - ``<transmission>`` (ROS ``transmission_interface/SimpleTransmission``) with the gear ratio as
   ``mechanicalReduction``, for a joint with its own motor.
 
-What URDF cannot hold travels in one element of the namespace :data:`~kinergy.model.urdf_extras.NAMESPACE`,
-``<kinergy:model>`` (:func:`kinergy.model.urdf.robot_from_urdf` reads it back; other parsers skip
-it): the convention and the DH or MDH parameters the origins were made from, the base and flange
-poses, gravity (URDF has none), the coupling, the acceleration limits, every drive's rotor and
-reducer inertia, torque and motor constants, k_t/k_b, winding resistance, thermal model and its
-friction family with all its parameters (and the grid its line was fitted over), the standby
-power, bus voltage, description and the provenance of every parameter group. XML comments say
-what a file leaves out: the rotor inertia (no URDF element), a friction family that is not a line
-(the line's error), a coupled transmission.
+The robot itself travels whole in one element of the namespace
+:data:`~kinergy.model.urdf_xml.NAMESPACE`, ``<kinergy:robot version="1">``, whose text is the
+robot file's dictionary as JSON (:func:`kinergy.model.toml.robot_to_dict`, the ``robot show
+--json`` shape; ``version`` is :data:`~kinergy.model.toml.ROBOT_SCHEMA`): one schema for TOML,
+JSON and URDF. :func:`kinergy.model.urdf.import_urdf` reads it back with the code that reads robot
+files and checks the standard elements against it; other parsers skip it. XML comments say what
+the standard elements leave out: the rotor inertia (no URDF element), a friction family that is
+not a line (the line's error), a coupled transmission.
 """
 
 from __future__ import annotations
 
 import json
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -48,15 +48,16 @@ from kinergy.model.export import (
     coupling_comment,
     friction_comments,
     layout,
+    line_note,
     number,
     numbers,
     reflected_comment,
     rpy,
 )
 from kinergy.model.friction_line import JointSide, joint_side
-from kinergy.model.robot import SOURCE_CATEGORIES, Robot
-from kinergy.model.toml import identified_to_dict
-from kinergy.model.urdf_extras import FORMAT_VERSION, NAMESPACE
+from kinergy.model.robot import Robot
+from kinergy.model.toml import ROBOT_SCHEMA, robot_to_dict
+from kinergy.model.urdf_xml import NAMESPACE
 
 __all__ = ["robot_to_urdf"]
 
@@ -90,14 +91,25 @@ def _unique(wanted: str, taken: set[str]) -> str:
     return name
 
 
-def _names(robot: Robot) -> tuple[list[str], str, str, str, str, str]:
+@dataclass(frozen=True)
+class _Names:
     """Unique names: the links of the moving bodies, the base, flange and payload links, and the
     fixed joints of the flange and the payload."""
+
+    links: list[str]
+    base: str
+    flange: str
+    payload: str
+    flange_joint: str
+    payload_joint: str
+
+
+def _names(robot: Robot) -> _Names:
     taken: set[str] = set()
     links = [_unique(f"{j.name}_link", taken) for j in robot.joints]
     base, flange, payload = (_unique(name, taken) for name in (BASE, FLANGE, PAYLOAD))
     joints = set(robot.joint_names)
-    return (
+    return _Names(
         links,
         base,
         flange,
@@ -114,71 +126,11 @@ def _fixed_joint(root: ET.Element, name: str, parent: str, child: str, pose: Arr
     ET.SubElement(joint, "child", link=child)
 
 
-def _kinergy_element(robot: Robot, side: JointSide, names: tuple[str, str, str]) -> ET.Element:
-    """``<kinergy:model>``: everything URDF has no element for."""
-    base, flange, payload = names
-    model = ET.Element(
-        _tag("model"),
-        version=FORMAT_VERSION,
-        convention=robot.convention,
-        gravity=numbers(robot.gravity),
-        standby_power=number(robot.standby_power),
-        bus_voltage=number(robot.bus_voltage),
-        root=base,
-        flange=flange,
-        base_xyz=numbers(robot.base[:3, 3]),
-        base_rpy=numbers(rpy(robot.base[:3, :3])),
-        flange_xyz=numbers(robot.flange[:3, 3]),
-        flange_rpy=numbers(rpy(robot.flange[:3, :3])),
-    )
-    if robot.payload is not None:
-        model.set("payload", payload)
-    ET.SubElement(model, _tag("description")).text = robot.description
-    if robot.identified is not None:  # where the model came from, as the robot file says it
-        record = identified_to_dict(robot.identified)
-        ET.SubElement(model, _tag("identified")).text = json.dumps(record, sort_keys=True)
-    for cat in SOURCE_CATEGORIES:
-        source = robot.sources[cat]
-        ET.SubElement(model, _tag("source"), category=cat, status=source.status, ref=source.ref)
-    if side.coupled:
-        coupling = ET.SubElement(model, _tag("coupling"))
-        assert robot.coupling is not None
-        for row in robot.coupling:
-            ET.SubElement(coupling, _tag("row")).text = numbers(row)
-    for joint, line in zip(robot.joints, side.lines, strict=True):
-        element = ET.SubElement(
-            model,
-            _tag("joint"),
-            name=joint.name,
-            d=number(joint.d),
-            a=number(joint.a),
-            alpha=number(joint.alpha),
-            offset=number(joint.offset),
-        )
-        if joint.limits.acceleration is not None:
-            element.set("acceleration", number(joint.limits.acceleration))
-        d = joint.drive
-        drive = ET.SubElement(element, _tag("drive"))
-        if side.coupled:  # else in the joint's <transmission>
-            drive.set("gear_ratio", number(d.gear_ratio))
-        for key in ("motor_inertia", "reducer_inertia", "torque_constant", "motor_constant"):
-            drive.set(key, number(getattr(d, key)))
-        drive.set("kt_over_kb", number(d.kt_over_kb))
-        if d.winding_resistance is not None:
-            drive.set("winding_resistance", number(d.winding_resistance))
-        friction = ET.SubElement(element, _tag("friction"), model=d.friction.model)
-        for key, value in d.friction.params.items():
-            friction.set(key, number(value))
-        friction.set("line_speed", number(line.speed))
-        friction.set("line_load", number(line.load))
-        if d.thermal is not None:
-            ET.SubElement(
-                element,
-                _tag("thermal"),
-                capacity=number(d.thermal.capacity),
-                resistance=number(d.thermal.resistance),
-            )
-    return model
+def _embedded(robot: Robot) -> ET.Element:
+    """``<kinergy:robot>``: the robot file's dictionary as JSON (module docstring)."""
+    element = ET.Element(_tag("robot"), version=str(ROBOT_SCHEMA))
+    element.text = "\n" + json.dumps(robot_to_dict(robot), indent=1) + "\n"
+    return element
 
 
 def _transmission(root: ET.Element, joint_name: str, gear_ratio: float) -> None:
@@ -188,6 +140,83 @@ def _transmission(root: ET.Element, joint_name: str, gear_ratio: float) -> None:
     ET.SubElement(joint, "hardwareInterface").text = "hardware_interface/EffortJointInterface"
     actuator = ET.SubElement(element, "actuator", name=f"{joint_name}_motor")
     ET.SubElement(actuator, "mechanicalReduction").text = number(gear_ratio)
+
+
+def _comments(robot: Robot, side: JointSide, source: str) -> tuple[list[str], list[str]]:
+    """The file's leading comments and the notes for the user."""
+    texts = [
+        f"{robot.name}, written by kinergy robot export"
+        + (f" from {source}" if source else "")
+        + ". Standard elements: kinematics (exact), link inertials, limits, joint-side Coulomb + "
+        "viscous friction, gear ratios; <kinergy:robot> (namespace "
+        f"{NAMESPACE}, ignored by other tools) holds the robot file itself, as JSON; kinergy "
+        "robot import-urdf reads it back and checks the standard elements against it.",
+        f"Gravity {numbers(robot.gravity)} m/s^2 in the base frame (URDF has no gravity; set "
+        "your tool's).",
+        reflected_comment(robot, side),
+    ]
+    notes = []
+    completion = completion_comment(robot)
+    coupling = coupling_comment(robot, side, tendons=False)
+    texts += [text for text in (completion, coupling) if text is not None]
+    if completion is not None:
+        notes.append(COMPLETION_NOTE)
+    if coupling is not None:
+        notes.append(
+            "coupled joints: URDF has no coupled transmission nor rotor inertia; <dynamics> holds "
+            "each joint's own share of the motors' friction (the file's comment says what is "
+            "left out; the embedded robot keeps the coupling, the MJCF export holds it exactly)"
+        )
+    line = line_note(robot, side)
+    if line is not None:
+        notes.append(line)
+    return texts, notes
+
+
+def _chain(root: ET.Element, robot: Robot, side: JointSide, names: _Names) -> None:
+    """The links and joints of the arm, the flange and the payload."""
+    place = layout(robot)
+    line_comments = dict(friction_comments(robot, side))
+    ET.SubElement(root, "link", name=names.base)
+    parent = names.base
+    for i, joint in enumerate(robot.joints):
+        link = ET.SubElement(root, "link", name=names.links[i])
+        post = place.links[i]
+        com = np.eye(4)
+        com[:3, :3] = post[:3, :3]
+        com[:3, 3] = post[:3, :3] @ joint.link.com + post[:3, 3]
+        _inertial(link, joint.link.mass, com, joint.link.inertia)
+        if i in line_comments:
+            root.append(ET.Comment(comment(line_comments[i])))
+        element = ET.SubElement(root, "joint", name=joint.name, type="revolute")
+        _origin(element, place.joints[i])
+        ET.SubElement(element, "parent", link=parent)
+        ET.SubElement(element, "child", link=names.links[i])
+        ET.SubElement(element, "axis", xyz="0 0 1")
+        lower, upper = joint.limits.position
+        limits = (lower, upper, joint.limits.speed, joint.limits.torque)
+        ET.SubElement(
+            element,
+            "limit",
+            {
+                k: number(v)
+                for k, v in zip(("lower", "upper", "velocity", "effort"), limits, strict=True)
+            },
+        )
+        ET.SubElement(
+            element, "dynamics", damping=number(side.damping[i]), friction=number(side.friction[i])
+        )
+        parent = names.links[i]
+    ET.SubElement(root, "link", name=names.flange)
+    _fixed_joint(root, names.flange_joint, parent, names.flange, place.flange)
+    if robot.payload is not None:
+        p = robot.payload
+        element = ET.SubElement(root, "link", name=names.payload)
+        if p.mass > 0.0:
+            pose = np.eye(4)
+            pose[:3, 3] = p.com
+            _inertial(element, p.mass, pose, p.inertia)
+        _fixed_joint(root, names.payload_joint, names.flange, names.payload, np.eye(4))
 
 
 def robot_to_urdf(robot: Robot, *, source: str = "") -> Export:
@@ -207,99 +236,12 @@ def robot_to_urdf(robot: Robot, *, source: str = "") -> Export:
     """
     ET.register_namespace("kinergy", NAMESPACE)
     side = joint_side(robot)
-    place = layout(robot)
-    links, base, flange, payload, flange_joint, payload_joint = _names(robot)
     root = ET.Element("robot", name=robot.name)
-    notes: list[str] = []
-    root.append(
-        ET.Comment(
-            comment(
-                f"{robot.name}, written by kinergy robot export"
-                + (f" from {source}" if source else "")
-                + ". Standard elements: kinematics (exact), link inertials, limits, joint-side "
-                "Coulomb + viscous friction, gear ratios; <kinergy:model> (namespace "
-                f"{NAMESPACE}, ignored by other tools) holds the drives, the friction model, "
-                "gravity and what else URDF has no element for; kinergy robot import-urdf reads "
-                "both back."
-            )
-        )
-    )
-    root.append(
-        ET.Comment(
-            comment(
-                f"Gravity {numbers(robot.gravity)} m/s^2 in the base frame (URDF has no gravity; "
-                "set your tool's)."
-            )
-        )
-    )
-    root.append(ET.Comment(comment(reflected_comment(robot, side))))
-    completion = completion_comment(robot)
-    coupling = coupling_comment(robot, side, tendons=False)
-    for text in filter(None, [completion, coupling]):
+    texts, notes = _comments(robot, side, source)
+    for text in texts:
         root.append(ET.Comment(comment(text)))
-    if completion is not None:
-        notes.append(COMPLETION_NOTE)
-    if coupling is not None:
-        notes.append(
-            "coupled joints: URDF has no coupled transmission nor rotor inertia; <dynamics> holds "
-            "each joint's own share of the motors' friction (the file's comment says what is "
-            "left out; the kinergy element keeps the coupling, the MJCF export holds it exactly)"
-        )
-    line_comments = dict(friction_comments(robot, side))
-    if line_comments:
-        notes.append(
-            "friction exported as the best Coulomb + viscous line (RMS error, % of the model's "
-            "RMS friction): "
-            + ", ".join(
-                f"{robot.joints[k].name} {100 * side.lines[k].relative_error:.1f} %"
-                for k in line_comments
-            )
-            + "; the file's comments give each line and the speeds and loads it was fitted over"
-        )
-    root.append(_kinergy_element(robot, side, (base, flange, payload)))
-
-    ET.SubElement(root, "link", name=base)
-    parent = base
-    for i, joint in enumerate(robot.joints):
-        link = ET.SubElement(root, "link", name=links[i])
-        post = place.links[i]
-        com = np.eye(4)
-        com[:3, :3] = post[:3, :3]
-        com[:3, 3] = post[:3, :3] @ joint.link.com + post[:3, 3]
-        _inertial(link, joint.link.mass, com, joint.link.inertia)
-        if i in line_comments:
-            root.append(ET.Comment(comment(line_comments[i])))
-        element = ET.SubElement(root, "joint", name=joint.name, type="revolute")
-        _origin(element, place.joints[i])
-        ET.SubElement(element, "parent", link=parent)
-        ET.SubElement(element, "child", link=links[i])
-        ET.SubElement(element, "axis", xyz="0 0 1")
-        lower, upper = joint.limits.position
-        ET.SubElement(
-            element,
-            "limit",
-            lower=number(lower),
-            upper=number(upper),
-            velocity=number(joint.limits.speed),
-            effort=number(joint.limits.torque),
-        )
-        ET.SubElement(
-            element,
-            "dynamics",
-            damping=number(side.damping[i]),
-            friction=number(side.friction[i]),
-        )
-        parent = links[i]
-    ET.SubElement(root, "link", name=flange)
-    _fixed_joint(root, flange_joint, parent, flange, place.flange)
-    if robot.payload is not None:
-        p = robot.payload
-        element = ET.SubElement(root, "link", name=payload)
-        if p.mass > 0.0:
-            pose = np.eye(4)
-            pose[:3, 3] = p.com
-            _inertial(element, p.mass, pose, p.inertia)
-        _fixed_joint(root, payload_joint, flange, payload, np.eye(4))
+    root.append(_embedded(robot))
+    _chain(root, robot, side, _names(robot))
     if not side.coupled:
         for joint in robot.joints:
             _transmission(root, joint.name, joint.drive.gear_ratio)

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from kinergy.accounting.energy import EnergyReport
-from kinergy.friction.registry import get_model, parameter_units
+from kinergy.friction.model import FrictionModel
 from kinergy.identification.metrics import JointMetrics
 from kinergy.model.robot import Robot
 from kinergy.report import seed
@@ -67,13 +67,13 @@ def parameter_tables(model: Robot, truth: Robot | None = None) -> list[Table]:
     return [inertia, *(friction_table(model, family, truth) for family in families)]
 
 
-def friction_table(model: Robot, family: str, truth: Robot | None = None) -> Table:
+def friction_table(model: Robot, family: FrictionModel, truth: Robot | None = None) -> Table:
     """UR5e Table VI for the joints of ``model`` whose friction model is ``family``: the torque
     constant, then one column per parameter of the model that any of them has (units from the
     friction registry; "-" where a joint lacks an optional one); a joint of ``truth`` with the
     same friction model in brackets."""
-    joints = [j for j, joint in enumerate(model.joints) if joint.drive.friction.model == family]
-    units = parameter_units(family)
+    joints = [j for j, joint in enumerate(model.joints) if joint.drive.friction.model is family]
+    units = family.parameter_units()
     used = {p for j in joints for p in model.joints[j].drive.friction.params}
     params = [p for p in units if p in used]
 
@@ -85,7 +85,7 @@ def friction_table(model: Robot, family: str, truth: Robot | None = None) -> Tab
     for j in joints:
         d = model.joints[j].drive
         t = truth.joints[j].drive if truth is not None else None
-        twin = t.friction.params if t is not None and t.friction.model == family else {}
+        twin = t.friction.params if t is not None and t.friction.model is family else {}
         rows.append(
             [
                 model.joint_names[j],
@@ -94,12 +94,12 @@ def friction_table(model: Robot, family: str, truth: Robot | None = None) -> Tab
             ]
         )
     headers = ["joint", "k_t [N m/A]", *(f"{p} [{units[p]}]" for p in params)]
-    note = f"Motor side. {family}: {get_model(family).citation}."
+    note = f"Motor side. {family.name}: {family.citation}."
     if truth is not None:
         note += " In brackets: the value the twin was built with (its true robot)."
     caption = "Friction and torque constants (UR5e Table VI)"
-    if family != "power_flow":
-        caption += f", {family} friction"
+    if family.name != "power_flow":  # the seed's own model, UR5e Table VI
+        caption += f", {family.name} friction"
     return Table(caption, headers, rows, note)
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.trajectory.motion import CONTROLLER_DT, Motion
@@ -86,8 +87,7 @@ def fourier_series(
         raise KinergyError(
             f"Fourier coefficients: a and b must both have shape ({q0.size}, L), got {a.shape} and {b.shape}"
         )
-    if not (np.isfinite(base_frequency) and base_frequency > 0):
-        raise KinergyError(f"base frequency must be > 0, got {base_frequency}")
+    base_frequency = checks.number(base_frequency, "base frequency", gt=0.0)
     pq, pqd, pqdd = fourier_basis(t, base_frequency, a.shape[1])
     ab = np.hstack([a, b]).T  # (2L, n)
     return q0 + pq @ ab, pqd @ ab, pqdd @ ab

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass
 
 import numpy as np
@@ -10,7 +11,18 @@ from numpy.typing import ArrayLike
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 
-__all__ = ["CONTROLLER_DT", "Motion"]
+__all__ = ["CONTROLLER_DT", "Motion", "MotionSource"]
+
+
+class MotionSource(enum.StrEnum):
+    """Which of a log's joint signals a motion is read from: the commanded ``target_q/qd/qdd``
+    (noise-free, what the program asked for), the measured ``actual_q/qd`` (accelerations from a
+    spline of the speed), or ``AUTO``: target signals when the log has them, else actual ones."""
+
+    AUTO = "auto"
+    TARGET = "target"
+    ACTUAL = "actual"
+
 
 #: the UR controller's cycle, s (e-Series: 500 Hz): the period it logs, plans and servos at
 CONTROLLER_DT = 0.002

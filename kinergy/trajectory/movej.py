@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.trajectory.motion import CONTROLLER_DT, Motion
@@ -304,11 +305,8 @@ def _setting(value: ArrayLike, moves: int, name: str) -> Array:
     """A per-move setting of the planner: finite, > 0 (``blend``: >= 0)."""
     arr = per_move(value, moves, name)
     if name == "blend":
-        if np.any(arr < 0.0) or not np.all(np.isfinite(arr)):
-            raise KinergyError(f"blend: must be finite and >= 0, got {arr.tolist()}")
-    elif np.any(arr <= 0.0) or not np.all(np.isfinite(arr)):
-        raise KinergyError(f"{name}: must be finite and > 0, got {arr.tolist()}")
-    return arr
+        return checks.vector(arr, name, ge=0.0)
+    return checks.vector(arr, name, gt=0.0)
 
 
 def plan_movej(
@@ -379,8 +377,7 @@ def movej(
     >>> round(m.duration, 2), m.q[-1].tolist()
     (1.5, [1.0, -0.5])
     """
-    if not (np.isfinite(dt) and dt > 0.0):
-        raise KinergyError(f"dt: must be > 0, got {dt}")
+    dt = checks.number(dt, "dt", gt=0.0)
     plan = plan_movej(waypoints, speed=speed, acceleration=acceleration, blend=blend)
     steps = int(np.ceil(plan.total_time / dt - 1e-9))
     t = np.arange(steps + 1) * dt

@@ -27,6 +27,8 @@ import numpy as np
 
 from kinergy.drives.electrics import controller_voltage, equivalent_voltage
 from kinergy.errors import KinergyError
+from kinergy.friction.model import FrictionModel
+from kinergy.friction.registry import MODELS
 from kinergy.identification.electrics import ElectricsFit, fit_electrics, with_electrics
 from kinergy.identification.friction_curve import (
     CurveFit,
@@ -35,6 +37,7 @@ from kinergy.identification.friction_curve import (
     fit_curve,
     points_from,
 )
+from kinergy.identification.options import AUTO, FrictionSearch, friction_option
 from kinergy.io.ur_calibration import JointCalibration, read_ur_calibration
 from kinergy.jsonable import to_jsonable
 from kinergy.model.library import library_names, load_robot
@@ -52,9 +55,11 @@ __all__ = [
 
 #: models ``--friction auto`` chooses from: those a calibration's points (no load torque, a few
 #: kelvin of temperature spread) can fit
-CALIBRATION_CANDIDATES = ("viscous_coulomb", "power_law", "directional_power_law", "stribeck")
+CALIBRATION_CANDIDATES = tuple(
+    MODELS[name] for name in ("viscous_coulomb", "power_law", "directional_power_law", "stribeck")
+)
 #: the model shown beside the chosen one, for contrast
-CONTRAST = "viscous_coulomb"
+CONTRAST = MODELS["viscous_coulomb"]
 #: points are weighted by 1 / max(|tau|, this), N m: the same relative accuracy at every speed
 WEIGHT_FLOOR = 1e-3
 
@@ -116,12 +121,14 @@ def _electrics(robot: Robot, j: int, cal: JointCalibration) -> ElectricsFit:
     return fit_electrics(cal.current, signed, wm, weights=1.0 / np.abs(signed))
 
 
-def _joint(robot: Robot, j: int, cal: JointCalibration, friction: str) -> CalibrationJoint:
+def _joint(
+    robot: Robot, j: int, cal: JointCalibration, friction: FrictionModel | FrictionSearch
+) -> CalibrationJoint:
     points = _points(robot, j, cal)
-    if friction == "auto":
-        chosen, tried = choose_model(CALIBRATION_CANDIDATES, points)
-    else:
+    if isinstance(friction, FrictionModel):
         chosen, tried = choose_model([friction], points)
+    else:
+        chosen, tried = choose_model(CALIBRATION_CANDIDATES, points)
     contrast = fit_curve(CONTRAST, points)
     electrics = _electrics(robot, j, cal)
     wm = points.wm
@@ -199,7 +206,7 @@ def import_calibration(
     robot: Robot,
     path: str | os.PathLike[str],
     *,
-    friction: str = "auto",
+    friction: FrictionModel | FrictionSearch | str = AUTO,
     out: str | os.PathLike[str] | None = None,
 ) -> CalibrationImport:
     """Import a UR joint calibration summary into ``robot`` (module docstring); write the robot
@@ -211,11 +218,14 @@ def import_calibration(
         A bad calibration file (the line and what was expected), a joint count that differs
         from the robot's, a friction model the points cannot fit.
     """
+    family = friction_option(friction)
+    if family is None:
+        raise KinergyError("--friction: a calibration import needs a family or auto")
     cal = read_ur_calibration(path)
     if len(cal.joints) != robot.n:
         raise KinergyError(f"{cal.path}: {len(cal.joints)} joints but {robot.name} has {robot.n}")
     _check_robot(robot, cal.path, [c.torque_constant for c in cal.joints])
-    joints = [_joint(robot, j, c, friction) for j, c in enumerate(cal.joints)]
+    joints = [_joint(robot, j, c, family) for j, c in enumerate(cal.joints)]
     revision = cal.joints[0].revision
     ref = f"UR joint calibration summary {os.path.basename(cal.path)} (revision {revision})"
     calibrated = _calibrated(robot, joints, ref)

@@ -26,6 +26,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from kinergy.checks import choice
 from kinergy.files import output_folder
 from kinergy.friction.model import SMOOTHING
 from kinergy.identification.metrics import fit_metrics
@@ -41,10 +42,9 @@ from kinergy.model.robot import Friction, Robot
 from kinergy.report.html import Section, Table
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import paper_trajectory
-from kinergy.twin import TwinSettings, realistic_truth, simulate
+from kinergy.twin import Mismatch, TwinSettings, realistic_truth, simulate
 from kinergy.workflows.identify import identify_model
 from kinergy.workflows.study import run_study, write_study
-from kinergy.workflows.twin import mismatch_of
 
 __all__ = ["DemoRun", "nominal_drives", "run_demo", "truth_tables"]
 
@@ -97,7 +97,7 @@ def truth_tables(truth: Robot, model: Robot, held_out: IdentData) -> list[Table]
                 mj.name,
                 _pct(m.torque_constant, t.torque_constant),
                 _pct(m.rotor_inertia, t.rotor_inertia),
-                m.friction.model,
+                m.friction.name,
                 f"{r2[j]:.4f}",
             ]
         )
@@ -183,7 +183,7 @@ def run_demo(
     out: Path | None = None,
     progress: Callable[[str], None] | None = None,
     *,
-    mismatch: str = "realistic",
+    mismatch: Mismatch | str = Mismatch.REALISTIC,
 ) -> DemoRun:
     """Run the demo into folder ``out``, built beside it and renamed into place at the end
     (:func:`kinergy.files.atomic_folder`: a failure or an interruption leaves no half-written
@@ -191,17 +191,17 @@ def run_demo(
     (nothing is written to the current folder unless asked). ``mismatch``: ``"realistic"`` or
     ``"none"`` (module docstring).
     """
-    mismatch = mismatch_of(mismatch)
+    kind = choice(mismatch, Mismatch, "--mismatch")
     begin = time.perf_counter()
     with output_folder(out, prefix="kinergy-demo") as (folder, target):
-        tables = _demo(folder, progress or (lambda _msg: None), mismatch)
+        tables = _demo(folder, progress or (lambda _msg: None), kind)
     return DemoRun(tables, target / "report.html", time.perf_counter() - begin)
 
 
-def _demo(out: Path, say: Callable[[str], None], mismatch: str) -> dict[str, list[Table]]:
+def _demo(out: Path, say: Callable[[str], None], mismatch: Mismatch) -> dict[str, list[Table]]:
     """The demo's steps, writing into folder ``out``; returns the report's tables."""
     model = load_robot("ur5e")
-    realistic = mismatch == "realistic"
+    realistic = mismatch == Mismatch.REALISTIC
     truth = realistic_truth(model, SEED) if realistic else model
     logs = out / "logs"
     logs.mkdir(parents=True, exist_ok=True)

@@ -9,10 +9,10 @@ from typing import Any
 
 import numpy as np
 
+from kinergy import checks
 from kinergy.accounting.energy import EnergyAccumulator, EnergyReport, energy
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.arrays import Array
-from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 from kinergy.io.motion import iter_motion
 from kinergy.io.urscript_reader import read_program
@@ -20,7 +20,7 @@ from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.optimize.program_samples import drive_by_payload
 from kinergy.predict import drive_state
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import Motion, MotionSource
 from kinergy.trajectory.program_motion import payload_index, program_motion
 from kinergy.trajectory.program_path import program_path
 from kinergy.trajectory.programs import paper_trajectory
@@ -29,7 +29,6 @@ from kinergy.workflows.twin import is_builtin
 
 __all__ = [
     "ENERGY_ROWS",
-    "MOTION_SOURCES",
     "EnergyOptions",
     "LogEnergy",
     "energy_of_log",
@@ -38,17 +37,13 @@ __all__ = [
 ]
 
 
-#: what ``--source`` takes: the motion of a log that is accounted
-MOTION_SOURCES = ("auto", "target", "actual")
-
-
 @dataclass(frozen=True)
 class EnergyOptions:
     """How ``kinergy energy`` accounts a log, checked on construction.
 
     Attributes
     ----------
-    source : {"auto", "target", "actual"}
+    source : MotionSource
         Which motion of a log: commanded (``target_*``), measured (``actual_*``), or ``auto``:
         the commanded one where the log has it.
     recovery : bool
@@ -56,13 +51,11 @@ class EnergyOptions:
         negative power.
     """
 
-    source: str = "auto"
+    source: MotionSource = MotionSource.AUTO
     recovery: bool = True
 
     def __post_init__(self) -> None:
-        if self.source not in MOTION_SOURCES:
-            known = ", ".join(MOTION_SOURCES)
-            raise KinergyError(f"--source: must be one of {known}, got {self.source!r}")
+        object.__setattr__(self, "source", checks.choice(self.source, MotionSource, "--source"))
         object.__setattr__(self, "recovery", bool(self.recovery))
 
 
@@ -121,14 +114,14 @@ def _measured_power(log: Log) -> Array | None:
 _EXTRAS = ("joint_temperatures", "actual_robot_voltage", "actual_robot_current", "segment")
 
 
-def _signals_used(log: CheckedLog, source: str) -> list[str] | None:
+def _signals_used(log: CheckedLog, source: MotionSource) -> list[str] | None:
     """The signals of ``log`` its energy uses (the others are never converted): the motion of
     ``source`` (``auto`` as :func:`kinergy.io.motion.motion_from_log`) and :data:`_EXTRAS`,
     those the log has; None (all) when it has no joint positions, so the error lists what it
     has."""
     names = log.names()
-    if source == "auto":
-        source = "target" if "target_q" in names else "actual"
+    if source == MotionSource.AUTO:
+        source = MotionSource.TARGET if "target_q" in names else MotionSource.ACTUAL
     if f"{source}_q" not in names:
         return None
     wanted = [f"{source}_{x}" for x in ("q", "qd", "qdd")] + list(_EXTRAS)

@@ -20,7 +20,7 @@ from kinergy._version import __version__
 from kinergy.drives.bus import supply_power
 from kinergy.drives.electrics import electrical_power, equivalent_voltage, torque_constants
 from kinergy.drives.transmission import transmission_matrix
-from kinergy.errors import KinergyError
+from kinergy.errors import Code, KinergyError
 from kinergy.identification.chunks import LogChunks, Summary, data_history
 from kinergy.identification.electrics import ElectricsFit, ElectricsSums, with_electrics
 from kinergy.identification.full import full
@@ -37,6 +37,7 @@ from kinergy.jsonable import to_jsonable
 from kinergy.logs.checks import Check
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs, LogReading
+from kinergy.messages import coded
 from kinergy.model import Robot, save_robot
 from kinergy.model.robot import Identified, InputRecord, Source
 from kinergy.predict import drive_state
@@ -312,8 +313,9 @@ class PayloadRun:
 
     @property
     def lacks(self) -> list[str]:
-        """The checks' "a payload the model lacks": what this identifies, so routine here."""
-        return [w for w in self.inputs.warnings if "that the model lacks" in w]
+        """The checks' "a payload the model lacks" (code ``PAYLOAD_MISSING``): what this
+        identifies, so routine here."""
+        return coded(self.inputs.warnings, Code.PAYLOAD_MISSING)
 
     @property
     def notes(self) -> list[str]:

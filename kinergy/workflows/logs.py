@@ -28,7 +28,7 @@ from kinergy.logs.prepare import (
 )
 from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
-from kinergy.trajectory.motion import Motion
+from kinergy.trajectory.motion import Motion, MotionSource
 from kinergy.trajectory.program_motion import program_motion
 from kinergy.trajectory.program_path import program_path
 
@@ -118,7 +118,7 @@ def read_motion(
     robot: Robot,
     reading: LogReading | None = None,
     *,
-    source: str = "auto",
+    source: MotionSource | str = MotionSource.AUTO,
 ) -> tuple[Motion, InputLogs]:
     """The joint motion of a log or motion file (:func:`kinergy.io.motion.motion_from_log`,
     read through the checks), or of a URScript program (``*.script``) on ``robot`` as the

@@ -16,13 +16,13 @@ from kinergy.model import SOURCE_CATEGORIES, Robot, library_names, load_robot
 from kinergy.model.export import Export
 from kinergy.model.mjcf import robot_to_mjcf
 from kinergy.model.toml import robot_to_dict, save_robot
+from kinergy.model.urdf import UrdfImport, import_urdf
 from kinergy.model.urdf_export import robot_to_urdf
 
 __all__ = [
     "ExportFormat",
     "LibraryRobot",
     "RobotFile",
-    "UrdfRead",
     "export_robot",
     "library",
     "read_urdf",
@@ -92,16 +92,6 @@ def export_robot(
     return export
 
 
-@dataclass(frozen=True, eq=False)
-class UrdfRead:
-    """A URDF read into a robot file: the robot, what its drives are, and whether the file
-    held kinergy's own model (written by ``robot export``)."""
-
-    robot: Robot
-    drives: str
-    restored: bool
-
-
 def read_urdf(
     urdf: str | os.PathLike[str],
     out: str | os.PathLike[str],
@@ -109,17 +99,15 @@ def read_urdf(
     root: str | None = None,
     tip: str | None = None,
     name: str | None = None,
-) -> UrdfRead:
-    """Read the serial chain of ``urdf`` (:func:`kinergy.model.urdf.import_urdf`, needs the urdf
-    extra) and write it to ``out`` as a robot file (TOML).
+) -> UrdfImport:
+    """Read the serial chain of ``urdf`` (:func:`kinergy.model.urdf.import_urdf`) and write it
+    to ``out`` as a robot file (TOML).
 
     Raises
     ------
     KinergyError
         ``out`` named ``.urdf`` (it is written as TOML); a URDF that is no serial chain.
     """
-    from kinergy.model.urdf import import_urdf  # needs the urdf extra (yourdfpy)
-
     if Path(out).suffix.lower() == ".urdf":
         raise KinergyError(
             f"--out: {os.fspath(out)} would be written as TOML but read back as URDF; name it .toml"
@@ -128,4 +116,4 @@ def read_urdf(
     r = result.robot
     header = f"{r.name}: imported from {Path(urdf).name} by kinergy robot import-urdf"
     save_robot(r, out, header=header)
-    return UrdfRead(r, result.drives, result.restored)
+    return result

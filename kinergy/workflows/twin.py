@@ -8,7 +8,7 @@ import os
 from dataclasses import dataclass
 from typing import TypeGuard
 
-from kinergy.checks import integer, number
+from kinergy.checks import choice, integer, number
 from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 from kinergy.io.rtde import write_log
@@ -19,7 +19,7 @@ from kinergy.model.robot import Robot
 from kinergy.model.toml import save_robot
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import TEST_TRAJECTORIES, paper_trajectory
-from kinergy.twin import MISMATCHES, TwinSettings, realistic_truth, simulate
+from kinergy.twin import Mismatch, TwinSettings, realistic_truth, simulate
 from kinergy.workflows.logs import read_motion
 
 __all__ = [
@@ -28,16 +28,15 @@ __all__ = [
     "Simulation",
     "builtin_log",
     "is_builtin",
-    "mismatch_of",
     "run_twin",
     "twin_truth",
 ]
 
 
-def twin_truth(robot: Robot, mismatch: str, seed: int) -> Robot:
+def twin_truth(robot: Robot, mismatch: Mismatch, seed: int) -> Robot:
     """The twin's true robot for ``--mismatch``: the model itself (``none``) or
     :func:`kinergy.twin.realistic_truth` of it, seeded (``realistic``)."""
-    return realistic_truth(robot, seed) if mismatch == "realistic" else robot
+    return realistic_truth(robot, seed) if mismatch == Mismatch.REALISTIC else robot
 
 
 def is_builtin(name: object) -> TypeGuard[str]:
@@ -48,7 +47,7 @@ def is_builtin(name: object) -> TypeGuard[str]:
 def builtin_log(robot: Robot, name: str, seed: int = 0) -> Log:
     """The log the realistic twin of ``robot`` (:func:`twin_truth`, seeded) writes running the
     built-in motion ``name`` planned on ``robot``: what a real arm's log of it looks like."""
-    truth = twin_truth(robot, "realistic", seed)
+    truth = twin_truth(robot, Mismatch.REALISTIC, seed)
     motion = paper_trajectory(robot, name)
     return simulate(truth, motion, TwinSettings.realistic(seed), name=name)
 
@@ -84,13 +83,6 @@ _IMPERFECTIONS = (
 )
 
 
-def mismatch_of(value: str) -> str:
-    """``value`` as a ``--mismatch`` (:data:`~kinergy.twin.MISMATCHES`), or one line naming it."""
-    if value not in MISMATCHES:
-        raise KinergyError(f"--mismatch: must be one of {', '.join(MISMATCHES)}, got {value!r}")
-    return value
-
-
 @dataclass(frozen=True)
 class SimulateOptions:
     """How ``kinergy simulate`` runs the twin, checked on construction (one line naming the
@@ -98,7 +90,7 @@ class SimulateOptions:
 
     Attributes
     ----------
-    mismatch : {"none", "realistic"}
+    mismatch : Mismatch
         ``none``: the model itself is the truth; ``realistic``: a true robot that differs from
         it as a real arm does (:func:`kinergy.twin.realistic_truth`, seeded), with a real
         controller's current steps, voltage noise and supply ripple.
@@ -118,7 +110,7 @@ class SimulateOptions:
         The joints' temperature at the start, deg C, -50 to 200 (None: the ambient).
     """
 
-    mismatch: str = "none"
+    mismatch: Mismatch = Mismatch.NONE
     seed: int = 0
     exact: bool = False
     lag: float | None = None
@@ -128,7 +120,7 @@ class SimulateOptions:
     initial_temperature: float | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "mismatch", mismatch_of(self.mismatch))
+        object.__setattr__(self, "mismatch", choice(self.mismatch, Mismatch, "--mismatch"))
         object.__setattr__(self, "seed", integer(self.seed, "--seed", ge=0, le=MAX_SEED))
         for name, what, most in _IMPERFECTIONS:
             value = getattr(self, name)
@@ -148,7 +140,7 @@ class SimulateOptions:
         with the lag and noises given."""
         if self.exact:
             base = TwinSettings.exact()
-        elif self.mismatch == "realistic":
+        elif self.mismatch == Mismatch.REALISTIC:
             base = TwinSettings.realistic(self.seed)
         else:
             base = TwinSettings()
@@ -207,7 +199,7 @@ def run_twin(
         ``truth_out`` without the realistic mismatch; an unknown trajectory; a motion file that
         fails its checks.
     """
-    if truth_out is not None and options.mismatch != "realistic":
+    if truth_out is not None and options.mismatch != Mismatch.REALISTIC:
         raise KinergyError(
             "--truth: only with --mismatch realistic (with none the twin's truth is ROBOT itself)"
         )
