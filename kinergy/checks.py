@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import enum
 import math
+import re
 from collections.abc import Collection, Mapping
 from typing import Any, TypeVar
 
@@ -33,7 +34,7 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.errors import Code, KinergyError
 
-__all__ = ["choice", "flag", "integer", "known_keys", "number", "vector"]
+__all__ = ["choice", "flag", "integer", "known_keys", "number", "plain_text", "vector"]
 
 E = TypeVar("E", bound=enum.Enum)
 
@@ -237,3 +238,30 @@ def choice(value: Any, kind: type[E], what: str) -> E:
             return member
     known = ", ".join(str(m.value) for m in kind)
     raise KinergyError(f"{what}: must be one of {known}, got {_shown(value)}", Code.UNKNOWN_CHOICE)
+
+
+#: control characters text printed to a terminal may not hold (a terminal acts on them: colours,
+#: bells, a cursor sent elsewhere), and the same but line breaks and tabs
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
+_CONTROL_BUT_BREAKS = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+
+
+def plain_text(value: str, what: str, *, breaks: bool = False) -> str:
+    """``value`` (a name that results print) without control characters; with ``breaks``, line
+    breaks and tabs are allowed (a description).
+
+    Raises
+    ------
+    KinergyError
+        ``robot name: must be plain text (no control characters: \\x07, \\x1b), got
+        'ur5e\\x1b[31mRED\\x07'``, the value escaped.
+    """
+    found = sorted(set((_CONTROL_BUT_BREAKS if breaks else _CONTROL).findall(value)))
+    if found:
+        shown = ", ".join(repr(c)[1:-1] for c in found)
+        escaped = value.encode("unicode_escape").decode("ascii")
+        raise KinergyError(
+            f"{what}: must be plain text (no control characters: {shown}; results print it to the "
+            f"terminal), got '{escaped}'"
+        )
+    return value

@@ -33,6 +33,7 @@ __all__ = [
     "Terminated",
     "all_or_none",
     "atomic_folder",
+    "atomic_open",
     "atomic_write",
     "check_folder",
     "check_output",
@@ -243,12 +244,13 @@ def _fsync_folder(folder: Path) -> None:
             os.close(fd)
 
 
-def atomic_write(
-    path: PathLike, write: Callable[[IO[Any]], object], *, binary: bool = False
-) -> Path:
-    """Write a file through ``write(handle)`` into a temporary file beside it, flush it to disk
-    and rename it into place: readers never see a half-written file, and a failure (an
-    exception, Ctrl-C, SIGTERM under :func:`terminate_on_signals`) leaves nothing behind.
+@contextlib.contextmanager
+def atomic_open(path: PathLike, *, binary: bool = False) -> Iterator[IO[Any]]:
+    """A handle to a temporary file beside ``path`` that becomes ``path`` when the ``with``
+    block ends without an exception: flushed to disk and renamed into place, so readers never
+    see a half-written file and a failure (an exception, Ctrl-C, SIGTERM under
+    :func:`terminate_on_signals`) leaves nothing behind. For output written as it is computed
+    (a trace of a long log).
 
     Raises
     ------
@@ -261,7 +263,7 @@ def atomic_write(
             mode = "wb" if binary else "w"
             kwargs: dict[str, Any] = {} if binary else {"encoding": "utf-8", "newline": "\n"}
             with os.fdopen(fd, mode, **kwargs) as handle:
-                write(handle)
+                yield handle
                 handle.flush()
                 os.fsync(handle.fileno())
             os.chmod(tmp, 0o644)  # mkstemp makes it private; outputs are for reading
@@ -270,7 +272,21 @@ def atomic_write(
         except OSError as exc:
             raise KinergyError(f"{target}: cannot write ({exc.strerror or exc})") from None
     _fsync_folder(target.parent)
-    return target
+
+
+def atomic_write(
+    path: PathLike, write: Callable[[IO[Any]], object], *, binary: bool = False
+) -> Path:
+    """Write a file through ``write(handle)``, whole or not at all (:func:`atomic_open`).
+
+    Raises
+    ------
+    KinergyError
+        ``PATH: cannot write (reason)``, or :func:`check_output`'s refusals.
+    """
+    with atomic_open(path, binary=binary) as handle:
+        write(handle)
+    return Path(path)
 
 
 def _sha256(path: Path) -> str:
@@ -294,9 +310,9 @@ def _manifest(folder: Path) -> str:
 
 
 def _foreign(folder: Path) -> Path | None:
-    """A file in ``folder`` that kinergy did not write there or that changed since (None: there
-    is none, the folder is kinergy's to replace). Without a marker listing its files, every file
-    is foreign."""
+    """A file in ``folder`` that kinergy did not write there or that changed since, or a folder
+    in it holding none of kinergy's files (None: there is none, the folder is kinergy's to
+    replace). Without a marker listing its files, every file and folder is foreign."""
     written: dict[str, str] = {}
     marker = folder / MARKER
     if marker.is_file() and not marker.is_symlink():
@@ -309,13 +325,20 @@ def _foreign(folder: Path) -> Path | None:
         rel = f.relative_to(folder).as_posix()
         if f.is_symlink() or not f.is_file() or written.get(rel) != _sha256(f):
             return f
+    for d in sorted(p for p in folder.rglob("*") if p.is_dir()):
+        # a folder of the user's, even an empty one (a folder named report.html), or a link to
+        # one: kinergy's own folders hold the files it wrote
+        rel = d.relative_to(folder).as_posix() + "/"
+        if d.is_symlink() or not any(name.startswith(rel) for name in written):
+            return d
     return None
 
 
 def check_folder(path: PathLike) -> Path:
     """``path`` as a folder of outputs (:func:`atomic_folder`): refused, before any work, when it
     is a file or a link, or a folder holding a file kinergy did not write there (or changed since:
-    the marker lists what it wrote, by SHA-256); an empty folder is taken.
+    the marker lists what it wrote, by SHA-256) or a folder of the user's (an empty one too); an
+    empty folder is taken.
 
     Returns the path. Raises KinergyError, one line naming it.
     """
@@ -325,10 +348,11 @@ def check_folder(path: PathLike) -> Path:
     if target.is_dir():
         other = _foreign(target)
         if other is not None:
+            kind = " (a folder)" if other.is_dir() else ""
             raise KinergyError(
-                f"{target}: holds {other.relative_to(target)}, which kinergy did not write there "
-                "(or which changed since): replacing the folder would delete it; give an empty "
-                "or new folder"
+                f"{target}: holds {other.relative_to(target)}{kind}, which kinergy did not write "
+                "there (or which changed since): replacing the folder would delete it; give an "
+                "empty or new folder"
             )
     if target.parent.exists() and not target.parent.is_dir():
         raise KinergyError(f"{target}: {target.parent} is not a folder")

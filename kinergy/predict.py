@@ -17,10 +17,10 @@ Energy accounting, validation, the twin and the optimiser all predict through
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from kinergy.arrays import Array
 from kinergy.drives.electrics import (
@@ -33,9 +33,9 @@ from kinergy.drives.electrics import (
 from kinergy.drives.transmission import reflected_inertia, transmission_matrix
 from kinergy.dynamics.chain import check_state
 from kinergy.dynamics.rnea import gravity_torque, rnea
-from kinergy.model.robot import Robot
+from kinergy.model.robot import Payload, Robot
 
-__all__ = ["DriveState", "drive_state"]
+__all__ = ["DriveState", "drive_by_payload", "drive_state"]
 
 
 @dataclass(frozen=True)
@@ -137,3 +137,51 @@ def drive_state(
         voltage=voltage,
         power=power,
     )
+
+
+def drive_by_payload(
+    robot: Robot,
+    payloads: tuple[Payload | None, ...],
+    load: NDArray[np.intp],
+    q: Array,
+    qd: Array,
+    qdd: Array,
+    *,
+    temperature: Array | None = None,
+) -> DriveState:
+    """:func:`drive_state` at samples that carry different loads (a program's ``set_payload``, a
+    log's ``payload`` column).
+
+    Parameters
+    ----------
+    robot : Robot
+    payloads : tuple of Payload or None
+        The loads (``None``: none at the flange).
+    load : ndarray of int, shape (N,)
+        Index into ``payloads`` of each sample's load.
+    q, qd, qdd : ndarray, shape (N, n)
+    temperature : ndarray, shape (N, n), optional
+        As :func:`drive_state`'s.
+
+    Returns
+    -------
+    DriveState
+        Arrays of shape (N, n), each sample computed with its load.
+    """
+    used = np.unique(load)
+    if used.size == 1:
+        loaded = robot.with_payload(payloads[int(used[0])])
+        return drive_state(loaded, q, qd, qdd, temperature=temperature)
+    parts = {}
+    for i in used:
+        m = load == i
+        temp = None if temperature is None else temperature[m]
+        loaded = robot.with_payload(payloads[int(i)])
+        parts[int(i)] = drive_state(loaded, q[m], qd[m], qdd[m], temperature=temp)
+    out = {}
+    for f in fields(DriveState):
+        arr = np.zeros(np.shape(q))
+        for i, state in parts.items():
+            arr[load == i] = getattr(state, f.name)
+        out[f.name] = arr
+    return DriveState(**out)

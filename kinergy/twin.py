@@ -12,11 +12,12 @@ motion is sampled (the controller's 500 Hz), the RTDE signals the UR5e doc works
   measured angle and speed carry encoder noise;
 - ``actual_current``: UR5e eq 17 on the *real* motion (friction included, at the joints'
   temperatures) plus current noise, quantised to the controller's current step;
-- ``actual_joint_voltage``: UR5e eq 19 as the controller logs it (dq voltage, 2/3 of the
-  equivalent DC motor's, :mod:`kinergy.drives.electrics`), plus noise;
 - ``actual_robot_voltage`` and ``actual_robot_current``: the arm's supply, the DC bus voltage
   (with ripple) and the current it draws for the bus model's power (:mod:`kinergy.drives.bus`:
-  motors summed on the bus, surplus braking power to the shunt, plus standby);
+  motors summed on the bus, surplus braking power to the shunt, plus the standing draw);
+- ``actual_joint_voltage``: each joint's supply as a UR controller logs it, the bus voltage at
+  the joint (the supply's less the arm's cable drop,
+  :func:`kinergy.drives.bus.joint_bus_voltage`), plus noise; not the motor's voltage;
 - ``joint_temperatures``: each joint warmed by its losses and its share of the arm's standby
   power (:mod:`kinergy.drives.thermal`), when the true robot has thermal models;
   temperature-dependent friction follows them;
@@ -42,8 +43,8 @@ from scipy.interpolate import CubicSpline
 
 from kinergy import checks
 from kinergy.arrays import Array
-from kinergy.drives.bus import supply_power
-from kinergy.drives.electrics import controller_voltage, winding_resistances
+from kinergy.drives.bus import joint_bus_voltage, supply_power
+from kinergy.drives.electrics import winding_resistances
 from kinergy.drives.thermal import joint_losses, joint_temperatures
 from kinergy.errors import KinergyError
 from kinergy.friction.load_thermal_power_law import MODEL as LOAD_THERMAL_POWER_LAW
@@ -225,9 +226,9 @@ def simulate(
     current = actual.current + settings.current_noise * rng.standard_normal((big_n, n))
     actual_q = real.q + settings.position_noise * rng.standard_normal((big_n, n))
     actual_qd = real.qd + settings.speed_noise * rng.standard_normal((big_n, n))
-    joint_voltage = controller_voltage(actual.voltage)
-    joint_voltage = joint_voltage + settings.voltage_noise * rng.standard_normal((big_n, n))
+    voltage_noise = settings.voltage_noise * rng.standard_normal((big_n, n))
     bus_voltage, bus_current = _supply(robot, actual, target.t, settings, rng)
+    joint_voltage = joint_bus_voltage(bus_voltage, bus_current, n) + voltage_noise
     signals = {
         "target_q": target.q,
         "actual_q": actual_q,

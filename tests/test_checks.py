@@ -175,6 +175,8 @@ def _dataset_logs() -> list[tuple[str, Path, str | None]]:
             continue  # positions of 1e305 rad: refused as corrupted (test_real_logs_refused)
         out.append(("ur10e", path, SHORT if path.name in SHORT_LOGS else SPEC))
     out += [("ur3e", path, None) for path in sorted(UR3E.glob("*.csv"))]
+    out += [("panda", DATASETS / "panda-gaz", None)]  # its folder, as its README reads it
+    out += [("ur3e", path, None) for path in sorted((DATASETS / "ur3e-rad").glob("*.csv"))]
     return out
 
 

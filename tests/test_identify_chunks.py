@@ -76,7 +76,7 @@ def _assert_same(got: Robot, want: Robot, rtol: float = RTOL) -> None:
 
 def _log(path: Path, robot: Robot, dt: float, payload: Payload | None = None) -> Path:
     """A realistic twin log of test A at ``dt`` with a gap (two segments), samples where the
-    program is not running at its start, and jittered time stamps in its second segment."""
+    robot is not running at its start, and jittered time stamps in its second segment."""
     truth = realistic_truth(robot, seed=3)
     if payload is not None:
         truth = truth.with_payload(payload)
@@ -87,8 +87,8 @@ def _log(path: Path, robot: Robot, dt: float, payload: Payload | None = None) ->
     second = twin.t + twin.t[-1] + 60.0 + jitter
     t = np.concatenate([twin.t, second])
     signals = {k: np.concatenate([v, v]) for k, v in twin.signals.items()}
-    if "runtime_state" in signals:
-        signals["runtime_state"][:40] = 1
+    if "robot_mode" in signals:
+        signals["robot_mode"][:40] = 5  # idle (brakes on) before the program
     write_log(path, t, signals)
     return path
 

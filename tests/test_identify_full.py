@@ -31,7 +31,8 @@ from kinergy.identification.physical import (
 )
 from kinergy.identification.result import IdentificationResult, validation_metrics
 from kinergy.io.log import Log
-from kinergy.logs.prepare import IdentData, lowpass, prepare
+from kinergy.logs.filtering import lowpass
+from kinergy.logs.prepare import IdentData, prepare
 from kinergy.model.robot import Friction, inertia_matrix
 from kinergy.trajectory.fourier import fourier_motion
 from kinergy.trajectory.motion import Motion

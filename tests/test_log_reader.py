@@ -21,7 +21,7 @@ DATASETS = Path(__file__).resolve().parents[2] / "shared" / "datasets"
 def _log(tmp_path: Path, n: int = 1000, period: float = 0.002, name: str = "x.csv") -> Path:
     rng = np.random.default_rng(1)
     t = np.arange(n) * period
-    write_log(tmp_path / name, t, {"actual_q": rng.normal(size=(n, 6)), "mode": np.ones(n)})
+    write_log(tmp_path / name, t, {"actual_q": rng.normal(size=(n, 6)), "robot_mode": np.ones(n)})
     return tmp_path / name
 
 
@@ -54,14 +54,14 @@ def test_a_bad_cell_after_the_first_chunk_names_its_line(tmp_path: Path) -> None
     lines[351] = lines[351].replace(" ", " x", 1).replace(" x", " ", 1).rsplit(" ", 1)[0] + " x"
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(
-        KinergyError, match=r"line 352, column 8 \(mode\): not a finite number: 'x'"
+        KinergyError, match=r"line 352, column 8 \(robot_mode\): not a finite number: 'x'"
     ):
         list(iter_log(path, rows=100))
 
 
 def test_select_reads_only_the_named_signals(tmp_path: Path) -> None:
-    log = read_log(_log(tmp_path), select=["mode"])
-    assert set(log.signals) == {"mode"}
+    log = read_log(_log(tmp_path), select=["robot_mode"])
+    assert set(log.signals) == {"robot_mode"}
     with pytest.raises(KinergyError, match="no column.*nothing"):
         read_log(_log(tmp_path), select=["nothing"])
 
@@ -76,8 +76,8 @@ def test_the_registry_names_its_formats() -> None:
 
 def test_a_byte_order_mark_is_skipped(tmp_path: Path) -> None:
     path = tmp_path / "bom.csv"
-    path.write_bytes("\ufefftimestamp,a_0\n0,1\n0.1,2\n".encode())
-    np.testing.assert_array_equal(read_log(path)["a"], [[1], [2]])
+    path.write_bytes("\ufefftimestamp,actual_q_0\n0,1\n0.1,2\n".encode())
+    np.testing.assert_array_equal(read_log(path)["actual_q"], [[1], [2]])
     headerless = tmp_path / "bom2.csv"
     headerless.write_bytes("\ufeff0,1\n0.1,2\n".encode())
     np.testing.assert_array_equal(read_log(headerless, columns="timestamp,actual_q:1").t, [0, 0.1])
@@ -110,21 +110,21 @@ def test_gaps_are_found() -> None:
 
 def test_a_complex_cell_is_named(tmp_path: Path) -> None:
     path = tmp_path / "c.csv"
-    path.write_text("timestamp a_0\n0 1\n0.1 1+2j\n")
-    with pytest.raises(KinergyError, match=r"line 3, column 2 \(a_0\).*'1\+2j' \(a complex"):
+    path.write_text("timestamp actual_q_0\n0 1\n0.1 1+2j\n")
+    with pytest.raises(KinergyError, match=r"line 3, column 2 \(actual_q_0\).*'1\+2j' \(a complex"):
         read_log(path)
 
 
 def test_repair_drops_a_complex_cell_and_counts_it(tmp_path: Path) -> None:
     path = tmp_path / "c.csv"
-    path.write_text("timestamp a_0\n0 1\n0.1 1+2j\n0.2 3\n0.3 4\n")
+    path.write_text("timestamp actual_q_0\n0 1\n0.1 1+2j\n0.2 3\n0.3 4\n")
     log = read_log(path, repair=True)
     assert len(log) == 3 and "dropped 1 malformed row(s) at line(s) 3" in log.notes[0]
 
 
 def test_nul_bytes_are_never_echoed(tmp_path: Path) -> None:
     path = tmp_path / "nul.csv"
-    path.write_bytes(b"timestamp a_0\n0 1\n0.1 \x00\x00\n")
+    path.write_bytes(b"timestamp actual_q_0\n0 1\n0.1 \x00\x00\n")
     with pytest.raises(KinergyError) as info:
         read_log(path)
     assert "\x00" not in str(info.value) and "NUL bytes" in str(info.value)
@@ -141,8 +141,8 @@ def test_column_limits_are_refused_before_allocation(tmp_path: Path) -> None:
 
 def test_fast_reader_falls_back_on_runs_of_spaces(tmp_path: Path) -> None:
     path = tmp_path / "s.csv"
-    path.write_text("timestamp  a_0\n0   1\n0.1\t2\n")
-    np.testing.assert_array_equal(read_log(path)["a"], [[1], [2]])
+    path.write_text("timestamp  actual_q_0\n0   1\n0.1\t2\n")
+    np.testing.assert_array_equal(read_log(path)["actual_q"], [[1], [2]])
     assert log_arrow.NotPlain.__doc__
 
 

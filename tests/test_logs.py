@@ -51,32 +51,40 @@ def test_headerless_with_columns_and_trailing_delimiter(tmp_path: Path) -> None:
     [
         ("0.0 1 2\n0.1 3 4\n", None, "no header line.*--columns"),
         (
-            "timestamp a_0 a_1\n0.0 1 2\n0.1 3 x\n",
+            "timestamp actual_q_0 actual_q_1\n0.0 1 2\n0.1 3 x\n",
             None,
-            r"line 3, column 3 \(a_1\): not a finite number: 'x'",
+            r"line 3, column 3 \(actual_q_1\): not a finite number: 'x'",
         ),
         (
-            "timestamp a_0 a_1\n0.0 1 2\n0.1 3 nan\n",
+            "timestamp actual_q_0 actual_q_1\n0.0 1 2\n0.1 3 nan\n",
             None,
-            r"line 3, column 3 \(a_1\): not a finite number",
+            r"line 3, column 3 \(actual_q_1\): not a finite number",
         ),
         (
-            "timestamp,a_0,a_1\n0.0,1,2\n0.1,3\n",
+            "timestamp,actual_q_0,actual_q_1\n0.0,1,2\n0.1,3\n",
             None,
-            r"line 3, column 3 \(a_1\): missing value \(truncated line\?\)",
+            r"line 3, column 3 \(actual_q_1\): missing value \(truncated line\?\)",
         ),
-        ("timestamp a_0\n0.0 1\n0.1 2\n0.1 3\n", None, r"line 4: timestamp repeats"),
-        ("timestamp a_0\n0.0 1\n0.2 2\n0.1 3\n", None, r"line 4: timestamp goes back"),
-        ("a_0 a_1\n1 2\n3 4\n", None, "no 'timestamp' column"),
-        ("timestamp a_0\n0.0 1\n", None, "at least 2 samples"),
+        ("timestamp actual_q_0\n0.0 1\n0.1 2\n0.1 3\n", None, r"line 4: timestamp repeats"),
+        ("timestamp actual_q_0\n0.0 1\n0.2 2\n0.1 3\n", None, r"line 4: timestamp goes back"),
+        ("actual_q_0 actual_q_1\n1 2\n3 4\n", None, "no 'timestamp' column"),
+        ("timestamp actual_q_0\n0.0 1\n", None, "at least 2 samples"),
         (
             "0.0,1\n0.1,2\n",
             "timestamp,actual_q:2",
             "rows have 2 fields but the --columns spec names 3",
         ),
         ("", None, "empty log"),
-        ("timestamp a_0 a_2\n0.0 1 2\n0.1 3 4\n", None, r"no column a_1 although a_0, _2 are"),
-        ("timestamp ab_1 ac_0\n0.0 1 2\n0.1 3 4\n", None, r"no column ab_0 .* 'ac_0' misspelled\?"),
+        (
+            "timestamp actual_q_0 actual_q_2\n0.0 1 2\n0.1 3 4\n",
+            None,
+            r"no column actual_q_1 although actual_q_0, _2 are",
+        ),
+        (
+            "timestamp actual_q_1 actual_qx_0\n0.0 1 2\n0.1 3 4\n",
+            None,
+            r"no column actual_q_0 .* 'actual_qx_0' misspelled\?",
+        ),
     ],
 )
 def test_malformed_logs_are_one_line(

@@ -16,14 +16,10 @@ from scipy.signal import butter, find_peaks, sosfreqz
 import kinergy
 from kinergy.errors import KinergyError
 from kinergy.io.log import Log
-from kinergy.logs.prepare import (
-    estimate_lag,
-    lowpass,
-    prepare,
-    resample,
-    running_range,
-    uniform_grid,
-)
+from kinergy.logs.filtering import lowpass
+from kinergy.logs.lag import estimate_lag
+from kinergy.logs.prepare import prepare
+from kinergy.logs.samples import resample, running_range, running_runs, uniform_grid
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import paper_trajectory
 from kinergy.twin import TwinSettings, simulate
@@ -51,51 +47,63 @@ def uniform(log: Log) -> Log:
 
 
 def _modes(states: list[tuple[int, int, int]]) -> tuple[np.ndarray, np.ndarray]:
-    """(runtime_state, robot_mode, count) blocks -> per-sample arrays."""
-    rs = np.concatenate([np.full(n, float(r)) for r, _, n in states])
+    """(safety_mode, robot_mode, count) blocks -> per-sample arrays."""
+    sm = np.concatenate([np.full(n, float(r)) for r, _, n in states])
     rm = np.concatenate([np.full(n, float(m)) for _, m, n in states])
-    return rs, rm
+    return sm, rm
 
 
-def test_running_keeps_the_block_where_the_program_plays() -> None:
-    rs, rm = _modes([(1, 7, 30), (2, 7, 50), (1, 7, 20)])
-    t = np.arange(rs.size) * DT
-    q = np.random.default_rng(0).normal(size=(rs.size, 6))
-    out = running(_log(t, actual_q=q, runtime_state=rs, robot_mode=rm))
+def test_running_keeps_the_block_where_the_robot_runs() -> None:
+    # robot_mode 5 (idle: brakes on) around 7 (running)
+    sm, rm = _modes([(1, 5, 30), (1, 7, 50), (1, 5, 20)])
+    t = np.arange(sm.size) * DT
+    q = np.random.default_rng(0).normal(size=(sm.size, 6))
+    out = running(_log(t, actual_q=q, safety_mode=sm, robot_mode=rm))
     np.testing.assert_array_equal(out.t, t[30:80])
     np.testing.assert_array_equal(out["actual_q"], q[30:80])
-    np.testing.assert_array_equal(out["runtime_state"], np.full(50, 2.0))
+    np.testing.assert_array_equal(out["robot_mode"], np.full(50, 7.0))
     assert out.path == "mem.csv"
 
 
+def test_a_stopped_or_paused_program_leaves_no_sample_out() -> None:
+    # runtime_state 1 (stopped) and 4 (paused) with the robot running: the arm holds still
+    # under control, its torques valid (the ur3e-rad log stops between its moves)
+    rs = np.concatenate([np.full(30, 1.0), np.full(50, 2.0), np.full(20, 4.0)])
+    log = _log(np.arange(rs.size) * DT, runtime_state=rs, robot_mode=np.full(rs.size, 7.0))
+    assert running_range(log) == slice(0, rs.size)
+    assert running_runs(log) == [(0, rs.size)]
+
+
 def test_running_keeps_the_longest_block() -> None:
-    # playing in three blocks; the middle one is cut in two by robot_mode leaving RUNNING,
-    # which leaves the last block (40 samples) the longest
-    rs, rm = _modes(
-        [(2, 7, 25), (0, 7, 5), (2, 7, 30), (2, 5, 3), (2, 7, 30), (1, 7, 4), (2, 7, 40), (1, 7, 2)]
+    # running in three blocks; the middle one is cut in two by a protective stop (safety mode
+    # 3), which leaves the last block (40 samples) the longest
+    sm, rm = _modes(
+        [(1, 7, 25), (1, 5, 5), (2, 7, 30), (3, 7, 3), (1, 7, 30), (1, 4, 4), (1, 7, 40), (1, 5, 2)]
     )
-    t = np.arange(rs.size) * DT
-    x = np.arange(rs.size, dtype=float)
-    out = running(_log(t, x=x, runtime_state=rs, robot_mode=rm))
+    t = np.arange(sm.size) * DT
+    x = np.arange(sm.size, dtype=float)
+    log = _log(t, x=x, safety_mode=sm, robot_mode=rm)
+    out = running(log)
     start = 25 + 5 + 30 + 3 + 30 + 4
     np.testing.assert_array_equal(out.t, t[start : start + 40])
     np.testing.assert_array_equal(out["x"], x[start : start + 40])
+    assert running_runs(log) == [(0, 25), (30, 60), (63, 93), (97, 137)]
 
 
 @settings(max_examples=80, deadline=None)
 @given(
-    playing=st.lists(st.booleans(), min_size=2, max_size=60),
+    safe=st.lists(st.booleans(), min_size=2, max_size=60),
     mode_ok=st.lists(st.booleans(), min_size=60, max_size=60),
 )
-def test_running_keeps_a_longest_maximal_run(playing: list[bool], mode_ok: list[bool]) -> None:
-    ok = np.array(playing) & np.array(mode_ok[: len(playing)])
-    rs = np.where(playing, 2.0, 1.0)
-    rm = np.where(mode_ok[: len(playing)], 7.0, 5.0)
-    idx = np.arange(len(playing), dtype=float)
+def test_running_keeps_a_longest_maximal_run(safe: list[bool], mode_ok: list[bool]) -> None:
+    ok = np.array(safe) & np.array(mode_ok[: len(safe)])
+    sm = np.where(safe, 2.0, 3.0)
+    rm = np.where(mode_ok[: len(safe)], 7.0, 5.0)
+    idx = np.arange(len(safe), dtype=float)
     t = idx * DT
-    log = _log(t, idx=idx, runtime_state=rs, robot_mode=rm)
+    log = _log(t, idx=idx, safety_mode=sm, robot_mode=rm)
     if not ok.any():
-        with pytest.raises(KinergyError, match="no sample where the program runs"):
+        with pytest.raises(KinergyError, match="no sample where the robot runs"):
             running(log)
         return
     out = running(log)
@@ -105,13 +113,16 @@ def test_running_keeps_a_longest_maximal_run(playing: list[bool], mode_ok: list[
     np.testing.assert_array_equal(np.diff(kept), 1)  # consecutive samples
     assert ok[kept].all()  # all of them running
     np.testing.assert_array_equal(out.t, t[kept])
+    runs = running_runs(log)  # every run, maximal and in order
+    assert sum(b - a for a, b in runs) == int(ok.sum())
+    assert all(ok[a:b].all() for a, b in runs)
 
 
-def test_running_raises_when_the_program_never_runs() -> None:
-    # playing only while the robot is not RUNNING, and RUNNING only while not playing
-    rs, rm = _modes([(2, 5, 20), (1, 7, 20)])
-    log = _log(np.arange(40) * DT, runtime_state=rs, robot_mode=rm)
-    with pytest.raises(KinergyError, match=r"^mem\.csv: no sample where the program runs"):
+def test_running_raises_when_the_robot_never_runs() -> None:
+    # running only while the safety system stops it, and safe only while not running
+    sm, rm = _modes([(3, 7, 20), (1, 5, 20)])
+    log = _log(np.arange(40) * DT, safety_mode=sm, robot_mode=rm)
+    with pytest.raises(KinergyError, match=r"^mem\.csv: no sample where the robot runs"):
         running(log)
 
 
@@ -390,8 +401,8 @@ def test_prepare_rejects_a_five_joint_speed_or_acceleration(widths: dict[str, in
 
 def test_prepare_cuts_measured_torques_with_the_log() -> None:
     log = _random_log({"actual_q": 6, "actual_qd": 6})
-    state = np.r_[np.full(50, 1.0), np.full(150, 2.0)]
-    log = _log(log.t, runtime_state=state, **log.signals)
+    state = np.r_[np.full(50, 5.0), np.full(150, 7.0)]  # idle, then running
+    log = _log(log.t, robot_mode=state, **log.signals)
     torque = np.random.default_rng(8).normal(size=(200, 6))
     d = prepare(_log(log.t, actual_joint_torque=torque, **log.signals), 6)
     assert d.torque is not None

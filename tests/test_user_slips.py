@@ -38,7 +38,8 @@ def test_a_number_that_is_not_finite_is_refused_naming_the_flag(
 
 
 def test_a_payload_centre_of_mass_in_mm_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["energy", "ur5e", "test-a", "--payload", "1.5,0,0,60"]) == 1
+    # the value refused where --payload is parsed (LogReading): a usage error, as --columns's
+    assert main(["energy", "ur5e", "test-a", "--payload", "1.5,0,0,60"]) == 2
     err = capsys.readouterr().err
     assert "--payload: payload com is 60 m from the flange" in err and "mm instead of m?" in err
 

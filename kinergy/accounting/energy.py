@@ -23,8 +23,8 @@ feed joints driving; the supply takes nothing back).
 
 What the arm draws from its supply -- the answer to "how much did it cost" -- is the report's
 ``supply`` (:mod:`kinergy.accounting.supply`): the joints' powers shared on the DC bus, the
-surplus burnt in the shunt, plus standby. Where a log measured its supply, ``measured`` holds that
-figure beside it.
+surplus burnt in the shunt, plus the arm's standing draw (``drawn = motors + standby``). Where
+a log measured its supply, ``measured`` holds that figure beside it.
 
 One accounting serves every motion: :class:`EnergyAccumulator` folds chunks of a motion into
 running sums (every integral is a column of one matrix of integrands, integrated by the trapezoid
@@ -224,6 +224,7 @@ class EnergyAccumulator:
             shunt=shunt,
             mean_power=drawn / d if d else float("nan"),
             peak_power=self.supply_peak,
+            standby_power=self.robot.standby_power,
         )
         meas = None
         if measured:

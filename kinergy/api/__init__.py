@@ -5,8 +5,10 @@ Options are frozen dataclasses checked on construction (a value out of range, or
 not one of an option's, is one :class:`~kinergy.errors.KinergyError` line naming the option as
 its flag), so the command line and Python refuse the same value with the same message:
 :class:`LogReading` (how every command reads its logs: ``--columns``, ``--repair``,
-``--cutoff``, ``--accept``, ``--topic``, ``--effort``; :meth:`LogReading.parse` takes them as
-the flags give them), :class:`IdentifyOptions`, :class:`EnergyOptions`,
+``--cutoff``, ``--accept``, ``--topic``, ``--effort``, ``--payload``, ``--from``/``--to``:
+the payload given replaces the one the log's controller logged, which is used otherwise, and
+the model's; the window is seconds on the log's own time axis; :meth:`LogReading.parse` takes
+them as the flags give them), :class:`IdentifyOptions`, :class:`EnergyOptions`,
 :class:`SimulateOptions`, :class:`FleetOptions`, :class:`StreamOptions`,
 :class:`RecordOptions`, ...
 

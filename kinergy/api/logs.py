@@ -18,7 +18,7 @@ from kinergy.io.formats import read_log as _read_file
 from kinergy.io.log import Log
 from kinergy.logs.reading import CheckedLog, LogReading
 from kinergy.trajectory.motion import Motion
-from kinergy.workflows.energy import EnergyOptions, LogEnergy, energy_of_log
+from kinergy.workflows.energy import EnergyOptions, LogEnergy, energy_with_outputs
 from kinergy.workflows.identify import PayloadRun, identify_logs, identify_payload_model
 from kinergy.workflows.study import StudyReport, study_report
 from kinergy.workflows.validate import validate_logs
@@ -114,22 +114,27 @@ def energy(
     *,
     reading: LogReading | None = None,
     temperature: Array | None = None,
+    trace: PathLike | None = None,
+    plot: PathLike | None = None,
 ) -> EnergyReport | LogEnergy:
     """``kinergy energy``: per-joint and total mechanical and electrical energy, what the arm
     draws from its supply, and where the energy goes.
 
     ``log_or_motion``: a :class:`Motion` (the energy of it held in memory, with its time series:
-    :class:`EnergyReport`; ``temperature`` (N, n) deg C for temperature-dependent friction), or
-    a log or motion file, a URScript program (``.script``), or a built-in motion (``"test-a"``,
-    ``"test-b"``): :class:`LogEnergy`, read in one pass through the checks.
+    :class:`EnergyReport`; ``temperature`` (N, n) deg C for temperature-dependent friction;
+    ``reading.payload`` the payload it carries), or a log or motion file, a URScript program
+    (``.script``), or a built-in motion (``"test-a"``, ``"test-b"``): :class:`LogEnergy`, read
+    in one pass through the checks, with the power sample by sample written to ``trace`` (CSV
+    or Parquet) and its plot to ``plot`` (PNG) when given.
     """
     r = robot_of(model)
     options = options or EnergyOptions()
     if isinstance(log_or_motion, Motion):
+        loaded = r if reading is None else reading.loaded(r)
         return _energy_of_motion(
-            r, log_or_motion, recovery=options.recovery, temperature=temperature
+            loaded, log_or_motion, recovery=options.recovery, temperature=temperature
         )
-    return energy_of_log(r, log_or_motion, reading, options)
+    return energy_with_outputs(r, log_or_motion, reading, options, trace=trace, plot=plot)
 
 
 def report(

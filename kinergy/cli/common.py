@@ -134,9 +134,12 @@ def load(robot_name: str, payload: str | None) -> Robot:
     return load_robot(robot_name, payload=None if payload is None else parse_payload(payload))
 
 
+#: ``--payload``'s value, as :func:`kinergy.model.toml.parse_payload` reads it
+PAYLOAD_METAVAR = "MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]"
+
 payload_option = click.option(
     "--payload",
-    metavar="MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]",
+    metavar=PAYLOAD_METAVAR,
     help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2 about its "
     "centre of mass.",
 )
@@ -208,7 +211,10 @@ _READING_FLAGS: dict[str, Callable[[Any], Any]] = {
         "--columns",
         metavar="SPEC",
         help="Layout of a headerless log: UR's RTDE field names, NAME:N for an N-vector, _ (or "
-        '_:N) for columns to skip, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6".',
+        '_:N) for columns to skip, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6"; or '
+        "a header log's own names mapped to RTDE fields, FIELD=COLUMN with * for a vector's "
+        'index, e.g. "timestamp=time,actual_q=positions_*" (_=COLUMN leaves a column unread). A '
+        "header's columns that are no RTDE field are ignored (a note names them).",
     ),
     "repair": click.option(
         "--repair",
@@ -243,6 +249,30 @@ _READING_FLAGS: dict[str, Callable[[Any], Any]] = {
         default=None,
         help="ROS 2 bags: what JointState effort holds, motor currents (A) or joint torques "
         "(N m) [current for UR arms, as UR's driver publishes by default; torque for others].",
+    ),
+    "payload": click.option(
+        "--payload",
+        metavar=PAYLOAD_METAVAR,
+        help="Payload at the flange: kg, m (flange frame), kg m^2 about its centre of mass. It "
+        "replaces the model's and the one a log's controller logged (payload, payload_cog, "
+        "payload_inertia), which is used otherwise.",
+    ),
+    "start": click.option(
+        "--from",
+        "start",
+        type=float,
+        default=None,
+        metavar="S",
+        help="Read each log from this time (s, on the log's own time axis) [its start].",
+    ),
+    "stop": click.option(
+        "--to",
+        "stop",
+        type=float,
+        default=None,
+        metavar="S",
+        help="Read each log up to this time (s, on the log's own time axis: its timestamp "
+        "column; a ROS 2 bag's from its first message) [its end].",
     ),
 }
 

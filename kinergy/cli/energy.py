@@ -12,8 +12,6 @@ from kinergy.cli.common import (
     as_usage,
     choice_of,
     json_result,
-    load,
-    payload_option,
     prose,
     reading_options,
     table,
@@ -51,10 +49,12 @@ def _row(
 def _supply_lines(result: api.LogEnergy) -> list[str]:
     """What the arm draws from its supply, predicted and (where logged) measured."""
     sup, measured = result.supply, result.measured
+    share = f", {100 * sup.standby / sup.drawn:.0f} % of it" if sup.drawn > 0 else ""
     lines = [
-        f"Drawn from the arm's supply: {sup.drawn:.1f} J predicted (motors {sup.motors:.1f} J "
-        f"+ standby {sup.standby:.1f} J; {sup.shunt:.1f} J of braking burnt in the shunt), "
-        f"mean {sup.mean_power:.1f} W, peak {sup.peak_power:.1f} W.",
+        f"Drawn from the arm's supply: {sup.drawn:.1f} J predicted = motors {sup.motors:.1f} J"
+        f" + standing draw {sup.standby:.1f} J ({sup.standby_power:.3g} W for "
+        f"{result.duration:.1f} s{share}); {sup.shunt:.1f} J of braking burnt in the shunt, "
+        f"not drawn. Mean {sup.mean_power:.1f} W, peak {sup.peak_power:.1f} W.",
     ]
     if measured is not None:
         error = result.measured_dict().get("error")
@@ -131,16 +131,30 @@ def energy_text(result: api.LogEnergy) -> str:
     show_default=True,
     help="Which motion of a log: commanded (target_*) or measured (actual_*).",
 )
-@payload_option
-@reading_options("columns", "repair", "accept", "topic", "effort")
-@writes(inputs=("model", "motion_path"))
+@click.option(
+    "--trace",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Write the power sample by sample: time, supply_predicted, supply_measured (where the "
+    "log measures it) and each joint's electrical power, W; CSV or Parquet by the extension.",
+)
+@click.option(
+    "--plot",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Draw the supply's power over time, predicted against measured, with the energy of "
+    "each (PNG).",
+)
+@reading_options("columns", "repair", "accept", "topic", "effort", "payload", "start", "stop")
+@writes(files=("trace", "plot"), inputs=("model", "motion_path"))
 def energy(
     model: str,
     motion_path: str,
     as_json: bool,
     no_recovery: bool,
     source: api.MotionSource,
-    payload: str | None,
+    trace: str | None,
+    plot: str | None,
     reading: LogReading,
 ) -> None:
     """What a logged or planned motion draws from the arm's supply, and per-joint mechanical and
@@ -152,7 +166,7 @@ def energy(
     """
     with as_usage():
         options = api.EnergyOptions(source=source, recovery=not no_recovery)
-    result = api.energy(load(model, payload), motion_path, options, reading=reading)
+    result = api.energy(model, motion_path, options, reading=reading, trace=trace, plot=plot)
     assert isinstance(result, api.LogEnergy)  # a file or a built-in motion, not a Motion
     tell(result.notes, result.warnings)
     click.echo(json_result(result) if as_json else energy_text(result))

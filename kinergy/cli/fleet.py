@@ -42,7 +42,7 @@ def fleet() -> None:
     help="Smallest rise called drift (a fraction, >= 0).",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the robots as JSON.")
-@reading_options("topic", "effort", "accept")
+@reading_options("topic", "effort", "accept", "payload", "start", "stop")
 def energy(
     logs: tuple[str, ...],
     manifest: str,

@@ -247,7 +247,10 @@ def identify(
 
     The sequential method (default, UR5e doc sections 3-4) keeps the model's link data and
     identifies rotor inertias from target_moment and torque constants with friction from
-    actual_current; the full method regresses the base inertial parameters too.
+    actual_current; the full method regresses the base inertial parameters too. Where the logs
+    measure the arm's supply (actual_robot_voltage, actual_robot_current), the standing draw
+    (electronics with the brakes released) is identified with its standard error; the motors' R
+    and k_b stay the model's (actual_joint_voltage is each joint's bus voltage).
     """
     with as_usage():
         options = IdentifyOptions(

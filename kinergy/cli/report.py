@@ -6,8 +6,6 @@ import click
 
 from kinergy import api
 from kinergy.cli.common import (
-    load,
-    payload_option,
     print_tables,
     progress,
     reading_options,
@@ -44,8 +42,7 @@ __all__ = ["report"]
     help="Account the energy of this log's or motion file's motion (repeatable).",
 )
 @report_folder_option()
-@payload_option
-@reading_options("columns", "repair", "accept", "topic", "effort")
+@reading_options("columns", "repair", "accept", "topic", "effort", "payload", "start", "stop")
 @writes(folders=("out",), inputs=("model", "identify_logs", "validate_logs", "energy_logs"))
 def report(
     model: str,
@@ -53,14 +50,12 @@ def report(
     validate_logs: tuple[str, ...],
     energy_logs: tuple[str, ...],
     out: str | None,
-    payload: str | None,
     reading: LogReading,
 ) -> None:
     """Build the study report (tables, figures, report.html) from your own model and logs."""
-    robot = load(model, payload)
     with progress() as say:
         study = api.report(
-            robot,
+            model,
             identify=identify_logs,
             validate=validate_logs,
             energy=energy_logs,

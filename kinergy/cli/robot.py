@@ -138,7 +138,8 @@ def _limits(r: Robot) -> str:
     rows = [
         [
             j.name,
-            fmt_vector(np.degrees(j.limits.position)),
+            fmt_vector(np.degrees(j.limits.position))
+            + (" (turns without limit)" if j.limits.continuous else ""),
             fmt(np.degrees(j.limits.speed)),
             "-" if j.limits.acceleration is None else fmt(np.degrees(j.limits.acceleration)),
             fmt(j.limits.torque),

@@ -11,8 +11,7 @@ import numpy as np
 from kinergy import api
 from kinergy.cli.common import (
     json_result,
-    load,
-    payload_option,
+    prose,
     reading_options,
     table,
     tell,
@@ -27,8 +26,9 @@ from kinergy.identification.validation import (
     ValidationReport,
 )
 from kinergy.logs.reading import LogReading
+from kinergy.model import load_robot
 
-__all__ = ["report_text", "validate", "validation_text"]
+__all__ = ["report_text", "supply_text", "validate", "validation_text"]
 
 
 def _r2(m: JointMetrics) -> str:
@@ -91,8 +91,22 @@ def _per_log_text(report: ValidationReport, names: Sequence[str]) -> str:
     return "\n".join(parts).rstrip()
 
 
+def supply_text(report: ValidationReport) -> str:
+    """The supply's power and energy, predicted against measured ('' where no log measures it)."""
+    s = report.supply
+    if s is None:
+        return ""
+    return (
+        f"Supply power against actual_robot_voltage x actual_robot_current ({s.samples} samples):"
+        f" RMSE {s.rms:.2f} W, R^2 {s.r2:.4f}, mean error {s.mean:+.2f} W; energy predicted "
+        f"{s.predicted:.1f} J against {s.measured:.1f} J measured ({s.error:+.1f} %). Predicted: "
+        "the motors summed on the DC bus plus the model's standing draw."
+    )
+
+
 def report_text(report: ValidationReport, names: Sequence[str]) -> str:
-    """``validate``'s text: pooled tables, the moving and holding segments, and each log."""
+    """``validate``'s text: pooled tables, the supply, the moving and holding segments, and
+    each log."""
     text = validation_text(report, names)
     if not text:
         return "the logs have neither target_moment nor actual_current nor measured torques"
@@ -101,6 +115,8 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
         f"below {HOLD_SPEED} rad/s for {HOLD_SECONDS} s or more)\n",
         text,
     ]
+    if supply := supply_text(report):
+        lines += ["", prose(supply)]
     for label, part in (("moving", report.moving), ("holding", report.holding)):
         if part is not None and report.moving is not None and report.holding is not None:
             lines += [f"\n--- {label} samples only ---", validation_text(part, names)]
@@ -121,7 +137,6 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
     help="Write plots (measured vs predicted, error box plots) to this folder (new, empty, or "
     "one kinergy wrote: it is replaced whole).",
 )
-@payload_option
 @reading_options()
 @writes(folders=("plots",), inputs=("model", "logs"))
 def validate(
@@ -129,7 +144,6 @@ def validate(
     logs: tuple[str, ...],
     as_json: bool,
     plots: str | None,
-    payload: str | None,
     reading: LogReading,
 ) -> None:
     """How well a model predicts logs: torque (UR5e Table V) and current (Table VII) errors and R^2.
@@ -137,7 +151,7 @@ def validate(
     A LOG may also be a built-in motion (test-a, test-b): the log the realistic twin of MODEL
     writes running it (a simulated robot that differs from the model as a real arm does).
     """
-    r = load(model, payload)
+    r = load_robot(model)
     report = api.validate(r, logs, reading=reading, plots=plots)
     tell(report.notes, report.warnings)
     if as_json:

@@ -19,13 +19,16 @@ Voltage conventions
 -------------------
 UR5e eqs 19-23 describe each brushless motor as its equivalent DC motor (Park-Clarke), whose
 power is ``V I`` and whose torque is ``k_t I``; kinergy's ``R``, ``k_b`` and voltages are that
-motor's. A UR controller's own voltages -- ``actual_joint_voltage`` in its logs and ``U`` in its
-joint calibration (``robot import-calibration``) -- are amplitude-invariant dq quantities, with
-the same current ``I`` (``actual_current``, the calibration's ``I``: ``Tau = K_tau I``) but power
-``3/2 u I``: ``V = 3/2 u`` (:data:`DQ_VOLTAGE_FACTOR`). The calibration file shows it: its
+motor's. A UR joint calibration (``robot import-calibration``) writes the motor's voltage ``U`` as
+an amplitude-invariant dq quantity, with the same current ``I`` (``Tau = K_tau I``) but power
+``3/2 U I``: ``V = 3/2 U`` (:data:`DQ_VOLTAGE_FACTOR`). The calibration file shows it: its
 ``K_tau / Km`` is 1.40 (joints 1-3) and 1.48 (joints 4-6), where a motor that does not create
 energy needs ``k_t / k_b <= 1``; read with the 3/2, ``k_t / k_b`` = 0.92 and 0.97 (the UR5e doc's
 catalogue conversion: 0.89). docs/FRICTION.md has the whole reconciliation.
+
+A controller's logs carry no motor voltage: ``actual_joint_voltage`` is each joint's supply (the
+DC bus at the joint, about 48 V, :func:`kinergy.drives.bus.joint_bus_voltage`), so ``R`` and
+``k_b`` come from the robot file or a calibration's ``U`` and ``I``, never from a log.
 """
 
 from __future__ import annotations
@@ -88,14 +91,14 @@ def electrical_power(robot: Robot, tau_m: ArrayLike, wm: ArrayLike) -> Array:
 
 
 def controller_voltage(voltage: ArrayLike) -> Array:
-    """The voltage a UR controller logs (``actual_joint_voltage``, dq) for an equivalent DC motor
-    voltage ``V`` (UR5e eq 19): ``V / 1.5``, V, shape like ``voltage``."""
+    """The dq voltage a UR joint calibration writes (``U``) for an equivalent DC motor voltage
+    ``V`` (UR5e eq 19): ``V / 1.5``, V, shape like ``voltage``."""
     return np.asarray(voltage, dtype=float) / DQ_VOLTAGE_FACTOR
 
 
 def equivalent_voltage(logged: ArrayLike) -> Array:
-    """The equivalent DC motor voltage (UR5e eq 19) of a controller's logged dq voltage:
-    ``1.5 u``, V, shape like ``logged``."""
+    """The equivalent DC motor voltage (UR5e eq 19) of a calibration's dq voltage ``U``:
+    ``1.5 U``, V, shape like ``logged``."""
     return np.asarray(logged, dtype=float) * DQ_VOLTAGE_FACTOR
 
 

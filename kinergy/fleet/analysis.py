@@ -44,9 +44,11 @@ from kinergy.identification.cycles import find_period
 from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
 from kinergy.io.segments import split_segments
+from kinergy.logs.payload import logged_loads
 from kinergy.logs.reading import CheckedLog, LogReading
 from kinergy.model.library import load_robot
 from kinergy.model.robot import Robot
+from kinergy.predict import drive_by_payload
 
 __all__ = ["CycleRecord", "LogResult", "analyse_log"]
 
@@ -122,7 +124,12 @@ def _robot(model: str) -> Robot:
 
 def _powers(robot: Robot, part: Log) -> dict[str, Array | None]:
     """Power over time of every figure a cycle row holds (W, shape (N,))."""
-    report = energy(robot, motion_from_log(part, n_joints=robot.n))
+    motion = motion_from_log(part, n_joints=robot.n)
+    loads = logged_loads(part)  # the payload the controller logged, sample by sample
+    state = (
+        None if loads is None else drive_by_payload(robot, *loads, motion.q, motion.qd, motion.qdd)
+    )
+    report = energy(robot, motion, state=state)
     bus = supply_power(report.p_elec, robot.standby_power)
     powers: dict[str, Array | None] = {
         "predicted": bus.supply,
@@ -195,8 +202,10 @@ def analyse_log(item: FleetLog) -> LogResult:
     ranges: list[float] = []
     try:
         with kernel_threads(1):  # the workers are the parallelism
-            robot = _robot(item.model)
-            reading = LogReading(bag=item.bag, accept=item.accept)
+            reading = LogReading(
+                bag=item.bag, accept=item.accept, payload=item.payload, window=item.window
+            )
+            robot = reading.loaded(_robot(item.model))
             log = CheckedLog(item.path, robot, reading).read()  # the checks decide first
             samples = len(log)
             for k, part in enumerate(split_segments(log)):

@@ -30,6 +30,8 @@ from kinergy.errors import KinergyError
 from kinergy.files import read_toml
 from kinergy.io.rosbag import BagOptions, Effort, bag_options, is_bag
 from kinergy.logs.checks import Check
+from kinergy.logs.window import TimeWindow
+from kinergy.model.robot import Payload
 
 __all__ = ["FleetLog", "Manifest", "RobotEntry", "fleet_logs", "log_date", "read_manifest"]
 
@@ -69,7 +71,8 @@ class Manifest:
 @dataclass(frozen=True)
 class FleetLog:
     """A log to analyse: its robot, the robot's model, the log's date and, for a ROS 2 bag, how
-    to read it."""
+    to read it; the checks accepted, the payload given (``--payload``: else the one the log's
+    controller logged, else the model's) and the time window (``--from``/``--to``)."""
 
     robot: str
     model: str
@@ -77,6 +80,8 @@ class FleetLog:
     date: dt.date
     bag: BagOptions | None = None
     accept: frozenset[Check] = frozenset()
+    payload: Payload | None = None
+    window: TimeWindow | None = None
 
 
 def _text(table: dict[str, object], key: str, where: str) -> str:

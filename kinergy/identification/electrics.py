@@ -1,15 +1,20 @@
-"""The motors' electrics from measured voltages, and the arm's standby power from its supply.
+"""The motors' electrics from a calibration's voltages, and the arm's standing draw from its
+supply.
 
 UR5e eq 19 for each motor, ``V = R I + k_b wm``, is linear in the winding resistance ``R`` and the
-back-EMF constant ``k_b``: given the voltage ``V`` (the equivalent DC motor's; a UR controller's
-logged ``actual_joint_voltage`` and its calibration's ``U`` are 2/3 of it,
-:mod:`kinergy.drives.electrics`), the current ``I`` and the motor speed ``wm``, least squares
-gives both (:func:`fit_electrics`). :func:`with_electrics` writes them into a model:
-``winding_resistance = R``, ``kt_over_kb = k_t / k_b`` and ``motor_constant = k_t / sqrt(R)``.
+back-EMF constant ``k_b``: given the voltage ``V`` (the equivalent DC motor's; a UR joint
+calibration's ``U`` is 2/3 of it, :mod:`kinergy.drives.electrics`), the current ``I`` and the
+motor speed ``wm``, least squares gives both (:func:`fit_electrics`; ``kinergy robot
+import-calibration``). :func:`with_electrics` writes them into a model: ``winding_resistance =
+R``, ``kt_over_kb = k_t / k_b`` and ``motor_constant = k_t / sqrt(R)``. A controller's log has
+no motor voltage (its ``actual_joint_voltage`` is the joint's bus voltage), so ``identify``
+never fits them.
 
 The arm's supply (``actual_robot_voltage`` x ``actual_robot_current``) is the motors' bus power
-plus a constant standby (:mod:`kinergy.drives.bus`); with a model that predicts the motors' power,
-the mean of the rest is the standby power (:func:`kinergy.workflows.identify.measured_electrics`).
+plus a constant standing draw (:mod:`kinergy.drives.bus`); with a model that predicts the motors'
+power, the mean of the rest is the standing draw (:class:`StandingDrawSums`), its standard error
+from the means of :data:`BLOCK_SECONDS` blocks (batch means: the rest is correlated from sample
+to sample, so the samples' own scatter would understate it).
 """
 
 from __future__ import annotations
@@ -21,14 +26,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.linalg import Reduced, scaled_solution
 from kinergy.model.robot import Robot
 
 __all__ = [
+    "BLOCK_SECONDS",
     "ElectricsFit",
     "ElectricsSums",
+    "StandingDraw",
+    "StandingDrawSums",
     "fit_electrics",
     "with_electrics",
 ]
@@ -53,7 +60,6 @@ def fit_electrics(
     wm: ArrayLike,
     *,
     weights: ArrayLike | None = None,
-    instrument: ArrayLike | None = None,
 ) -> ElectricsFit:
     """``R`` and ``k_b`` of one motor by least squares on UR5e eq 19, ``V = R I + k_b wm``.
 
@@ -63,11 +69,6 @@ def fit_electrics(
         Current (A), the equivalent DC motor's voltage (V, signed) and motor speed (rad/s).
     weights : array_like, shape (k,), optional
         Least-squares weights (``1 / |V|`` fits every point to the same relative accuracy).
-    instrument : array_like, shape (k,), optional
-        A noise-free stand-in for the current (a model's predicted current, A), used as the
-        instrumental variable of the current column: noise in a logged current biases
-        ordinary least squares' ``R`` low (errors in variables; 5 % on a UR wrist with 0.04 A
-        of noise), the instrument does not. Points and standard errors as without it.
 
     Raises
     ------
@@ -76,7 +77,7 @@ def fit_electrics(
         the speed proportional to each other, or one of them zero throughout).
     """
     sums = ElectricsSums()
-    sums.add(current, voltage, wm, weights=weights, instrument=instrument)
+    sums.add(current, voltage, wm, weights=weights)
     return sums.fit()
 
 
@@ -92,14 +93,10 @@ def _check_separable(cond: float) -> None:
 @dataclass
 class ElectricsSums:
     """:func:`fit_electrics` of one motor folded block by block: eq 19's least squares in a
-    triangle of its weighted rows (and of its rows as they are, for the RMS, when weighted) and,
-    with an instrument, the instrumental normal equations ``Z^T W^2 A`` (2, 2) and
-    ``Z^T W^2 V`` (2,), ``Z = [instrument, wm]``, ``A = [I, wm]``, ``W`` the weights."""
+    triangle of its weighted rows (and of its rows as they are, for the RMS, when weighted)."""
 
     problem: Reduced = field(default_factory=lambda: Reduced.empty(2))
     plain: Reduced | None = None
-    zta: Array | None = None
-    ztv: Array | None = None
 
     def add(
         self,
@@ -108,21 +105,15 @@ class ElectricsSums:
         wm: ArrayLike,
         *,
         weights: ArrayLike | None = None,
-        instrument: ArrayLike | None = None,
     ) -> None:
-        """Fold in a block of samples, each (k,): A, V, rad/s, the weights and the
-        instrument (A), as :func:`fit_electrics` takes them."""
+        """Fold in a block of samples, each (k,): A, V, rad/s and the weights, as
+        :func:`fit_electrics` takes them."""
         i, v, w = (np.asarray(x, dtype=float).ravel() for x in (current, voltage, wm))
         a = np.column_stack([i, w])
         wt = np.ones(i.size) if weights is None else np.asarray(weights, dtype=float).ravel()
         self.problem = self.problem.stack(a * wt[:, None], v * wt)
         if weights is not None:
             self.plain = (self.plain or Reduced.empty(2)).stack(a, v)
-        if instrument is not None:
-            z = np.column_stack([np.asarray(instrument, dtype=float).ravel(), w]) * wt[:, None]
-            zta, ztv = z.T @ (a * wt[:, None]), z.T @ (v * wt)
-            self.zta = zta if self.zta is None else self.zta + zta
-            self.ztv = ztv if self.ztv is None else self.ztv + ztv
 
     def fit(self) -> ElectricsFit:
         """The :class:`ElectricsFit` of every block.
@@ -137,8 +128,6 @@ class ElectricsSums:
             raise KinergyError(f"fitting R and k_b needs at least 3 points, got {samples}")
         x, std, cond = scaled_solution(self.problem)
         _check_separable(cond)
-        if self.zta is not None and self.ztv is not None:
-            x = np.asarray(np.linalg.solve(self.zta, self.ztv), dtype=float)
         rows = self.plain or self.problem
         rms = float(np.sqrt(rows.norm2(np.append(x, -1.0)) / samples))
         return ElectricsFit(float(x[0]), float(x[1]), float(std[0]), float(std[1]), rms, samples)
@@ -172,3 +161,69 @@ def with_electrics(robot: Robot, fits: Sequence[ElectricsFit | None]) -> Robot:
         )
         joints.append(dataclasses.replace(joint, drive=drive))
     return robot.with_joints(joints)
+
+
+#: s: the length of the blocks whose means give the standing draw's standard error
+BLOCK_SECONDS = 2.0
+
+
+@dataclass(frozen=True)
+class StandingDraw:
+    """The arm's standing draw found from a measured supply: ``power`` (W), its standard error
+    ``std`` (W, batch means of :data:`BLOCK_SECONDS` blocks; NaN from fewer than 2 blocks), over
+    ``samples`` samples in ``blocks`` blocks, and what it includes."""
+
+    power: float
+    std: float
+    samples: int
+    blocks: int
+    includes: str = (
+        "actual_robot_voltage x actual_robot_current less the motors' predicted draw (UR5e eq 23 "
+        "summed on the bus), averaged: the arm's electronics with the brakes released, and "
+        "whatever the model leaves out of the motors (a tool's draw too)"
+    )
+
+
+@dataclass
+class StandingDrawSums:
+    """:class:`StandingDraw` folded chunk by chunk: per block of :data:`BLOCK_SECONDS` of each
+    log (segment), the sum and count of the supply power less the motors' draw."""
+
+    blocks: dict[tuple[int, int], list[float]] = field(default_factory=dict)
+    origin: dict[int, float] = field(default_factory=dict)
+
+    def add(self, segment: int, t: ArrayLike, rest: ArrayLike) -> None:
+        """Fold in samples of log ``segment`` at times ``t`` (s, (k,)) whose supply power less
+        the motors' draw is ``rest`` (W, (k,))."""
+        t, rest = np.asarray(t, dtype=float), np.asarray(rest, dtype=float)
+        if t.size == 0:
+            return
+        start = self.origin.setdefault(segment, float(t[0]))
+        index = np.floor((t - start) / BLOCK_SECONDS).astype(int)
+        for b in np.unique(index):
+            inside = rest[index == b]
+            acc = self.blocks.setdefault((segment, int(b)), [0.0, 0.0])
+            acc[0] += float(inside.sum())
+            acc[1] += inside.size
+
+    def fit(self) -> StandingDraw:
+        """The mean over every sample and its batch-means standard error:
+        ``sqrt(B / (B - 1) sum_b n_b^2 (m_b - m)^2) / N`` for blocks ``b`` of ``n_b`` samples
+        with mean ``m_b``, ``N = sum n_b``.
+
+        Raises
+        ------
+        KinergyError
+            No samples.
+        """
+        sums = np.array(list(self.blocks.values())).reshape(-1, 2)
+        total = float(sums[:, 1].sum())
+        if total == 0:
+            raise KinergyError("no samples of the supply to find the standing draw from")
+        mean = float(sums[:, 0].sum()) / total
+        k = len(sums)
+        std = float("nan")
+        if k > 1:
+            dev = sums[:, 0] - sums[:, 1] * mean  # n_b (m_b - m)
+            std = float(np.sqrt(k / (k - 1) * np.sum(dev**2)) / total)
+        return StandingDraw(mean, std, int(total), k)

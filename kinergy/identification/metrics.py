@@ -85,6 +85,20 @@ class MetricSums:
         self.sq += np.sum(y**2, axis=0)
         self.count = total
 
+    def merge(self, other: MetricSums) -> None:
+        """Fold in ``other``'s blocks (Chan's formula for the measured signal's moments)."""
+        if other.count == 0:
+            return
+        total = self.count + other.count
+        delta = other.mean - self.mean
+        self.dev_sq += other.dev_sq + delta**2 * self.count * other.count / total
+        self.mean += delta * other.count / total
+        self.err_sum += other.err_sum
+        self.err_max = np.maximum(self.err_max, other.err_max)
+        self.err_sq += other.err_sq
+        self.sq += other.sq
+        self.count = total
+
     def metrics(self) -> tuple[JointMetrics, ...]:
         """Per joint :class:`JointMetrics` of all the blocks."""
         with np.errstate(divide="ignore", invalid="ignore"):

@@ -26,7 +26,7 @@ steps:
 
 Passes over the logs' chunks (:class:`~kinergy.identification.chunks.LogChunks`): the first finds each
 log's moving joints; the filtered, cycle-averaged signals of the excitation logs are folded
-chunk by chunk (the zero-phase filter on windows reaching :data:`~kinergy.logs.prepare.FILTER_REACH`
+chunk by chunk (the zero-phase filter on windows reaching :data:`~kinergy.logs.filtering.FILTER_REACH`
 periods of its cutoff into the neighbouring chunks, :func:`~kinergy.identification.chunks.windowed`;
 eq 24 as sums per sample of the period, :class:`~kinergy.identification.cycles.CycleAverage`: the same
 bits as whole). Three things take a log's samples of a few signals instead, because their maths
@@ -84,7 +84,8 @@ from kinergy.identification.result import (
 )
 from kinergy.identification.ridge import RidgeFit, ridge_minimal
 from kinergy.jsonable import OPTIONAL
-from kinergy.logs.prepare import FILTER_REACH, IdentData, lowpass
+from kinergy.logs.filtering import FILTER_REACH, lowpass
+from kinergy.logs.prepare import IdentData
 from kinergy.messages import Messages
 from kinergy.model.robot import Friction, Joint, Link, Robot, Source
 

@@ -20,8 +20,10 @@ from dataclasses import dataclass, field
 from typing import Any, TypedDict
 
 from kinergy.arrays import Array
+from kinergy.drives.bus import supply_power
 from kinergy.drives.transmission import joint_torque
 from kinergy.identification.chunks import LogChunks, data_history
+from kinergy.identification.electrics import StandingDraw
 from kinergy.identification.metrics import JointMetrics, MetricSums
 from kinergy.jsonable import to_jsonable
 from kinergy.logs.prepare import IdentData
@@ -152,6 +154,9 @@ class IdentificationResult:
         The logs it was identified from (by content) and what their checks found.
     accepted : tuple of str
         Checks that failed and the user accepted (``--accept``), with what they saw.
+    standing_draw : StandingDraw or None
+        The arm's standing draw found from the logs' measured supply (None where they do not
+        measure it).
     """
 
     robot: Robot = field(metadata={"json": lambda r: r.name})
@@ -160,6 +165,7 @@ class IdentificationResult:
     fit: Fit
     inputs: InputLogs = field(default_factory=InputLogs, metadata={"json": lambda i: i.records()})
     accepted: tuple[str, ...] = ()
+    standing_draw: StandingDraw | None = None
 
     @property
     def warnings(self) -> list[str]:
@@ -186,12 +192,15 @@ class Prediction:
 
     ``torque`` is the controller's reference torque (UR5e eq 7, against ``target_moment``),
     ``current`` the motor current (eq 17, against ``actual_current``), ``joint_torque`` the torque
-    at the joints with friction (against measured joint torques).
+    at the joints with friction (against measured joint torques), ``supply`` (N,) what the arm
+    draws from its supply, W (the bus model with the standing draw, :mod:`kinergy.drives.bus`;
+    against ``actual_robot_voltage x actual_robot_current``).
     """
 
     torque: Array | None
     current: Array | None
     joint_torque: Array | None
+    supply: Array | None = None
 
     def after(self, skip: int) -> Prediction:
         """The predictions from row ``skip`` on."""
@@ -204,12 +213,14 @@ def predict(robot: Robot, data: IdentData) -> Prediction:
     torque = None
     if data.tau_ref is not None:
         torque = drive_state(robot, data.q_cmd, data.qd_cmd, data.qdd_cmd).tau_sim
-    current = joint = None
-    if data.current is not None or data.torque is not None:
+    current = joint = supply = None
+    measures = data.supply_voltage is not None and data.supply_current is not None
+    if data.current is not None or data.torque is not None or measures:
         state = drive_state(robot, data.q, data.qd, data.qdd, temperature=data.temperature)
         current = state.current if data.current is not None else None
         joint = joint_torque(robot, state.tau_m) if data.torque is not None else None
-    return Prediction(torque, current, joint)
+        supply = supply_power(state.power, robot.standby_power).supply if measures else None
+    return Prediction(torque, current, joint, supply)
 
 
 def predictions(
@@ -246,11 +257,11 @@ def fit_fields(
 def validation_metrics(robot: Robot, logs: LogChunks | Sequence[IdentData]) -> Validation:
     """UR5e Tables V and VII over several logs (pooled): per joint mean, max, RMS error and R^2
     of the torque (against ``target_moment``), the current (against ``actual_current``) and, for
-    arms with torque sensors, the joint torque. Where every log has joint voltages, the
-    predicted currents are kept (:attr:`LogChunks.currents`) for the electrics' fit."""
+    arms with torque sensors, the joint torque. Where every log measures the supply, the
+    predicted currents are kept (:attr:`LogChunks.currents`) for the standing draw's fit."""
     logs = logs if isinstance(logs, LogChunks) else LogChunks.of(logs)
     sums: dict[str, MetricSums] = {}
-    keep = logs.every("voltage", "current")
+    keep = logs.every("supply_voltage", "current")
     kept = logs.derived() if keep else None
     for _, chunk, pred in predictions(robot, logs):
         for key, measured, predicted in (

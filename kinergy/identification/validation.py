@@ -10,6 +10,11 @@ wandering standstill friction no motion model predicts; so every figure is given
 ``moving`` and the ``holding`` samples apart (holding: every joint slower than
 :data:`HOLD_SPEED` for at least :data:`HOLD_SECONDS`), and for each log on its own.
 
+Where the logs measure the arm's supply (``actual_robot_voltage`` x ``actual_robot_current``),
+``supply`` compares the power the model says the arm draws (the bus model with the standing
+draw) with it: RMS error and R^2 of the power, and the energy of each with the prediction's
+error (:class:`SupplyValidation`).
+
 Every figure is accumulated over each log's chunks in one pass (:func:`validation_report`), so a
 log of any length is validated in bounded memory.
 """
@@ -43,6 +48,7 @@ __all__ = [
     "SegmentedValidation",
     "Series",
     "SignalMetrics",
+    "SupplyValidation",
     "ValidationReport",
     "holding_mask",
     "validation_report",
@@ -73,15 +79,39 @@ class SignalMetrics(JointMetrics):
 
 
 @dataclass(frozen=True)
+class SupplyValidation:
+    """The arm's supply power, predicted (the bus model plus the standing draw) against
+    measured (``actual_robot_voltage x actual_robot_current``) over ``samples`` samples: mean,
+    largest ``|.|`` and RMS of the error (measured - predicted), W, and R^2 of the power; the
+    energy of each (trapezoid over each log, J) and the prediction's error against the
+    measured, %."""
+
+    mean: float
+    max: float
+    rms: float
+    r2: float
+    predicted: float
+    measured: float
+    error: float
+    samples: int
+    includes: str = (
+        "predicted: the motors' powers summed on the DC bus (braking surplus to the shunt) plus "
+        "the model's standing draw; measured: actual_robot_voltage x actual_robot_current"
+    )
+
+
+@dataclass(frozen=True)
 class SegmentedValidation(Validation):
     """A :class:`Validation` (of :class:`SignalMetrics`) over ``samples`` samples, with the same
-    figures over the ``moving`` and the ``holding`` samples (None when there are none) and the
-    share of samples in static holds."""
+    figures over the ``moving`` and the ``holding`` samples (None when there are none), the
+    share of samples in static holds and, where the logs measure it, the supply's power
+    (:class:`SupplyValidation`; None otherwise)."""
 
     samples: int = 0
     holding_fraction: float = 0.0
     moving: Validation | None = None
     holding: Validation | None = None
+    supply: SupplyValidation | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -279,6 +309,46 @@ class _Tally:
         }
 
 
+class _SupplyTally:
+    """:class:`SupplyValidation` accumulated chunk by chunk: the power's error statistics and
+    the two energies by the trapezoid rule, the last sample of a chunk carried into the next
+    one (one tally per log; :meth:`merge` pools them)."""
+
+    def __init__(self) -> None:
+        self.sums = MetricSums(1)
+        self.energy = np.zeros(2)  # predicted, measured
+        self.last: tuple[float, Array] | None = None
+
+    def add(self, t: Array, predicted: Array, measured: Array) -> None:
+        if not len(t):
+            return
+        self.sums.add(measured[:, None], predicted[:, None])
+        y = np.column_stack([predicted, measured])
+        if self.last is not None:
+            t0, y0 = self.last
+            self.energy += 0.5 * (t[0] - t0) * (y0 + y[0])
+        if len(t) > 1:
+            self.energy += np.sum(0.5 * np.diff(t)[:, None] * (y[1:] + y[:-1]), axis=0)
+        self.last = (float(t[-1]), y[-1].copy())
+
+    def merge(self, other: _SupplyTally) -> None:
+        """Add ``other``'s samples and energies (another log's)."""
+        if other.sums.count == 0:
+            return
+        self.energy += other.energy
+        self.sums.merge(other.sums)
+
+    def result(self) -> SupplyValidation | None:
+        if self.sums.count == 0:
+            return None
+        (m,) = self.sums.metrics()
+        predicted, measured = (float(x) for x in self.energy)
+        error = 100.0 * (predicted / measured - 1.0) if measured else float("nan")
+        return SupplyValidation(
+            m.mean, m.max, m.rms, m.r2, predicted, measured, error, self.sums.count
+        )
+
+
 class _Sampled:
     """Every ``step``-th sample of a log's signals, chunk by chunk (:class:`Series`)."""
 
@@ -318,6 +388,7 @@ def validation_report(
     *,
     rows: int = CHUNK_ROWS,
     plot_samples: int = 0,
+    robots: Sequence[Robot] | None = None,
 ) -> ValidationReport:
     """How well ``robot`` predicts ``logs`` (prepared segments, or prepared logs in memory):
     pooled and per log, moving and holding apart (module docstring), in one pass over each
@@ -327,6 +398,8 @@ def validation_report(
     (:func:`~kinergy.identification.chunks.data_history`). With ``plot_samples`` > 0, each
     log's :attr:`LogValidation.series` keeps its signals for plots: every sample of a log up to
     that many samples, every ``k``-th of a longer one (the figures use every sample).
+    ``robots``: each log's model where they differ (the payload each log's controller logged:
+    :meth:`kinergy.logs.prepare.PreparedSegment.robot`); default ``robot`` for every log.
 
     Raises
     ------
@@ -338,14 +411,18 @@ def validation_report(
     pooled = _Tally(robot.n)
     held = data_history(robot)
     out = []
+    pooled_supply = _SupplyTally()
     for k, segment in enumerate(segments):
-        tally, holds = _Tally(robot.n), _Holds()
+        tally, holds, supply = _Tally(robot.n), _Holds(), _SupplyTally()
         sampled = _Sampled(-(-len(segment) // plot_samples)) if plot_samples > 0 else None
         for chunk in segment.chunks(rows):
             check_signals([chunk])
             data, skip = held.ahead(k, chunk)
-            pred = predict(robot, data).after(skip)
+            pred = predict(robot if robots is None else robots[k], data).after(skip)
             held.update(data, skip)
+            if pred.supply is not None:
+                assert chunk.supply_voltage is not None and chunk.supply_current is not None
+                supply.add(chunk.t, pred.supply, chunk.supply_voltage * chunk.supply_current)
             found = _rows(robot, chunk, pred)
             if sampled is not None:
                 sampled.add(found)
@@ -357,5 +434,8 @@ def validation_report(
             tally.add(last, np.zeros(len(last.t), dtype=bool))
             pooled.add(last, np.zeros(len(last.t), dtype=bool))
         series = {} if sampled is None else sampled.series()
-        out.append(LogValidation(**tally.fields(), log=str(segment.path), series=series))  # type: ignore[arg-type]
-    return ValidationReport(**pooled.fields(), logs=tuple(out))  # type: ignore[arg-type]
+        pooled_supply.merge(supply)
+        fields = {**tally.fields(), "supply": supply.result()}
+        out.append(LogValidation(**fields, log=str(segment.path), series=series))  # type: ignore[arg-type]
+    fields = {**pooled.fields(), "supply": pooled_supply.result()}
+    return ValidationReport(**fields, logs=tuple(out))  # type: ignore[arg-type]

@@ -1,12 +1,25 @@
-"""Log columns: the ``--columns`` spec of a headerless file, and vectors grouped by name.
+"""Log columns: the ``--columns`` spec, and vectors grouped by name.
 
-RTDE writes an n-vector as columns ``name_0 .. name_{n-1}``; a column spec names them
-``name:n``. Both are capped (:data:`MAX_COLUMNS`) and checked before anything is allocated.
+``--columns`` says one of two things, told apart by its entries:
+
+- the layout of a headerless file (:func:`parse_columns`): RTDE's field names in file order,
+  ``name:n`` for an n-vector (its columns ``name_0 .. name_{n-1}``), ``_`` or ``_:n`` for
+  columns to skip;
+- how a header log's own names map to RTDE's (:class:`ColumnMap`): entries ``FIELD=COLUMN``,
+  ``*`` in ``COLUMN`` standing for a vector's index (``actual_q=positions_*`` reads the columns
+  ``positions_0``, ``positions_1``, ... as ``actual_q``, in the order of their numbers, whatever
+  the first one is); ``_=COLUMN`` leaves the column(s) unread, as ``_`` skips columns of a
+  headerless file. Columns the header names by RTDE's names stay as they are.
+
+Both are capped (:data:`MAX_COLUMNS`) and checked before anything is allocated.
 
 Examples
 --------
 >>> parse_columns("timestamp,actual_q:2,_,robot_mode")
 ['timestamp', 'actual_q_0', 'actual_q_1', '_0', 'robot_mode']
+>>> spec = parse_column_spec("timestamp=time,actual_q=pos_*", 2)
+>>> spec.rename(["time", "pos_1", "pos_2", "note"], "log.csv")
+['timestamp', 'actual_q_0', 'actual_q_1', 'note']
 >>> group_columns(["timestamp", "a_0", "a_1"], "log.csv")
 {'a': ['a_0', 'a_1'], 'timestamp': ['timestamp']}
 """
@@ -15,15 +28,19 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 from kinergy.errors import KinergyError
 from kinergy.io.fields import FIELDS, JOINTS, SKIP, closest, is_known
 
 __all__ = [
     "MAX_COLUMNS",
+    "ColumnMap",
+    "Columns",
     "check_joint_columns",
     "compact_columns",
     "group_columns",
+    "parse_column_spec",
     "parse_columns",
     "printable",
 ]
@@ -138,6 +155,161 @@ def check_joint_columns(names: Sequence[str], n_joints: int) -> None:
             _joint_width(name, len(members), n_joints)
 
 
+@dataclass(frozen=True)
+class ColumnMap:
+    """A header log's own column names mapped to RTDE fields (``--columns
+    "timestamp=time,actual_q=positions_*"``; module docstring).
+
+    Attributes
+    ----------
+    entries : tuple of (str, str)
+        ``(field, column)`` pairs: an RTDE field (or one of kinergy's) and the header's name for
+        it, ``*`` in the name standing for a vector's index.
+    n_joints : int or None
+        The robot's joint count: a joint field must map exactly this many columns.
+    """
+
+    entries: tuple[tuple[str, str], ...]
+    n_joints: int | None = None
+
+    def __str__(self) -> str:
+        return ",".join(f"{name}={column}" for name, column in self.entries)
+
+    def rename(self, header: Sequence[str], path: str) -> list[str]:
+        """``header`` with the mapped columns under their RTDE names (a vector's members in the
+        order of their numbers as ``field_0``, ``field_1``, ...), the others as they are.
+
+        Raises
+        ------
+        KinergyError
+            A mapped name the header lacks (naming a few it has), a vector whose numbers are not
+            consecutive or whose count does not fit the field, a field the header names already.
+        """
+        out = list(header)
+        taken: dict[int, str] = {}
+        for name, column in self.entries:
+            if name == SKIP:
+                for member in self._members(name, column, header, path):
+                    out[member] = f"{SKIP}{member}"  # a skipped column (never read)
+                continue
+            if name in header or f"{name}_0" in header:
+                raise KinergyError(
+                    f"{path}: --columns maps {printable(column)} to {name}, but the header names "
+                    f"{name} itself; map one of them only"
+                )
+            for k, member in enumerate(self._members(name, column, header, path)):
+                if member in taken:
+                    raise KinergyError(
+                        f"{path}: --columns maps column {printable(header[member])} twice "
+                        f"({taken[member]} and {name})"
+                    )
+                taken[member] = name
+                out[member] = name if "*" not in column else f"{name}_{k}"
+        return out
+
+    def _members(self, name: str, column: str, header: Sequence[str], path: str) -> list[int]:
+        """The header's columns (indices, in order of their numbers) that ``column`` names."""
+        shown = ", ".join(printable(h, 20) for h in header[:6]) + (
+            ", ..." if len(header) > 6 else ""
+        )
+        if "*" not in column:
+            if column not in header:
+                raise KinergyError(
+                    f"{path}: --columns {name}={printable(column)}: the header has no column "
+                    f"{printable(column)} (it names {shown})"
+                )
+            return [list(header).index(column)]
+        pattern = re.compile("^" + re.escape(column).replace(r"\*", r"(\d+)") + "$")
+        found = sorted(
+            (int(m[1]), k) for k, h in enumerate(header) if (m := pattern.match(h)) is not None
+        )
+        if not found:
+            raise KinergyError(
+                f"{path}: --columns {name}={printable(column)}: no column of the header matches "
+                f"(it names {shown}); * stands for the index"
+            )
+        numbers = [i for i, _ in found]
+        if numbers != list(range(numbers[0], numbers[0] + len(numbers))):
+            raise KinergyError(
+                f"{path}: --columns {name}={printable(column)} matches columns numbered "
+                f"{', '.join(map(str, numbers[:8]))}: not consecutive"
+            )
+        want = FIELDS.get(name, 1)
+        count = self.n_joints if want == JOINTS else want
+        if name != SKIP and isinstance(count, int) and len(found) != count:
+            what = "the robot's joints" if want == JOINTS else f"the values of {name}"
+            raise KinergyError(
+                f"{path}: --columns {name}={printable(column)} matches {len(found)} columns, but "
+                f"{name} has {count} ({what})"
+            )
+        return [k for _, k in found]
+
+
+#: what ``--columns`` says (:func:`parse_column_spec`): the column names of a headerless file,
+#: or a header log's names mapped to RTDE's
+Columns = tuple[str, ...] | ColumnMap
+
+
+def parse_column_spec(spec: str, n_joints: int | None = None) -> Columns:
+    """``--columns`` as what it says: entries ``FIELD=COLUMN`` map a header log's names
+    (:class:`ColumnMap`), others lay out a headerless file (:func:`parse_columns`).
+
+    Raises
+    ------
+    KinergyError
+        Both kinds of entry in one spec; an entry of either kind that :func:`parse_columns` or
+        the mapping refuses: an unknown field (with the closest known one), a vector field mapped
+        without ``*`` or a scalar with it, a field or column given twice.
+    """
+    items = [item.strip() for item in spec.split(",")]
+    mapped = [item for item in items if "=" in item]
+    if not mapped:
+        return tuple(parse_columns(spec, n_joints))
+    if len(mapped) != len(items):
+        plain = next(item for item in items if "=" not in item)
+        raise KinergyError(
+            f"--columns: {printable(plain)!r} beside FIELD=COLUMN entries: a spec either maps a "
+            "header log's names (FIELD=COLUMN, ...) or lays out a headerless file (FIELD:N, ...)"
+        )
+    if len(items) > MAX_COLUMNS:
+        raise KinergyError(f"--columns: more than {MAX_COLUMNS} entries")
+    entries: list[tuple[str, str]] = []
+    for item in items:
+        name, _, column = (part.strip() for part in item.partition("="))
+        _check_mapped(name, column, item, entries)
+        entries.append((name, column))
+    return ColumnMap(tuple(entries), n_joints)
+
+
+def _check_mapped(name: str, column: str, item: str, seen: list[tuple[str, str]]) -> None:
+    """Refuse a mapping entry that names no known field, maps a vector without ``*`` (or a
+    scalar with it), or repeats a field or a column."""
+    if not name or not column:
+        raise KinergyError(f"--columns: {printable(item)!r} must be FIELD=COLUMN")
+    if name == SKIP:  # _=COLUMN: not read
+        return
+    if not is_known(name):
+        guess = closest(name)
+        hint = f" (did you mean {guess}?)" if guess else ""
+        raise KinergyError(
+            f"--columns: unknown field {printable(name)!r}{hint}; map a column to one of UR's "
+            "RTDE names (timestamp, actual_q, actual_qd, actual_current, target_moment, ...)"
+        )
+    vector = FIELDS.get(name, 1) != 1
+    if vector and column.count("*") != 1:
+        raise KinergyError(
+            f"--columns: {name} is a vector: write {name}={printable(column)}_* (* stands for "
+            "the index in the column names)"
+        )
+    if not vector and "*" in column:
+        raise KinergyError(f"--columns: {name} is one value: map it to one column, without *")
+    for other, col in seen:
+        if other == name:
+            raise KinergyError(f"--columns: {name} is mapped twice")
+        if col == column:
+            raise KinergyError(f"--columns: column {printable(column)} is mapped twice")
+
+
 def compact_columns(names: Sequence[str]) -> str:
     """A column spec for ``names`` (the inverse of :func:`parse_columns`): runs of
     ``name_0 .. name_{k-1}`` as ``name:k``, skipped columns as ``_`` or ``_:k``."""
@@ -165,8 +337,12 @@ def compact_columns(names: Sequence[str]) -> str:
     return ",".join(out)
 
 
-def group_columns(columns: Sequence[str], path: str) -> dict[str, list[str]]:
-    """Group ``name_0..name_k`` columns into vectors; other columns stay scalars.
+def group_columns(
+    columns: Sequence[str], path: str, others: Sequence[str] = ()
+) -> dict[str, list[str]]:
+    """Group ``name_0..name_k`` columns into vectors; other columns stay scalars (the known
+    scalars of RTDE too, ``output_bit_registers0_to_31``). ``others``: the file's columns not
+    read (no field), looked at for a misspelling where a vector lacks a member.
 
     Returns
     -------
@@ -177,7 +353,7 @@ def group_columns(columns: Sequence[str], path: str) -> dict[str, list[str]]:
     groups: dict[str, dict[int, str]] = {}
     scalars: list[str] = []
     for col in columns:
-        m = _VECTOR.match(col)
+        m = None if is_known(col) else _VECTOR.match(col)  # a known scalar: one column
         if m:
             groups.setdefault(m["name"], {})[int(m["index"])] = col
         else:
@@ -189,10 +365,11 @@ def group_columns(columns: Sequence[str], path: str) -> dict[str, list[str]]:
             missing = [f"{name}_{i}" for i in range(idx[-1] + 1) if i not in members]
             shown = idx if len(idx) <= 8 else [*idx[:8], "..."]
             index = missing[0].rsplit("_", 1)[1]
-            others = [  # a column of another known vector is not a misspelling
-                c for c in columns if c.endswith(f"_{index}") and not is_known(c.rsplit("_", 1)[0])
+            pool = [*columns, *others]
+            candidates = [  # a column of another known vector is not a misspelling
+                c for c in pool if c.endswith(f"_{index}") and not is_known(c.rsplit("_", 1)[0])
             ]
-            near = [c for c in [closest(missing[0], others)] if c is not None]
+            near = [c for c in [closest(missing[0], candidates)] if c is not None]
             hint = f"; {printable(near[0])!r} misspelled?" if near else ""
             raise KinergyError(
                 f"{path}: no column {printable(missing[0])} although {printable(name)}_"

@@ -2,20 +2,32 @@
 
 A record.py log names its columns in a header line, a headerless one through ``--columns``; both
 use the names of UR's Real-Time Data Exchange (RTDE) interface, an n-vector as ``name_0 ..
-name_{n-1}``. :data:`FIELDS` says of each name how wide it is: ``"joints"`` (one value per joint:
-its width must be the robot's joint count), a fixed width (a TCP pose is 6 values, an
-accelerometer 3) or 1 (a scalar). :func:`closest` finds the known name a misspelt one was meant
-to be.
+name_{n-1}``. :data:`FIELDS` says of each RTDE output field how wide it is: ``"joints"`` (one
+value per joint: its width must be the robot's joint count), a fixed width (a TCP pose is 6
+values, an accelerometer 3) or 1 (a scalar, integers and bit masks included). The list is UR's
+RTDE guide's output table for e-Series controllers (PolyScope 5, as UR's client library
+``ur_client_library``, ``src/rtde/data_package.cpp``, types it), registers included:
+``output_bit_registers0_to_31`` and ``output_bit_registers32_to_63`` (32 bits in one number),
+``output_bit_register_64`` .. ``_127``, ``output_int_register_0`` .. ``_47``,
+``output_double_register_0`` .. ``_47`` and the ``input_`` ones an output recipe may read back.
+:func:`closest` finds the known name a misspelt one was meant to be.
 
 Besides RTDE's fields kinergy reads ``actual_joint_torque`` (measured joint torques, N m, of arms
-with joint torque sensors) and ``segment`` (the recorder's reconnection count,
-:mod:`kinergy.live.recorder`). A column spec entry ``_`` (or ``_:n``) skips columns kinergy
-should not read.
+with joint torque sensors), ``actual_qdd`` (measured joint accelerations, rad/s², where a logger
+has them: used instead of differentiating the speed) and ``segment`` (the recorder's
+reconnection count, :mod:`kinergy.live.recorder`). A column spec entry ``_`` (or ``_:n``) skips
+columns kinergy should not read.
+
+RTDE's state codes (UR's RTDE guide): ``robot_mode`` 7 is RUNNING (powered, brakes released);
+``safety_mode`` 1 NORMAL and 2 REDUCED let the arm move, the others stop it;
+``runtime_state`` 0 stopping, 1 stopped, 2 playing, 3 pausing, 4 paused, 5 resuming.
 
 Examples
 --------
 >>> width("actual_q", 6), width("actual_TCP_pose", 6), width("runtime_state", 6)
 (6, 6, 1)
+>>> is_known("output_int_register_12"), is_known("output_bit_registers0_to_31")
+(True, True)
 >>> closest("actual_curent")
 'actual_current'
 """
@@ -25,15 +37,32 @@ from __future__ import annotations
 import difflib
 import re
 
-__all__ = ["FIELDS", "JOINTS", "SKIP", "closest", "is_known", "width"]
+__all__ = [
+    "FIELDS",
+    "JOINTS",
+    "KINERGY_FIELDS",
+    "ROBOT_RUNNING",
+    "SAFETY_MOVING",
+    "SKIP",
+    "USED",
+    "closest",
+    "is_known",
+    "vector_member",
+    "width",
+]
 
 #: the width of a field that holds one value per joint
 JOINTS = "joints"
 #: the column spec entry that skips a column (``_:n`` skips n)
 SKIP = "_"
 
-#: RTDE output fields (UR's RTDE guide, e-Series, PolyScope 5) and kinergy's own: name -> width
-FIELDS: dict[str, int | str] = {
+#: ``robot_mode`` RUNNING: the arm is powered, its brakes released, under control
+ROBOT_RUNNING = 7
+#: ``safety_mode`` NORMAL and REDUCED: the safety system lets the arm move
+SAFETY_MOVING = (1, 2)
+
+#: RTDE's output fields (UR's RTDE guide, e-Series, PolyScope 5), registers aside: name -> width
+RTDE_FIELDS: dict[str, int | str] = {
     "timestamp": 1,
     # joint space, one value per joint
     "target_q": JOINTS,
@@ -50,19 +79,25 @@ FIELDS: dict[str, int | str] = {
     "joint_temperatures": JOINTS,
     "joint_mode": JOINTS,
     "actual_joint_voltage": JOINTS,
-    "joint_position_deviation_ratio": JOINTS,
-    # tool centre point and payload
+    # tool centre point, forces and the payload
     "actual_TCP_pose": 6,
     "actual_TCP_speed": 6,
     "actual_TCP_force": 6,
+    "actual_TCP_acceleration": 6,
     "target_TCP_pose": 6,
     "target_TCP_speed": 6,
+    "target_TCP_acceleration": 6,
+    "tcp_offset": 6,
     "ft_raw_wrench": 6,
+    "wrench_calc_from_currents": 6,
+    "target_base_acceleration": 6,
+    "target_base_wrench": 6,
     "payload_inertia": 6,
     "actual_tool_accelerometer": 3,
     "payload_cog": 3,
     "elbow_position": 3,
     "elbow_velocity": 3,
+    "target_gravity": 3,
     "payload": 1,
     "tcp_force_scalar": 1,
     # robot, safety and program state
@@ -73,26 +108,34 @@ FIELDS: dict[str, int | str] = {
     "robot_status_bits": 1,
     "safety_status_bits": 1,
     "actual_execution_time": 1,
+    "target_execution_time": 1,
+    "control_step": 1,
     "speed_scaling": 1,
     "target_speed_fraction": 1,
-    "speed_scaling_combined": 1,
     "actual_momentum": 1,
     "script_control_line": 1,
+    "joint_position_deviation_ratio": 1,
     "collision_detection_ratio": 1,
     "time_scale_source": 1,
     # power
     "actual_main_voltage": 1,
     "actual_robot_voltage": 1,
     "actual_robot_current": 1,
+    "actual_robot_energy_consumed": 1,
+    "actual_robot_braking_energy_dissipated": 1,
     # I/O
     "actual_digital_input_bits": 1,
     "actual_digital_output_bits": 1,
+    "actual_configurable_digital_input_bits": 1,
+    "actual_configurable_digital_output_bits": 1,
     "analog_io_types": 1,
     "standard_analog_input0": 1,
     "standard_analog_input1": 1,
     "standard_analog_output0": 1,
     "standard_analog_output1": 1,
     "io_current": 1,
+    "encoder0_raw": 1,
+    "encoder1_raw": 1,
     "euromap67_input_bits": 1,
     "euromap67_output_bits": 1,
     "euromap67_24V_voltage": 1,
@@ -107,28 +150,83 @@ FIELDS: dict[str, int | str] = {
     "tool_output_mode": 1,
     "tool_digital_output0_mode": 1,
     "tool_digital_output1_mode": 1,
+    "tool_digital_output_mask": 1,
+    "tool_digital_output": 1,
+    # the general-purpose bit registers as 32-bit masks (the numbered ones: :data:`REGISTERS`)
     "output_bit_registers0_to_31": 1,
     "output_bit_registers32_to_63": 1,
     "input_bit_registers0_to_31": 1,
     "input_bit_registers32_to_63": 1,
-    # kinergy's own
+}
+
+#: kinergy's own fields: name -> width
+KINERGY_FIELDS: dict[str, int | str] = {
     "actual_joint_torque": JOINTS,
+    "actual_qdd": JOINTS,
     "segment": 1,
 }
 
-#: RTDE's numbered registers, ``output_int_register_12``, ``input_double_register_3`` ...
-_REGISTER = re.compile(r"^(input|output)_(bit|int|double)_register_\d+$")
+#: every named field: RTDE's and kinergy's, name -> width
+FIELDS: dict[str, int | str] = {**RTDE_FIELDS, **KINERGY_FIELDS}
+
+#: the fields kinergy uses (the others are read only to be passed on): a value in them that is
+#: not a number is a damaged line, where a logger's text in an unused field is ignored
+USED = frozenset(
+    {
+        "timestamp",
+        *(f"{kind}_{x}" for kind in ("target", "actual") for x in ("q", "qd", "qdd")),
+        "target_moment",
+        "target_current",
+        "actual_current",
+        "actual_current_as_torque",
+        "actual_joint_torque",
+        "actual_joint_voltage",
+        "joint_temperatures",
+        "actual_robot_voltage",
+        "actual_robot_current",
+        "robot_mode",
+        "safety_mode",
+        "runtime_state",
+        "payload",
+        "payload_cog",
+        "payload_inertia",
+        "segment",
+    }
+)
+
+#: RTDE's numbered registers (scalars): kind -> the numbers there are
+REGISTERS = {"bit": range(64, 128), "int": range(48), "double": range(48)}
+_REGISTER = re.compile(r"^(?:input|output)_(bit|int|double)_register_(\d+)$")
+_VECTOR = re.compile(r"^(?P<name>.+)_(?P<index>\d+)$")
 
 
 def is_known(name: str) -> bool:
-    """Whether ``name`` is an RTDE field or one of kinergy's (a register of any number too)."""
-    return name in FIELDS or bool(_REGISTER.match(name))
+    """Whether ``name`` is an RTDE field or one of kinergy's (a numbered register too)."""
+    if name in FIELDS:
+        return True
+    m = _REGISTER.match(name)
+    return m is not None and int(m[2]) in REGISTERS[m[1]]
 
 
 def width(name: str, n_joints: int) -> int:
     """How many columns the known field ``name`` has on a robot of ``n_joints`` joints."""
     w = FIELDS.get(name, 1)
     return n_joints if w == JOINTS else int(w)
+
+
+def vector_member(column: str) -> tuple[str, int] | None:
+    """The vector field and index a column ``name_k`` belongs to (``actual_q_3`` -> ``("actual_q",
+    3)``), or None when the column is no member of a known vector field (a scalar, a register, an
+    unknown name). A fixed-width field's index must be below its width; a joint field's any."""
+    if is_known(column):
+        return None
+    m = _VECTOR.match(column)
+    if m is None or m["name"] not in FIELDS:
+        return None
+    w, k = FIELDS[m["name"]], int(m["index"])
+    if w == 1 or (w != JOINTS and k >= int(w)):
+        return None
+    return m["name"], k
 
 
 def closest(name: str, among: list[str] | None = None) -> str | None:

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from kinergy.errors import KinergyError
-from kinergy.io.columns import parse_columns
+from kinergy.io.columns import Columns, parse_column_spec
 from kinergy.io.log import Log
 
 if TYPE_CHECKING:  # the bag options live with the bag reader, which registers itself here
@@ -133,7 +133,7 @@ NOT_LOGS = {
 def iter_log(
     path: str | os.PathLike[str],
     *,
-    columns: str | Sequence[str] | None = None,
+    columns: str | Columns | Sequence[str] | None = None,
     repair: bool = False,
     select: Sequence[str] | None = None,
     rows: int = CHUNK_ROWS,
@@ -147,9 +147,11 @@ def iter_log(
     Parameters
     ----------
     path : path
-    columns : str or sequence of str, optional
+    columns : str, ColumnMap or sequence of str, optional
         The layout of a headerless file: its column spec (``"timestamp,actual_q:6,..."``, parsed
-        by :func:`kinergy.io.columns.parse_columns`) or the column names it expands to.
+        by :func:`kinergy.io.columns.parse_column_spec`) or the column names it expands to; or
+        a header log's names mapped to RTDE's (``"timestamp=time,actual_q=pos_*"``,
+        :class:`kinergy.io.columns.ColumnMap`).
     repair : bool
         Drop malformed rows instead of rejecting the file; the first chunk's ``notes`` say
         which.
@@ -181,7 +183,7 @@ def iter_log(
             "a headerless file with --columns, a ROS 2 bag, the panda-gaz layout)"
         )
     if isinstance(columns, str):
-        columns = parse_columns(columns)
+        columns = parse_column_spec(columns)
     fmt = _format_of(path, format)
     if not fmt.joints:
         if bag is not None:
@@ -205,7 +207,7 @@ def iter_log(
 def read_log(
     path: str | os.PathLike[str],
     *,
-    columns: str | Sequence[str] | None = None,
+    columns: str | Columns | Sequence[str] | None = None,
     repair: bool = False,
     select: Sequence[str] | None = None,
     format: str | None = None,

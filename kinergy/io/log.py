@@ -32,12 +32,16 @@ class Log:
         Vectors as (N, n) arrays under their RTDE name (``actual_q``), scalars as (N,) arrays.
     notes : list of str
         What reading changed (rows dropped by ``repair``), for the user to see.
+    ignored : tuple of str
+        The file's columns that were not read (no RTDE field), as the file names them; a
+        reader sets them on the first chunk only.
     """
 
     path: str
     t: Array
     signals: dict[str, Array] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    ignored: tuple[str, ...] = ()
 
     def __contains__(self, name: str) -> bool:
         return name in self.signals
@@ -70,6 +74,7 @@ class Log:
             np.concatenate([p.t for p in parts]),
             {name: np.concatenate([p.signals[name] for p in parts]) for name in first.signals},
             [note for p in parts for note in p.notes],
+            first.ignored,
         )
 
 

@@ -3,6 +3,13 @@ its first two lines before any data is read.
 
 A record.py log starts with a header line naming its columns; a headerless one is described by a
 column spec (:func:`kinergy.io.columns.parse_columns`). A UTF-8 byte-order mark is skipped.
+
+A header log is read as its logger wrote it: a column is read when its name is an RTDE field
+(or one of kinergy's, :mod:`kinergy.io.fields`), after the user's mapping of the header's own
+names (:class:`kinergy.io.columns.ColumnMap`), and ignored otherwise (a logger's wall-clock
+string, a user's own column), as is a known field that holds no numbers on the first line
+(a bit mask a logger wrote as text) unless kinergy uses it. The ignored columns are never
+converted; the reader names them in one note.
 """
 
 from __future__ import annotations
@@ -12,8 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from kinergy.errors import KinergyError
-from kinergy.io.columns import MAX_COLUMNS, printable
-from kinergy.io.fields import closest
+from kinergy.io.columns import MAX_COLUMNS, ColumnMap, Columns, printable
+from kinergy.io.fields import USED, closest, is_known, vector_member
 
 __all__ = ["LogLayout", "first_lines", "log_layout"]
 
@@ -43,6 +50,13 @@ class LogLayout:
         and as many fields as :attr:`names`, or one more that is empty: a fast reader can read it.
     trailing : bool
         Lines end with a delimiter (one more, empty field).
+    ignored : tuple of str
+        The header's columns that are not read (no RTDE field), as the header names them; in
+        :attr:`names` they are skipped columns (``_k``).
+    textual : tuple of str
+        Known fields ignored because their first value is not a number (text a logger wrote).
+    header : tuple of str
+        The columns as the file's header names them (empty for a headerless file).
     """
 
     path: Path
@@ -52,6 +66,34 @@ class LogLayout:
     source: str
     plain: bool
     trailing: bool
+    ignored: tuple[str, ...] = ()
+    textual: tuple[str, ...] = ()
+    header: tuple[str, ...] = ()
+
+    def label(self, k: int) -> str:
+        """Column ``k`` as messages name it: the header's name, and what it is read as when the
+        user mapped it (``--columns``)."""
+        name = self.names[k]
+        own = self.header[k] if len(self.header) == len(self.names) else name
+        if own == name or name.startswith("_"):
+            return own
+        return f"{own}, read as {name}"
+
+    def note(self) -> str | None:
+        """The one note naming the columns not read, or None when every column is."""
+        if not (self.ignored or self.textual):
+            return None
+        parts = []
+        if self.ignored:
+            shown = ", ".join(printable(n, 40) for n in self.ignored[:8])
+            more = f" and {len(self.ignored) - 8} more" if len(self.ignored) > 8 else ""
+            parts.append(
+                f"{len(self.ignored)} column(s) that are no RTDE field ({shown}{more}); "
+                "map a column to a field with --columns FIELD=COLUMN"
+            )
+        if self.textual:
+            parts.append(f"{', '.join(self.textual)} (not numbers, and not used)")
+        return f"{self.path}: ignored {'; and '.join(parts)}"
 
 
 def first_lines(path: Path, count: int) -> list[str]:
@@ -114,15 +156,17 @@ def _separator(path: Path, head: str, data: str) -> str:
     return "," if "," in head else " "
 
 
-def log_layout(path: Path, columns: Sequence[str] | None) -> LogLayout:
+def log_layout(path: Path, columns: Columns | Sequence[str] | None) -> LogLayout:
     """The layout of the log at ``path``; ``columns`` names the columns of a headerless file
-    (:func:`kinergy.io.columns.parse_columns` of its ``--columns`` spec).
+    (:func:`kinergy.io.columns.parse_columns` of its ``--columns`` spec) or maps a header's
+    names (:class:`kinergy.io.columns.ColumnMap`).
 
     Raises
     ------
     KinergyError
-        Empty file; no header line and no spec; more than :data:`MAX_COLUMNS` columns; no
-        ``timestamp`` column.
+        Empty file; no header line and no layout; a layout for a file with a header line; more
+        than :data:`MAX_COLUMNS` columns; no ``timestamp`` column; a mapping the header does not
+        fit (:meth:`kinergy.io.columns.ColumnMap.rename`).
     """
     lines = first_lines(path, _MAX_COMMENTS + 2)
     comments = 0
@@ -137,31 +181,42 @@ def log_layout(path: Path, columns: Sequence[str] | None) -> LogLayout:
     fields = head.strip().replace(sep if sep != " " else ",", " ").split()
     first = fields[0] if fields else ""
     numeric = bool(first) and (first[:1].isdigit() or first[:1] in "+-.")
-    if columns is None:
+    ignored: tuple[str, ...] = ()
+    textual: tuple[str, ...] = ()
+    if columns is None or isinstance(columns, ColumnMap):
         if len(fields) > MAX_COLUMNS:
             raise KinergyError(
                 f"{path}: the header names {len(fields)} columns; at most {MAX_COLUMNS}"
             )
         if not first or numeric:
-            raise KinergyError(
-                f"{path}: no header line (record.py layout); give the layout with --columns"
+            hint = (
+                "FIELD=COLUMN maps a header's names; give this file's layout instead "
+                "(--columns timestamp,actual_q:6,...)"
+                if columns is not None
+                else "give the layout with --columns"
             )
-        names, skip, source = fields, comments + 1, "header"
+            raise KinergyError(f"{path}: no header line (record.py layout); {hint}")
+        named = fields if columns is None else columns.rename(fields, str(path))
+        cells = data.strip().replace(sep if sep != " " else ",", " ").split()
+        names, ignored, textual = _read_columns(named, fields, cells)
+        skip, source = comments + 1, "header"
     else:
         if not numeric and "timestamp" in fields:
             shown = ", ".join(fields[:3])
             raise KinergyError(
                 f"{path}: the file names its columns in a header line ({shown}, ...): leave out "
-                "--columns"
+                "--columns, or map its names to RTDE's with --columns FIELD=COLUMN,..."
             )
         names, skip, source, data = list(columns), comments, "--columns spec", head
     if "timestamp" not in names:
-        guess = closest("timestamp", [n for n in names if not n.startswith("_")])
+        own = list(ignored) or [n for n in names if not n.startswith("_")]
+        guess = closest("timestamp", own)
         hint = f" ({guess!r} is not the name kinergy reads)" if guess else ""
-        shown = ", ".join(printable(n, 20) for n in names[:4])
+        shown = ", ".join(printable(n, 20) for n in (fields if source == "header" else names)[:4])
         raise KinergyError(
             f"{path}: no 'timestamp' column{hint}; the {source} names {shown}, ...: kinergy reads "
-            "UR's RTDE names (timestamp, actual_q_0, ...)"
+            "UR's RTDE names (timestamp, actual_q_0, ...); map others with --columns "
+            "timestamp=COLUMN,..."
         )
     if len(set(names)) != len(names):
         raise KinergyError(f"{path}: the {source} repeats a column name")
@@ -170,4 +225,42 @@ def log_layout(path: Path, columns: Sequence[str] | None) -> LogLayout:
     same_width = len(cells) == len(names) + trailing
     single = sep in ",;" or cells == data.split()
     plain = same_width and single and "\t" not in data and '"' not in data
-    return LogLayout(path, names, sep, skip, source, plain, trailing)
+    header = tuple(fields) if source == "header" else ()
+    return LogLayout(path, names, sep, skip, source, plain, trailing, ignored, textual, header)
+
+
+def _number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
+
+
+def _read_columns(
+    named: list[str], header: list[str], cells: list[str]
+) -> tuple[list[str], tuple[str, ...], tuple[str, ...]]:
+    """The column names to read a header log by (``named``: the header after the user's
+    mapping), with the columns not read as skipped ones (``_k``, k the column's index), the
+    header's names of those that are no field, and the known fields not read because their
+    first value (``cells``: the first data line's fields, when it has as many) is no number and
+    kinergy does not use them."""
+    names: list[str] = []
+    ignored: list[str] = []
+    textual: set[str] = set()
+    first = cells if len(cells) == len(named) else [""] * len(named)
+    for k, name in enumerate(named):
+        if name == f"_{k}":  # skipped by the user's mapping (``_=COLUMN``): not noted
+            names.append(name)
+            continue
+        member = vector_member(name)
+        field = member[0] if member is not None else name
+        if not (is_known(name) or member is not None):
+            names.append(f"_{k}")
+            ignored.append(header[k])
+        elif first[k] and not _number(first[k]) and field not in USED:
+            names.append(f"_{k}")
+            textual.add(field)
+        else:
+            names.append(name)
+    return names, tuple(ignored), tuple(sorted(textual))

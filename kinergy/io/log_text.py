@@ -52,7 +52,9 @@ def read_text_table(layout: LogLayout, *, repair: bool = False) -> tuple[Array, 
     frame = _text_frame(layout)
     values = _numbers(frame)
     bad = ~np.isfinite(values)
-    bad[:, [k for k, name in enumerate(names) if re.fullmatch(r"_\d+", name)]] = False
+    # a skipped column may hold anything but must be there (a line cut short is damaged)
+    skipped = [k for k, name in enumerate(names) if re.fullmatch(r"_\d+", name)]
+    bad[:, skipped] = np.asarray((frame.iloc[:, skipped] == "").to_numpy(), dtype=bool)
     notes: list[str] = []
     t_col = names.index("timestamp")
     if repair:
@@ -67,7 +69,7 @@ def read_text_table(layout: LogLayout, *, repair: bool = False) -> tuple[Array, 
         what = _what(str(frame.iat[row, col]))
         hint = "; the last line is cut short (--repair drops it)" if row == len(frame) - 1 else ""
         raise KinergyError(
-            f"{path}: line {row + skip + 1}, column {col + 1} ({printable(names[col])}): "
+            f"{path}: line {row + skip + 1}, column {col + 1} ({printable(layout.label(col))}): "
             f"{what}{hint}"
         )
     check_times(values[:, t_col], layout, first_line=skip + 1)

@@ -10,6 +10,10 @@ n-vector::
 
     timestamp,actual_q:6,actual_qd:6,actual_current:6,target_current:6,target_moment:6
 
+A header log whose names are not RTDE's is mapped (``--columns "timestamp=time,actual_q=pos_*"``,
+:class:`kinergy.io.columns.ColumnMap`); columns that are no RTDE field are not read, and the
+first chunk's note names them (:mod:`kinergy.io.log_layout`).
+
 Every problem is one line naming the file and, where it applies, the line and column.
 """
 
@@ -26,7 +30,7 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
-from kinergy.io.columns import group_columns, parse_columns
+from kinergy.io.columns import Columns, group_columns, parse_columns
 from kinergy.io.formats import LogFormat, iter_log, read_log, register
 from kinergy.io.log import TIME_UNITS, Log, time_unit
 from kinergy.io.log_arrow import NotPlain, arrow_chunks
@@ -39,7 +43,7 @@ __all__ = ["RTDE", "iter_log", "parse_columns", "read_log", "write_log"]
 def _selection(layout: LogLayout, select: Sequence[str] | None) -> dict[str, list[int]]:
     """Signal name -> indices of its columns in the file (``timestamp`` first), for the
     signals ``select`` names (default all)."""
-    groups = group_columns(layout.names, str(layout.path))
+    groups = group_columns(layout.names, str(layout.path), layout.ignored)
     # columns a spec skips (``_`` -> ``_0``, ``_1``, ...) are never read
     groups = {name: cols for name, cols in groups.items() if not re.fullmatch(r"_\d*", name)}
     if select is not None:
@@ -60,7 +64,9 @@ class _Chunker:
 
     def __init__(self, layout: LogLayout, selection: dict[str, list[int]], notes: list[str]):
         self.path = str(layout.path)
-        self.notes = notes
+        note = layout.note()
+        self.notes = [*notes, *([note] if note else [])]
+        self.ignored: tuple[str, ...] = layout.ignored
         self.scale: float | None = None
         wanted = [i for cols in selection.values() for i in cols]
         position = {i: k for k, i in enumerate(wanted)}
@@ -90,13 +96,14 @@ class _Chunker:
             for name, (cols, scalar) in self.signals.items()
         }
         notes, self.notes = self.notes, []
-        return Log(self.path, np.ascontiguousarray(t), signals, notes)
+        ignored, self.ignored = self.ignored, ()
+        return Log(self.path, np.ascontiguousarray(t), signals, notes, ignored)
 
 
 def _rtde_chunks(
     path: Path,
     *,
-    columns: Sequence[str] | None,
+    columns: Columns | Sequence[str] | None,
     repair: bool,
     select: Sequence[str] | None,
     rows: int,

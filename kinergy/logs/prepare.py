@@ -11,7 +11,8 @@ which signal feeds which regression (UR5e doc sections 3-4):
   the real one is taken as the commanded motion delayed by the lag estimated from ``target_qd``
   against ``actual_qd`` (noise-free, and exact for a controller that tracks well); otherwise the
   measured ``actual_q/qd`` with the speed low-pass filtered (zero phase, Butterworth) and
-  differentiated for the acceleration (nursing eq 24's filtering);
+  differentiated for the acceleration (nursing eq 24's filtering), or the logged acceleration
+  ``actual_qdd`` filtered as the speed is where the log has it;
 - samples where the program does not run (``runtime_state`` != 2 or ``robot_mode`` != 7, when the
   log has them) are left out, and irregular time stamps are resampled to a uniform grid.
 
@@ -50,16 +51,11 @@ What reaches across chunk edges, and the pad that makes each chunk equal the who
 
 from __future__ import annotations
 
-import itertools
 import math
-import os
-import tempfile
-from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, fields
-from typing import BinaryIO
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
 from kinergy.arrays import Array
@@ -68,306 +64,30 @@ from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
 from kinergy.io.motion import HALO
 from kinergy.io.segments import segment_bounds
-from kinergy.logs.reading import CheckedLog
+from kinergy.logs.filtering import FILTER_REACH, check_cutoff, default_cutoff, lowpass
+from kinergy.logs.ident_data import SAMPLE_FIELDS, IdentData, Motion3, check_joints, ident_data
+from kinergy.logs.lag import LAG_BATCH_ROWS, batches, delay, lag_samples, lag_search
+from kinergy.logs.payload import with_logged
+from kinergy.logs.samples import STATE, resample, running_range, uniform_grid
+from kinergy.logs.spill import SIGNALS, LogSpill, spill_chunks, spill_log
+from kinergy.model.robot import Robot
 
 __all__ = [
-    "FILTER_REACH",
-    "JOINT_SIGNALS",
-    "MAX_LAG",
-    "MEASURED_TORQUE",
+    # the prepared samples' type, also importable from here (identification imports it so)
     "SAMPLE_FIELDS",
     "SIGNALS",
     "STATE",
     "IdentData",
-    "LogSpill",
     "PreparedSegment",
-    "check_cutoff",
-    "check_joints",
     "commanded_motion",
-    "default_cutoff",
-    "delay",
-    "estimate_lag",
-    "ident_data",
-    "lag_samples",
-    "lag_search",
-    "lowpass",
     "prepare",
     "prepare_segment",
-    "resample",
-    "running_range",
     "segment_paths",
     "spill_log",
-    "uniform_grid",
 ]
 
 
-#: runtime_state PLAYING and robot_mode RUNNING in RTDE
-_PLAYING = 2
-_RUNNING = 7
-
-
-@dataclass(frozen=True, eq=False)
-class IdentData:
-    """One log, ready for identification. Arrays are (N, n) unless noted.
-
-    Attributes
-    ----------
-    path : str
-    t : ndarray, shape (N,)
-        Uniform time stamps, s.
-    q_cmd, qd_cmd, qdd_cmd :
-        The motion ``target_moment`` refers to (commanded; measured when the log has no target).
-    q, qd, qdd :
-        The real motion (commanded delayed by ``lag``, or the filtered measured motion).
-    tau_ref : ndarray or None
-        ``target_moment``, N m.
-    current : ndarray or None
-        ``actual_current``, A.
-    torque : ndarray or None
-        Measured joint torques, N m (arms with torque sensors).
-    lag : float
-        Estimated lag of the real motion behind the commanded one, s.
-    source : str
-        How the real motion was obtained: ``"delayed target"`` or ``"filtered actual"``.
-    temperature : ndarray or None
-        ``joint_temperatures``, deg C.
-    voltage : ndarray or None
-        ``actual_joint_voltage``, V (as the controller logs it).
-    supply_voltage, supply_current : ndarray, shape (N,), or None
-        ``actual_robot_voltage`` (V) and ``actual_robot_current`` (A): the arm's supply.
-    """
-
-    path: str
-    t: Array
-    q_cmd: Array
-    qd_cmd: Array
-    qdd_cmd: Array
-    q: Array
-    qd: Array
-    qdd: Array
-    tau_ref: Array | None
-    current: Array | None
-    torque: Array | None
-    lag: float
-    source: str
-    temperature: Array | None = None
-    voltage: Array | None = None
-    supply_voltage: Array | None = None
-    supply_current: Array | None = None
-
-    def __len__(self) -> int:
-        return int(self.t.size)
-
-    @property
-    def dt(self) -> float:
-        return float(self.t[1] - self.t[0])
-
-    @classmethod
-    def joined(cls, parts: Sequence[IdentData]) -> IdentData:
-        """Samples of ``parts`` one after the other (a field is None when any part lacks it);
-        the last part's path, lag and source."""
-        if len(parts) == 1:
-            return parts[0]
-        joined: dict[str, Array | None] = {}
-        for name in SAMPLE_FIELDS:
-            values = [getattr(p, name) for p in parts]
-            joined[name] = None if any(v is None for v in values) else np.concatenate(values)
-        last = parts[-1]
-        return cls(path=last.path, lag=last.lag, source=last.source, **joined)  # type: ignore[arg-type]
-
-    def sliced(self, start: int, stop: int) -> IdentData:
-        """Samples ``start:stop`` (for hold-out splits)."""
-
-        def cut(x: Array | None) -> Array | None:
-            return None if x is None else x[start:stop]
-
-        return IdentData(
-            self.path,
-            self.t[start:stop],
-            self.q_cmd[start:stop],
-            self.qd_cmd[start:stop],
-            self.qdd_cmd[start:stop],
-            self.q[start:stop],
-            self.qd[start:stop],
-            self.qdd[start:stop],
-            cut(self.tau_ref),
-            cut(self.current),
-            cut(self.torque),
-            self.lag,
-            self.source,
-            cut(self.temperature),
-            cut(self.voltage),
-            cut(self.supply_voltage),
-            cut(self.supply_current),
-        )
-
-
-def running_range(log: Log) -> slice:
-    """The samples identification keeps: the longest run of consecutive samples where a program
-    runs (``runtime_state`` 2 and ``robot_mode`` 7; all of them when the log has neither column).
-
-    Raises
-    ------
-    KinergyError
-        No sample is left.
-    """
-    keep = np.ones(len(log), dtype=bool)
-    if "runtime_state" in log:
-        keep &= log["runtime_state"] == _PLAYING
-    if "robot_mode" in log:
-        keep &= log["robot_mode"] == _RUNNING
-    if keep.all():
-        return slice(0, len(log))
-    if not keep.any():
-        raise KinergyError(
-            f"{log.path}: no sample where the program runs (runtime_state 2, robot_mode 7)"
-        )
-    # keep the longest run of consecutive running samples: gaps would join unrelated motions
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], keep.astype(int), [0]])))
-    starts, stops = edges[::2], edges[1::2]
-    k = int(np.argmax(stops - starts))
-    return slice(int(starts[k]), int(stops[k]))
-
-
-def uniform_grid(t: Array, *, tolerance: float = 0.01) -> tuple[float, int] | None:
-    """The uniform grid irregular time stamps ``t`` (N,) are resampled to, as its period (s)
-    and size (the grid is ``t[0] + period * arange(size)``); None when every period is within
-    ``tolerance`` of the median (the log is kept as is)."""
-    step = np.diff(t)
-    dt = float(np.median(step))
-    if np.max(np.abs(step - dt)) <= tolerance * dt:
-        return None
-    return dt, int(np.floor((t[-1] - t[0]) / dt + 1e-9)) + 1
-
-
-def resample(log: Log, grid: Array) -> Log:
-    """``log``'s signals at the times ``grid`` (linear interpolation; a row depends only on the
-    two samples around it)."""
-    signals = {}
-    for name, x in log.signals.items():
-        if x.ndim == 1:
-            signals[name] = np.interp(grid, log.t, x)
-        else:
-            signals[name] = np.column_stack(
-                [np.interp(grid, log.t, x[:, k]) for k in range(x.shape[1])]
-            )
-    return Log(log.path, grid, signals)
-
-
-def check_cutoff(fs: float, cutoff: float) -> None:
-    """Raise unless ``0 < cutoff < fs / 2`` (Hz)."""
-    if not 0.0 < cutoff < fs / 2.0:
-        raise KinergyError(
-            f"--cutoff: the filter cutoff must be between 0 and {fs / 2:g} Hz (half of the log's "
-            f"{fs:g} Hz), got {cutoff:g}"
-        )
-
-
-def lowpass(x: Array, fs: float, cutoff: float, order: int = 4) -> Array:
-    """Zero-phase Butterworth low-pass of ``x`` (N, ...) along time; ``cutoff`` Hz, ``fs`` Hz."""
-    from scipy.signal import butter, sosfiltfilt  # slow to import; only filtering needs it
-
-    check_cutoff(fs, cutoff)
-    sos = butter(order, cutoff / (fs / 2.0), output="sos")
-    # pad by several periods of the cutoff so the ends have settled
-    padlen = min(int(np.ceil(6.0 * fs / cutoff)), x.shape[0] - 1)
-    return np.asarray(sosfiltfilt(sos, x, axis=0, padlen=padlen), dtype=float)
-
-
-#: s: the largest lag :func:`estimate_lag` looks for
-MAX_LAG = 0.05
-
-
-def lag_samples(t: Array, *, max_lag: float = MAX_LAG) -> NDArray[np.intp]:
-    """The samples of uniform time stamps ``t`` (N,) :func:`estimate_lag` compares: those more
-    than ``max_lag`` from either end, thinned to a few thousand (empty: too few to tell)."""
-    inner = np.flatnonzero((t > t[0] + max_lag) & (t < t[-1] - max_lag))
-    if inner.size < 10:
-        return inner[:0]
-    # a few thousand samples pin a lag of milliseconds down; evaluating every one is waste
-    return inner[:: max(1, inner.size // 4000)]
-
-
-def estimate_lag(t: Array, commanded: Array, measured: Array, *, max_lag: float = MAX_LAG) -> float:
-    """Delay of ``measured`` behind ``commanded`` (both (N, n) speeds), s, by least squares over
-    sub-sample shifts up to ``max_lag`` (a coarse grid then a golden-section refinement) at the
-    samples :func:`lag_samples` picks."""
-    inner = lag_samples(t, max_lag=max_lag)
-    if inner.size == 0:
-        return 0.0
-    spline = CubicSpline(t, commanded, axis=0)
-    return lag_search(spline, t[inner], measured[inner], float(t[1] - t[0]), max_lag=max_lag)
-
-
-def lag_search(
-    spline: Callable[[Array], Array],
-    t: Array,
-    measured: Array,
-    dt: float,
-    *,
-    max_lag: float = MAX_LAG,
-) -> float:
-    """The shift (s) of the commanded speeds ``spline`` (times (k,) -> speeds (k, n)) that best
-    matches ``measured`` (k, n) at the times ``t`` (k,): a grid of whole periods ``dt`` then a
-    golden-section refinement."""
-
-    def cost(lag: float) -> float:
-        return float(np.sum((spline(t - lag) - measured) ** 2))
-
-    grid = np.arange(-2, int(np.ceil(max_lag / dt)) + 1) * dt
-    best = grid[int(np.argmin([cost(g) for g in grid]))]
-    lo, hi = best - dt, best + dt
-    ratio = (np.sqrt(5.0) - 1.0) / 2.0
-    for _ in range(40):
-        a, b = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
-        if cost(a) < cost(b):
-            hi = b
-        else:
-            lo = a
-    return float(0.5 * (lo + hi))
-
-
-def delay(t: Array, x: Array, lag: float, span: tuple[float, float] | None = None) -> Array:
-    """``x(t - lag)`` by a cubic spline through ``t`` (N,), ``x`` (N, n), held at the value at
-    the start of ``span`` (default ``t``'s ends: the whole log) before it."""
-    lo, hi = (t[0], t[-1]) if span is None else span
-    spline = CubicSpline(t, x, axis=0)
-    return np.asarray(spline(np.clip(t - lag, lo, hi)), dtype=float)
-
-
-#: the log signal of measured joint torques, N m (RTDE-style name, ``actual_joint_torque_k``)
-MEASURED_TORQUE = "actual_joint_torque"
-
-#: (N, n) signals whose joint count must match the robot's
-JOINT_SIGNALS = (
-    "target_q",
-    "target_qd",
-    "target_qdd",
-    "actual_q",
-    "actual_qd",
-    "target_moment",
-    "actual_current",
-    MEASURED_TORQUE,
-    "joint_temperatures",
-    "actual_joint_voltage",
-)
-
-
-def check_joints(log: Log, n_joints: int) -> None:
-    """Raise when a joint signal of ``log`` does not have ``n_joints`` columns."""
-    for name in JOINT_SIGNALS:
-        if name in log and (log[name].ndim != 2 or log[name].shape[1] != n_joints):
-            width = 1 if log[name].ndim == 1 else log[name].shape[1]
-            raise KinergyError(
-                f"{log.path}: {name} has {width} joints but the robot has {n_joints}"
-            )
-
-
-#: (q, qd, qdd), each (N, n)
-_Motion3 = tuple[Array, Array, Array]
-
-
-def commanded_motion(log: Log) -> _Motion3:
+def commanded_motion(log: Log) -> Motion3:
     """``target_q``, ``target_qd`` and ``target_qdd`` of a uniform ``log`` (the acceleration
     differentiated from the speed when the log lacks it: a row depends on its neighbours only)."""
     q_cmd, qd_cmd = log["target_q"], log["target_qd"]
@@ -375,171 +95,8 @@ def commanded_motion(log: Log) -> _Motion3:
     return q_cmd, qd_cmd, qdd_cmd
 
 
-def default_cutoff(t: Array) -> float:
-    """The low-pass cutoff for measured speeds of uniform time stamps ``t``: min(10 Hz, a fifth
-    of the sample rate)."""
-    fs = 1.0 / float(t[1] - t[0])
-    return min(10.0, fs / 5.0)
-
-
-def ident_data(
-    log: Log,
-    commanded: _Motion3,
-    real: _Motion3,
-    how: tuple[float, str],
-    *,
-    torque: Array | None = None,
-) -> IdentData:
-    """:class:`IdentData` of a uniform ``log`` with its ``commanded`` and ``real`` motions (each
-    (q, qd, qdd)), ``how`` = (lag in s, how the real motion was obtained); measured joint
-    torques from ``torque`` or else the log's :data:`MEASURED_TORQUE`."""
-    if torque is None and MEASURED_TORQUE in log:  # arms with joint torque sensors
-        torque = np.asarray(log[MEASURED_TORQUE], dtype=float)
-    q_cmd, qd_cmd, qdd_cmd = (np.asarray(x, dtype=float) for x in commanded)
-    q, qd, qdd = (np.asarray(x, dtype=float) for x in real)
-    return IdentData(
-        path=log.path,
-        t=log.t,
-        q_cmd=q_cmd,
-        qd_cmd=qd_cmd,
-        qdd_cmd=qdd_cmd,
-        q=q,
-        qd=qd,
-        qdd=qdd,
-        tau_ref=log["target_moment"] if "target_moment" in log else None,
-        current=log["actual_current"] if "actual_current" in log else None,
-        torque=torque,
-        lag=how[0],
-        source=how[1],
-        temperature=_signal(log, "joint_temperatures"),
-        voltage=_signal(log, "actual_joint_voltage"),
-        supply_voltage=_signal(log, "actual_robot_voltage"),
-        supply_current=_signal(log, "actual_robot_current"),
-    )
-
-
-def _signal(log: Log, name: str) -> Array | None:
-    """A measured signal of the log, or None when it lacks it."""
-    return np.asarray(log[name], dtype=float) if name in log else None
-
-
-#: the signals identification takes from a log (those it has are spilled)
-SIGNALS = (*JOINT_SIGNALS, "actual_robot_voltage", "actual_robot_current")
-#: per-sample state kept in memory: it decides segments and the samples a program runs in
-STATE = ("runtime_state", "robot_mode", "segment")
-#: IdentData fields that hold samples, (N, ...) each
-SAMPLE_FIELDS = tuple(f.name for f in fields(IdentData) if f.name not in ("path", "lag", "source"))
-#: periods of the low-pass cutoff each chunk of a filtered log is filtered with on either side
-FILTER_REACH = 24.0
-
 #: how the real motion was obtained (``IdentData.source``)
 DELAYED, FILTERED = "delayed target", "filtered actual"
-
-
-class LogSpill:
-    """A log's signals as raw float64 rows in an unnamed temporary file, read back by row range.
-
-    Attributes
-    ----------
-    path : str
-        The log's path (for messages).
-    layout : list of (str, int, bool)
-        Per signal: name, width, and whether it is a vector (N, width) rather than (N,).
-    state : Log
-        Time stamps and the :data:`STATE` columns of every sample, in memory.
-    notes : list of str
-        What reading the file said (rows dropped by ``repair``).
-    names : set of str
-        Every signal the log has (spilled or not).
-    head : Log
-        The log's first samples, every signal.
-    """
-
-    def __init__(self, path: str, layout: list[tuple[str, int, bool]], file: BinaryIO):
-        self.path = path
-        self.layout = layout
-        self.width = sum(w for _, w, _ in layout)
-        self.file = file
-        self.state = Log(path, np.empty(0))
-        self.notes: list[str] = []
-        self.names = {name for name, _, _ in layout}
-        self.head = Log(path, np.empty(0))
-
-    def __len__(self) -> int:
-        return len(self.state)
-
-    def close(self) -> None:
-        """Remove the spill."""
-        self.file.close()
-
-    def append(self, chunk: Log) -> None:
-        """Write ``chunk``'s signals of :attr:`layout` at the end."""
-        rows = np.empty((len(chunk), self.width))
-        col = 0
-        for name, width, _ in self.layout:
-            rows[:, col : col + width] = chunk[name].reshape(len(chunk), width)
-            col += width
-        self.file.write(rows.tobytes())
-
-    def read(self, start: int, stop: int, names: Sequence[str] | None = None) -> Log:
-        """Samples ``start:stop`` as a :class:`Log` (time stamps from :attr:`state`), of the
-        signals ``names`` (default all)."""
-        size = (stop - start) * self.width * 8
-        raw = os.pread(self.file.fileno(), size, start * self.width * 8)
-        rows = np.frombuffer(raw, dtype=float).reshape(stop - start, self.width)
-        signals, col = {}, 0
-        for name, width, vector in self.layout:
-            if names is None or name in names:
-                block = rows[:, col : col + width]
-                signals[name] = block.copy() if vector else block[:, 0].copy()
-            col += width
-        return Log(self.path, self.state.t[start:stop], signals)
-
-
-def _spill(path: str, chunks: Iterator[Log], notes: Sequence[str]) -> LogSpill:
-    """``chunks`` (consecutive, of one log) written to a :class:`LogSpill`."""
-    first = next(chunks, None)
-    if first is None:
-        raise KinergyError(f"{path}: the log has no samples")
-    names = first.signals
-    # with the commanded motion, the measured positions are not used (only looked for)
-    skip = {"actual_q"} if {"target_q", "target_qd"} <= set(names) else set()
-    layout = [
-        (s, 1 if names[s].ndim == 1 else names[s].shape[1], names[s].ndim == 2)
-        for s in SIGNALS
-        if s in names and s not in skip
-    ]
-    spill = LogSpill(path, layout, tempfile.TemporaryFile())
-    spill.names, spill.head = set(names), first
-    times: list[Array] = []
-    state: dict[str, list[Array]] = {s: [] for s in STATE if s in names}
-    try:
-        for chunk in itertools.chain([first], chunks):
-            spill.append(chunk)
-            # copies: a view would keep the chunk's whole block of values alive
-            times.append(np.array(chunk.t, dtype=float))
-            for name, parts in state.items():
-                parts.append(np.array(chunk[name], dtype=float))
-        spill.file.flush()
-    except BaseException:
-        spill.close()
-        raise
-    spill.notes = list(notes)
-    spill.state = Log(
-        spill.path, np.concatenate(times), {k: np.concatenate(v) for k, v in state.items()}
-    )
-    return spill
-
-
-def spill_log(log: CheckedLog) -> LogSpill:
-    """Read ``log`` once, in its chunks (through its checks), into a :class:`LogSpill` (the
-    caller closes it). ``log`` should select the signals identification uses (:data:`SIGNALS`)
-    and the state (:data:`STATE`)."""
-    chunks = log.chunks()
-    first = next(chunks, None)
-    spill = _spill(log.path, itertools.chain([] if first is None else [first], chunks), ())
-    spill.notes = list(log.notes)
-    return spill
 
 
 @dataclass(frozen=True, eq=False)
@@ -563,6 +120,9 @@ class PreparedSegment:
         ``"delayed target"`` or ``"filtered actual"`` (module docstring).
     cutoff : float
         The low-pass cutoff of a filtered log's speeds, Hz.
+    load : ndarray, shape (10,), or None
+        The payload the controller logged over the segment (one: a log is cut where it
+        changes; :func:`kinergy.logs.payload.payload_columns`), None when it logs none.
     """
 
     path: str
@@ -572,6 +132,11 @@ class PreparedSegment:
     lag: float
     source: str
     cutoff: float = math.inf
+    load: Array | None = None
+
+    def robot(self, robot: Robot) -> Robot:
+        """``robot`` carrying the payload the segment logged (:attr:`load`), else as it is."""
+        return with_logged(robot, self.load)
 
     def __len__(self) -> int:
         return self.rows.stop - self.rows.start if self.grid is None else self.grid[1]
@@ -624,7 +189,11 @@ class PreparedSegment:
             return ident_data(window, commanded, real, (self.lag, self.source))  # type: ignore[arg-type]
         fs = 1.0 / self.dt
         qd = lowpass(window["actual_qd"], fs, self.cutoff)
-        measured = (window["actual_q"], qd, np.gradient(qd, window.t, axis=0))
+        if "actual_qdd" in window:  # measured: filtered as the speed is, not differentiated
+            qdd = lowpass(window["actual_qdd"], fs, self.cutoff)
+        else:
+            qdd = np.gradient(qd, window.t, axis=0)
+        measured = (window["actual_q"], qd, qdd)
         return ident_data(window, measured, measured, (0.0, self.source))
 
     def chunks(self, rows: int = CHUNK_ROWS) -> Iterator[IdentData]:
@@ -664,7 +233,7 @@ def _lag(segment: PreparedSegment) -> float:
     splines: list[tuple[CubicSpline, int, int]] = []
     measured: list[Array] = []
     done = 0
-    for batch in _batches(list(zip(edges[::2], edges[1::2], strict=True)), LAG_BATCH_ROWS):
+    for batch in batches(list(zip(edges[::2], edges[1::2], strict=True)), LAG_BATCH_ROWS):
         window = Log.concatenate([segment.uniform(a, b, speeds) for a, b in batch])
         stop = int(np.searchsorted(inner, batch[-1][1]))
         splines.append((CubicSpline(window.t, window["target_qd"], axis=0), done, stop))
@@ -677,25 +246,6 @@ def _lag(segment: PreparedSegment) -> float:
         return np.concatenate([spline(x[a:b]) for spline, a, b in splines])
 
     return lag_search(commanded, times, np.concatenate(measured), float(t[1] - t[0]))
-
-
-#: samples splined at once by the lag estimate (the windows around the compared samples, in
-#: batches: the spline of a batch's windows needs a few times its samples while it is built)
-LAG_BATCH_ROWS = 50_000
-
-
-def _batches(windows: list[tuple[int, int]], rows: int) -> Iterator[list[tuple[int, int]]]:
-    """Consecutive ``windows`` (start, stop) grouped into batches of about ``rows`` samples."""
-    batch: list[tuple[int, int]] = []
-    size = 0
-    for a, b in windows:
-        batch.append((a, b))
-        size += b - a
-        if size >= rows:
-            yield batch
-            batch, size = [], 0
-    if batch:
-        yield batch
 
 
 def prepare_segment(
@@ -728,7 +278,8 @@ def prepare_segment(
             head = segment.uniform(0, 2)
             fs = 1.0 / float(head.t[1] - head.t[0])
             check_cutoff(fs, default_cutoff(head.t) if cutoff is None else cutoff)
-        return PreparedSegment(path, spill, rows, grid, _lag(segment), DELAYED)
+        lag = _lag(segment)
+        return PreparedSegment(path, spill, rows, grid, lag, DELAYED, load=spill.load_at(a))
     if not has_actual:
         spill.head.require("actual_q", "actual_qd", purpose="identification")
     segment = PreparedSegment(path, spill, rows, grid, 0.0, FILTERED)
@@ -736,7 +287,7 @@ def prepare_segment(
     fs = 1.0 / float(head.t[1] - head.t[0])
     cut = default_cutoff(head.t) if cutoff is None else cutoff
     check_cutoff(fs, cut)
-    return PreparedSegment(path, spill, rows, grid, 0.0, FILTERED, cut)
+    return PreparedSegment(path, spill, rows, grid, 0.0, FILTERED, cut, spill.load_at(a))
 
 
 def prepare(log: Log, n_joints: int, *, cutoff: float | None = None) -> IdentData:
@@ -749,7 +300,7 @@ def prepare(log: Log, n_joints: int, *, cutoff: float | None = None) -> IdentDat
     KinergyError
         As :func:`prepare_segment`.
     """
-    spill = _spill(log.path, iter([log]), log.notes)
+    spill = spill_chunks(log.path, iter([log]), log.notes)
     try:
         return prepare_segment(spill, (0, len(log)), log.path, n_joints, cutoff).whole()
     finally:

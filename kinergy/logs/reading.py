@@ -10,9 +10,11 @@ as it is read, for the results to say which data they came from.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import os
 import queue
+import re
 import threading
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -23,14 +25,23 @@ import numpy as np
 
 from kinergy.checks import number
 from kinergy.errors import KinergyError
-from kinergy.io.columns import check_joint_columns, parse_columns, printable
-from kinergy.io.fields import closest, is_known
+from kinergy.io.columns import (
+    ColumnMap,
+    Columns,
+    check_joint_columns,
+    parse_column_spec,
+    printable,
+)
+from kinergy.io.fields import closest
 from kinergy.io.formats import CHUNK_ROWS, iter_log
 from kinergy.io.log import Log
 from kinergy.io.panda_layout import is_panda_layout, panda_files
 from kinergy.io.rosbag import BagOptions, bag_options
 from kinergy.logs.checks import Check, LogCheck, LogChecks, parse_accept
-from kinergy.model.robot import Robot
+from kinergy.logs.payload import PAYLOAD_SIGNALS, describe, from_columns, payload_columns
+from kinergy.logs.window import TimeWindow, WindowCut
+from kinergy.model.robot import Payload, Robot
+from kinergy.model.toml import parse_payload
 
 __all__ = ["CHECKED_SIGNALS", "MAX_CUTOFF", "CheckedLog", "InputLogs", "LogReading", "Provenance"]
 
@@ -44,6 +55,7 @@ CHECKED_SIGNALS = (
     "target_qdd",
     "actual_q",
     "actual_qd",
+    "actual_qdd",
     "target_moment",
     "actual_current",
     "target_current",
@@ -53,6 +65,7 @@ CHECKED_SIGNALS = (
     "joint_temperatures",
     "actual_robot_voltage",
     "actual_robot_current",
+    *PAYLOAD_SIGNALS,
 )
 
 
@@ -63,10 +76,12 @@ class LogReading:
 
     Attributes
     ----------
-    columns : tuple of str or None
+    columns : tuple of str, ColumnMap or None
         The columns of a headerless file (:func:`kinergy.io.columns.parse_columns` of the
-        ``--columns`` spec, parsed on construction when given as text); None: the file names
-        them in a header line (UR's record.py layout).
+        ``--columns`` spec), or a header log's names mapped to RTDE's
+        (:class:`kinergy.io.columns.ColumnMap`); a spec given as text is parsed on construction
+        (:func:`kinergy.io.columns.parse_column_spec`). None: the file names them in a header
+        line by RTDE's names (UR's record.py layout).
     repair : bool
         Drop rows that cannot be read (each drop noted) instead of refusing the file.
     cutoff : float or None
@@ -77,19 +92,35 @@ class LogReading:
     bag : BagOptions or None
         How to read a ROS 2 bag (``--topic``, ``--effort``); None: its defaults. Refused for a
         log that is not a bag.
+    payload : Payload or None
+        The payload at the flange (``--payload``): it replaces the one the controller logged
+        (``payload``, ``payload_cog``, ``payload_inertia``, :mod:`kinergy.logs.payload`) and the
+        robot file's. None: the log's where it logs one, else the robot file's. Text
+        (``MASS[,CX,CY,CZ[,...]]``) is parsed on construction.
+    window : TimeWindow or None
+        The samples read (``--from``/``--to``, s on the log's own time axis); None: all. A pair
+        ``(start, stop)`` becomes a :class:`~kinergy.logs.window.TimeWindow` on construction.
     """
 
-    columns: tuple[str, ...] | None = None
+    columns: Columns | None = None
     repair: bool = False
     cutoff: float | None = None
     accept: frozenset[Check] = frozenset()
     bag: BagOptions | None = None
+    payload: Payload | None = None
+    window: TimeWindow | None = None
+
+    def loaded(self, robot: Robot) -> Robot:
+        """``robot`` with the payload :attr:`payload` gives, when it gives one."""
+        return robot if self.payload is None else robot.with_payload(self.payload)
 
     def __post_init__(self) -> None:
         columns = self.columns
         if isinstance(columns, str):
-            columns = tuple(parse_columns(columns))
-        object.__setattr__(self, "columns", None if columns is None else tuple(columns))
+            columns = parse_column_spec(columns)
+        if columns is not None and not isinstance(columns, ColumnMap):
+            columns = tuple(columns)
+        object.__setattr__(self, "columns", columns)
         if self.cutoff is not None:
             cutoff = number(self.cutoff, "--cutoff", gt=0.0, le=MAX_CUTOFF)
             object.__setattr__(self, "cutoff", cutoff)
@@ -97,6 +128,11 @@ class LogReading:
         names = (c.value if isinstance(c, Check) else c for c in accept)
         object.__setattr__(self, "accept", parse_accept(names))
         object.__setattr__(self, "repair", bool(self.repair))
+        if isinstance(self.payload, str):
+            object.__setattr__(self, "payload", parse_payload(self.payload))
+        if isinstance(self.window, tuple):
+            window = None if self.window == (None, None) else TimeWindow(*self.window)
+            object.__setattr__(self, "window", window)
 
     @classmethod
     def parse(
@@ -108,15 +144,20 @@ class LogReading:
         accept: str | Iterable[str] = (),
         topic: str | None = None,
         effort: str | None = None,
+        payload: str | None = None,
+        start: float | None = None,
+        stop: float | None = None,
     ) -> LogReading:
         """The reading options as a command's flags give them, each parsed once: ``columns`` a
-        column spec (``"timestamp,actual_q:6,..."``, :func:`kinergy.io.columns.parse_columns`),
-        ``accept`` check names (``--accept``, repeatable or comma-separated, ``all``),
-        ``topic`` and ``effort`` a ROS 2 bag's (:func:`kinergy.io.rosbag.bag_options`).
+        column spec (``"timestamp,actual_q:6,..."`` or ``"timestamp=time,actual_q=pos_*"``,
+        :func:`kinergy.io.columns.parse_column_spec`), ``accept`` check names (``--accept``,
+        repeatable or comma-separated, ``all``), ``topic`` and ``effort`` a ROS 2 bag's
+        (:func:`kinergy.io.rosbag.bag_options`), ``payload`` ``MASS[,CX,CY,CZ[,...]]``
+        (:func:`kinergy.model.toml.parse_payload`), ``start`` and ``stop`` the window, s.
 
         The parameters are the command line's flags (``--columns``, ``--repair``,
-        ``--cutoff``, ``--accept``, ``--topic``, ``--effort``), which the commands build from
-        this signature.
+        ``--cutoff``, ``--accept``, ``--topic``, ``--effort``, ``--payload``, ``--from``,
+        ``--to``), which the commands build from this signature.
 
         Raises
         ------
@@ -129,6 +170,8 @@ class LogReading:
             cutoff=cutoff,
             accept=accept,  # type: ignore[arg-type]
             bag=bag_options(topic, effort),
+            payload=payload,  # type: ignore[arg-type]
+            window=(start, stop),  # type: ignore[arg-type]
         )
 
 
@@ -300,10 +343,15 @@ class CheckedLog:
     checks: LogChecks | None = None
     provenance: Provenance | None = None
     notes: list[str] = field(default_factory=list)
+    _told: bool = field(default=False, repr=False)
 
     def __post_init__(self) -> None:
-        if self.reading.columns is not None:
-            check_joint_columns(self.reading.columns, self.robot.n)
+        columns = self.reading.columns
+        if isinstance(columns, ColumnMap) and columns.n_joints is None:
+            mapped = dataclasses.replace(columns, n_joints=self.robot.n)
+            self.reading = dataclasses.replace(self.reading, columns=mapped)
+        elif isinstance(columns, tuple):
+            check_joint_columns(columns, self.robot.n)
 
     @property
     def path(self) -> str:
@@ -353,19 +401,25 @@ class CheckedLog:
         return next(chunks, None)
 
     def _check_names(self) -> None:
-        """Refuse a column whose name is not a known field but a misspelling of one the log
-        lacks (``actual_curent`` for ``actual_current``): a command needing it would otherwise
-        find nothing, or quietly do without. Names that resemble nothing known pass (a recorder
-        may log fields kinergy does not read)."""
-        have = self.names()
-        for name in sorted(have):
-            if is_known(name) or name.startswith("_"):
-                continue
-            guess = closest(name)
-            if guess is not None and guess not in have:
+        """Refuse a column the reader ignored (no field kinergy knows) whose name is a
+        misspelling of a field the command needs and the log lacks (``actual_curent_0`` for
+        ``actual_current`` when currents are needed): the command would otherwise find nothing,
+        or quietly do without. Other ignored columns pass (a recorder may log anything)."""
+        head = self._head()
+        if head is None or not head.ignored:
+            return
+        have = set(head.signals)
+        needed = set(CHECKED_SIGNALS) if self.select is None else set(self.select)
+        lacking = sorted(needed - have)
+        for column in head.ignored:
+            base = re.sub(r"_\d+$", "", column)
+            guess = closest(base, lacking) or closest(column, lacking)
+            if guess is not None:
+                mapped = re.sub(r"_\d+$", "_*", column)
                 raise KinergyError(
-                    f"{self.path}: column {printable(name)} is not a field kinergy knows (did you "
-                    f"mean {guess}?): name it as UR's RTDE does"
+                    f"{self.path}: column {printable(column)} is not a field kinergy knows (did you "
+                    f"mean {guess}?): name it as UR's RTDE does, or map it with --columns "
+                    f"{guess}={printable(mapped)}"
                 )
 
     def _wanted(self) -> list[str] | None:
@@ -374,6 +428,21 @@ class CheckedLog:
             return None
         have = self.names()
         return [s for s in dict.fromkeys([*self.select, *CHECKED_SIGNALS]) if s in have]
+
+    def _given_payload(self, chunk: Log) -> Log:
+        """``chunk`` without the logged payload when ``--payload`` replaces it (noted once)."""
+        if self.reading.payload is None or not any(s in chunk for s in PAYLOAD_SIGNALS):
+            return chunk
+        if not self._told:
+            cols = payload_columns(chunk)
+            logged = "" if cols is None else f" ({describe(from_columns(cols[0]))} first)"
+            self.notes.append(
+                f"{self.path}: the controller's logged payload{logged} is not used: --payload "
+                f"gives {describe(self.reading.payload)}"
+            )
+            self._told = True
+        keep = {k: v for k, v in chunk.signals.items() if k not in PAYLOAD_SIGNALS}
+        return Log(chunk.path, chunk.t, keep, chunk.notes, chunk.ignored)
 
     def _selected(self, chunk: Log) -> Log:
         """``chunk`` with only the selected signals: those only the checks read are not
@@ -396,7 +465,7 @@ class CheckedLog:
             the user did not accept (:meth:`kinergy.logs.checks.LogCheck.finish`).
         """
         self._check_names()
-        check = LogCheck(self.robot, self.path, self.reading.accept)
+        check = LogCheck(self.reading.loaded(self.robot), self.path, self.reading.accept)
         hashed: list[str] = []
         stop = threading.Event()
         hasher = None
@@ -404,17 +473,25 @@ class CheckedLog:
             args = (Path(self.source), hashed, stop)
             hasher = threading.Thread(target=_file_hash, args=args, daemon=True)
         rows = 0
+        window = self.reading.window
+        cut = None if window is None else WindowCut(window, self.path)
         try:
-            for chunk in self._raw(self._wanted()):
+            for raw in self._raw(self._wanted()):
                 if hasher is not None and hasher.ident is None:
                     hasher.start()  # the file opened: hash it beside the reading
-                self.notes.extend(chunk.notes)
-                check.add(chunk)
-                rows += len(chunk)
-                yield self._selected(chunk)
+                self.notes.extend(raw.notes)
+                chunk = self._given_payload(raw if cut is None else cut.cut(raw))
+                if len(chunk):
+                    check.add(chunk)
+                    rows += len(chunk)
+                    yield self._selected(chunk)
+                if cut is not None and cut.done:
+                    break
         except BaseException:
             stop.set()
             raise
+        if cut is not None:
+            self.notes.append(cut.finish())
         if rows == 0:
             raise KinergyError(f"{self.path}: the log has no samples")
         self.checks = check.finish()
@@ -492,4 +569,4 @@ class InputLogs:
                 )
         self.provenance.append(log.provenance)
         self.checks.append(log.checks)
-        self.notes.extend(log.notes)
+        self.notes.extend([*log.notes, *log.checks.notes])

@@ -376,14 +376,20 @@ class Limits:
         Maximum |tau|, N m.
     acceleration : float or None
         Maximum |qdd|, rad/s^2, where published.
+    continuous : bool
+        The joint turns without limit (no end stop: the UR3e's wrist 3): ``position`` is then
+        the range a planner uses, and a logged angle beyond it is no error.
     """
 
     position: Array
     speed: float
     torque: float
     acceleration: float | None = None
+    continuous: bool = False
 
     def __post_init__(self) -> None:
+        if not isinstance(self.continuous, bool):
+            raise KinergyError(f"limits.continuous must be true or false, got {self.continuous!r}")
         pos = _vector(self.position, 2, "limits.position")
         if not pos[0] < pos[1]:
             raise KinergyError(
@@ -418,6 +424,7 @@ class Joint:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise KinergyError(f"joint name must be a non-empty string, got {self.name!r}")
+        checks.plain_text(self.name, "joint name")
         for name in ("d", "a", "alpha", "offset"):
             object.__setattr__(self, name, _number(getattr(self, name), name))
 
@@ -538,6 +545,9 @@ class Robot:
         object.__setattr__(
             self, "convention", checks.choice(self.convention, Convention, "convention")
         )
+        checks.plain_text(self.name, "robot name")
+        if isinstance(self.description, str):
+            checks.plain_text(self.description, "robot description", breaks=True)
         joints = tuple(self.joints)
         if not joints:
             raise KinergyError("a robot needs at least one joint")

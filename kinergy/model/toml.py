@@ -46,6 +46,7 @@ version :data:`ROBOT_SCHEMA`); :func:`robot_from_dict` reads it back from any of
     position = [-6.283185307179586, 6.283185307179586]
     speed = 3.141592653589793
     torque = 150.0
+    continuous = true                 # optional: no end stop (positions beyond the range are fine)
 
 Every error names the file and the field, e.g.
 ``ur5e.toml: joints[4] (wrist_2).inertia: ... violates the triangle inequality``.
@@ -122,7 +123,7 @@ _DRIVE_NUMBERS = (
 )
 _DRIVE_KEYS = {*_DRIVE_NUMBERS, "friction", "winding_resistance", "thermal"}
 _THERMAL_KEYS = ("capacity", "resistance")
-_LIMIT_KEYS = {"position", "speed", "torque", "acceleration"}
+_LIMIT_KEYS = {"position", "speed", "torque", "acceleration", "continuous"}
 #: friction parameters a file may not make negative: each is a friction (it opposes the motion)
 #: or a rate (Makkar's gamma2, gamma3, gamma5; nursing eq 13); gamma1 may take either sign
 _NON_NEGATIVE_FRICTION = {
@@ -219,7 +220,10 @@ def _joint_from_dict(data: Any, index: int) -> Joint:
     lwhere = f"{where}.limits"
     lim_data = _known(_take(data, "limits", where), _LIMIT_KEYS, lwhere)
     limit_fields = _fields(
-        lim_data, lwhere, ("position", "speed", "torque"), {"acceleration": None}
+        lim_data,
+        lwhere,
+        ("position", "speed", "torque"),
+        {"acceleration": None, "continuous": False},
     )
     limits = _at(where, lambda: Limits(**limit_fields))
     joint_fields = _fields(data, where, ("name", "d", "a", "alpha"), {"offset": 0.0})
@@ -399,6 +403,8 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         }
         if j.limits.acceleration is not None:
             limits["acceleration"] = j.limits.acceleration
+        if j.limits.continuous:
+            limits["continuous"] = True
         joints.append(
             {
                 "name": j.name,

@@ -240,7 +240,8 @@ def body_inertial(parts: Sequence[Part]) -> tuple[float, Array, Array]:
 
 
 def joint_limits(joint: UrdfJoint, where: str) -> Limits:
-    """kinergy's limits of a URDF joint (continuous: +-2 pi rad)."""
+    """kinergy's limits of a URDF joint (continuous: +-2 pi rad for planners, and
+    ``Limits.continuous``)."""
     jwhere = f"{where}: joint {joint.name!r}"
     limit = joint.limit
     if limit is None:
@@ -252,12 +253,15 @@ def joint_limits(joint: UrdfJoint, where: str) -> Limits:
     if limit.effort is None or limit.velocity is None:
         missing = "effort" if limit.effort is None else "velocity"
         raise _fail(jwhere, f"<limit> lacks {missing!r}", Code.MISSING)
-    if joint.type == "continuous":
+    continuous = joint.type == "continuous"
+    if continuous:  # the planners' range; the joint turns without limit
         position = np.array([-_TWO_PI, _TWO_PI])
     else:  # URDF: lower and upper default to 0
         position = np.array([limit.lower, limit.upper])
     try:
-        return Limits(position=position, speed=limit.velocity, torque=limit.effort)
+        return Limits(
+            position=position, speed=limit.velocity, torque=limit.effort, continuous=continuous
+        )
     except KinergyError as exc:
         raise exc.prefixed(jwhere) from None
 

@@ -14,13 +14,11 @@ form, so one objective (:mod:`kinergy.optimize.objectives`) scores both.
 
 from __future__ import annotations
 
-from dataclasses import fields
-
 import numpy as np
 from numpy.typing import NDArray
 
 from kinergy.arrays import Array
-from kinergy.model.robot import Payload, Robot
+from kinergy.model.robot import Robot
 from kinergy.optimize.program import (
     ProgramSamples,
     grid_weights,
@@ -28,7 +26,7 @@ from kinergy.optimize.program import (
     samples_at,
     settings,
 )
-from kinergy.predict import DriveState, drive_state
+from kinergy.predict import drive_by_payload  # its home is the one forward path
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.program_motion import (
     LineTable,
@@ -44,48 +42,6 @@ __all__ = ["drive_by_payload", "grid_path_samples", "path_schedule", "sample_pat
 
 #: Gauss-Legendre sub-intervals per piece (the 500 Hz re-simulation makes the final figures)
 _SUB = 2
-
-
-def drive_by_payload(
-    robot: Robot,
-    payloads: tuple[Payload | None, ...],
-    load: NDArray[np.intp],
-    q: Array,
-    qd: Array,
-    qdd: Array,
-) -> DriveState:
-    """The drive model (:func:`kinergy.predict.drive_state`) at samples that carry different
-    loads.
-
-    Parameters
-    ----------
-    robot : Robot
-    payloads : tuple of Payload or None
-        The loads (``None``: none at the flange).
-    load : ndarray of int, shape (N,)
-        Index into ``payloads`` of each sample's load.
-    q, qd, qdd : ndarray, shape (N, n)
-
-    Returns
-    -------
-    DriveState
-        Arrays of shape (N, n), each sample computed with its load.
-    """
-    used = np.unique(load)
-    if used.size == 1:
-        return drive_state(robot.with_payload(payloads[int(used[0])]), q, qd, qdd)
-    parts = {
-        int(i): drive_state(robot.with_payload(payloads[int(i)]), q[m], qd[m], qdd[m])
-        for i in used
-        if np.any(m := load == i)
-    }
-    out = {}
-    for f in fields(DriveState):
-        arr = np.zeros(q.shape)
-        for i, state in parts.items():
-            arr[load == i] = getattr(state, f.name)
-        out[f.name] = arr
-    return DriveState(**out)
 
 
 def path_schedule(path: ProgramPath, t: Array, f: Array) -> Schedule:

@@ -14,6 +14,8 @@ writes one as a PNG atomically.
 :func:`energy_breakdown`    cumulative energy of the inertial, gravity, friction and copper parts
                             and their total (framework Fig. 4)
 :func:`pareto`              energy against cycle time, the Pareto front and named motions
+:func:`supply_power`        the arm's supply power over time, predicted against measured, with
+                            the energy of each
 ==========================  ==================================================================
 """
 
@@ -44,6 +46,7 @@ __all__ = [
     "pareto",
     "power_energy",
     "save",
+    "supply_power",
     "time_series",
     "timing_pareto",
 ]
@@ -388,6 +391,65 @@ def power_energy(t: ArrayLike, power: ArrayLike, *, joint_names: Sequence[str]) 
         title_fontsize=_LEGEND,
         frameon=False,
     )
+    return fig
+
+
+def supply_power(
+    t: ArrayLike,
+    predicted: ArrayLike,
+    *,
+    energy: float,
+    measured: ArrayLike | None = None,
+    measured_energy: float | None = None,
+    standing: float = 0.0,
+) -> Figure:
+    """The power the arm draws from its supply over time, predicted (the bus model plus the
+    standing draw, :mod:`kinergy.drives.bus`) against measured (``actual_robot_voltage x
+    actual_robot_current``), the legend giving the energy of each over the whole motion.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Time stamps, s, strictly increasing (the samples plotted: a long log's every k-th).
+    predicted : array_like, shape (N,)
+        W.
+    energy : float
+        The predicted supply energy of the whole motion, J (from every sample, not the plotted).
+    measured : array_like, shape (N,), optional
+        W.
+    measured_energy : float, optional
+        J, with ``measured``.
+    standing : float
+        The model's standing draw, W, drawn as a line where it is above 0.
+
+    Raises
+    ------
+    KinergyError
+        If the shapes disagree, ``t`` does not increase or a value is not finite.
+    """
+    ts = _time(t)
+    pred = _vector(predicted, "predicted")
+    if pred.size != ts.size:
+        raise KinergyError(f"predicted has {pred.size} samples, t has {ts.size}")
+    fig = _figure(11.0, 4.5)
+    ax = fig.subplots()
+    if measured is not None:
+        meas = _vector(measured, "measured")
+        if meas.size != ts.size:
+            raise KinergyError(f"measured has {meas.size} samples, t has {ts.size}")
+        label = "measured" + ("" if measured_energy is None else f": {measured_energy:.1f} J")
+        ax.plot(ts - ts[0], meas, label=label, **_MEASURED)
+    ax.plot(ts - ts[0], pred, label=f"predicted: {energy:.1f} J", **_PREDICTED)
+    if standing > 0.0:
+        ax.axhline(standing, color="0.5", linewidth=0.8, linestyle=":", zorder=0,
+                   label=f"standing draw {standing:.3g} W")  # fmt: skip
+    ax.set_xlim(0.0, ts[-1] - ts[0] if ts.size > 1 else 1.0)
+    ax.set_ylim(bottom=0.0)
+    _style(ax)
+    ax.set_title("Power drawn from the arm's supply", fontsize=_TITLE)
+    ax.set_ylabel("Power [W]", fontsize=_LABEL)
+    ax.set_xlabel("Time from the first sample [s]", fontsize=_LABEL)
+    ax.legend(loc="upper right", fontsize=_LEGEND, framealpha=0.9)
     return fig
 
 

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from kinergy.accounting.energy import EnergyReport
+from kinergy.accounting.trace import SupplyTrace
 from kinergy.arrays import Array
 from kinergy.identification.metrics import JointMetrics
 from kinergy.identification.result import IdentificationResult
@@ -27,6 +28,7 @@ from kinergy.report.plots import (
     error_boxplot,
     power_energy,
     save,
+    supply_power,
     time_series,
     timing_pareto,
 )
@@ -88,6 +90,8 @@ class Study:
     energy : mapping of str to EnergyReport
         Per motion name.
     timing : Timing, optional
+    supply : mapping of str to SupplyTrace
+        Per log name, the supply's power over the log, predicted and (where logged) measured.
     """
 
     model: Robot
@@ -98,6 +102,7 @@ class Study:
     current: Mapping[str, Comparison] = field(default_factory=dict)
     energy: Mapping[str, EnergyReport] = field(default_factory=dict)
     timing: Timing | None = None
+    supply: Mapping[str, SupplyTrace] = field(default_factory=dict)
 
 
 def _slug(name: str) -> str:
@@ -233,6 +238,24 @@ def _energy_section(study: Study, figdir: Path) -> tuple[Section, list[Table], l
                 figdir,
                 f"{_slug(name)}_breakdown.png",
                 f"{name}: electrical energy by where it goes (framework Fig. 4).",
+            )
+        )
+    for name, trace in study.supply.items():
+        measured = "against the measured (actual_robot_voltage x actual_robot_current)"
+        figures.append(
+            _figure(
+                supply_power(
+                    trace.t,
+                    trace.predicted,
+                    energy=trace.energy,
+                    measured=trace.measured,
+                    measured_energy=trace.measured_energy,
+                    standing=trace.standing,
+                ),
+                figdir,
+                f"{_slug(name)}_supply.png",
+                f"{name}: the power drawn from the arm's supply, predicted (the motors on the DC "
+                f"bus plus the standing draw){'' if trace.measured is None else ' ' + measured}.",
             )
         )
     viii = energy_tables(study.energy, study.paper and study.model.n == 6)

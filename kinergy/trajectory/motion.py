@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 
-__all__ = ["CONTROLLER_DT", "Motion", "MotionSource"]
+__all__ = ["CONTROLLER_DT", "MAX_SAMPLES", "Motion", "MotionSource", "sample_times"]
 
 
 class MotionSource(enum.StrEnum):
@@ -26,6 +26,31 @@ class MotionSource(enum.StrEnum):
 
 #: the UR controller's cycle, s (e-Series: 500 Hz): the period it logs, plans and servos at
 CONTROLLER_DT = 0.002
+#: the most samples a planned program takes (1000 s at the controller's 500 Hz): its drive state
+#: holds about 40 arrays of (samples, joints) in memory
+MAX_SAMPLES = 500_000
+
+
+def sample_times(duration: float, dt: float, longest: str = "") -> Array:
+    """The sample times of a planned program, ``0, dt, ...`` up to the first at or after
+    ``duration`` (s), shape (N,).
+
+    Raises
+    ------
+    KinergyError
+        More than :data:`MAX_SAMPLES` samples (a speed or acceleration far too small), the
+        message naming the program's length and ``longest`` (what takes longest, in words).
+    """
+    steps = np.ceil(duration / dt - 1e-9)
+    if not steps < MAX_SAMPLES:
+        what = f" ({longest})" if longest else ""
+        raise KinergyError(
+            f"the program lasts {duration:.4g} s{what}: sampled every {dt:g} s it would take "
+            f"{steps:.4g} samples, more than the {MAX_SAMPLES:,} kinergy plans "
+            f"({MAX_SAMPLES * dt / 60:.0f} min); a speed or acceleration far too small? "
+            "(rad/s and rad/s^2, m/s and m/s^2 for a linear move)"
+        )
+    return np.arange(int(steps) + 1, dtype=float) * dt
 
 
 @dataclass(frozen=True, eq=False)

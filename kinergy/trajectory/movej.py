@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from kinergy import checks
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.trajectory.motion import CONTROLLER_DT, Motion
+from kinergy.trajectory.motion import CONTROLLER_DT, Motion, sample_times
 
 __all__ = [
     "MovejPlan",
@@ -210,10 +210,11 @@ def blend_starts(
     for k in range(1, duration.shape[-1]):
         overlap = np.zeros(duration.shape[:-1])
         if links[k - 1] and blend[k - 1] > 0.0 and travel[k - 1] > 0.0 and travel[k] > 0.0:
+            # a radius beyond the move's travel blends no more than the travel itself (the ramp
+            # caps it first), and 2 r of a huge r would overflow
+            radius = min(blend[k - 1], travel[k - 1])
             overlap = np.minimum(
-                np.minimum(
-                    np.sqrt(2.0 * blend[k - 1] / acceleration[..., k - 1]), ramp[..., k - 1]
-                ),
+                np.minimum(np.sqrt(2.0 * radius / acceleration[..., k - 1]), ramp[..., k - 1]),
                 ramp[..., k],
             )
         start[..., k] = start[..., k - 1] + duration[..., k - 1] - overlap + gap[k]
@@ -379,7 +380,13 @@ def movej(
     """
     dt = checks.number(dt, "dt", gt=0.0)
     plan = plan_movej(waypoints, speed=speed, acceleration=acceleration, blend=blend)
-    steps = int(np.ceil(plan.total_time / dt - 1e-9))
-    t = np.arange(steps + 1) * dt
+    k = int(np.argmax(plan.duration)) if plan.duration.size else 0
+    longest = (
+        f"move {k + 1} alone {plan.duration[k]:.4g} s at v = "
+        f"{per_move(speed, plan.duration.size, 'speed')[k]:.4g} rad/s"
+        if plan.duration.size
+        else ""
+    )
+    t = sample_times(plan.total_time, dt, longest)
     q, qd, qdd = plan.sample(t)
-    return Motion(t.astype(float), q, qd, qdd)
+    return Motion(t, q, qd, qdd)

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from kinergy.arrays import Array
 from kinergy.model.robot import Robot
-from kinergy.trajectory.motion import CONTROLLER_DT, Motion
+from kinergy.trajectory.motion import CONTROLLER_DT, Motion, sample_times
 from kinergy.trajectory.movej import blend_starts, trapezoid, trapezoid_timing
 from kinergy.trajectory.movel import ToolSegment, joints_on_path, tool_motion
 from kinergy.trajectory.program_path import ProgramPath
@@ -341,7 +341,8 @@ def program_motion(
     """One program at ``path.speed`` and ``path.accel`` sampled every ``dt`` s (the controller's
     500 Hz), from its start to the first sample at or after its end."""
     sched = schedule(path, path.speed, path.accel)
-    steps = int(np.ceil(float(sched.total[0]) / dt - 1e-9))
-    t = np.arange(steps + 1, dtype=float) * dt
+    k = int(np.argmax(sched.duration[0])) if sched.duration.shape[1] else 0
+    longest = f"move {k + 1} alone {sched.duration[0, k]:.4g} s" if sched.duration.shape[1] else ""
+    t = sample_times(float(sched.total[0]), dt, longest)
     q, qd, qdd = sample_path(robot, path, sched, t[None, :])
     return Motion(t, q[0], qd[0], qdd[0]), sched

@@ -10,7 +10,8 @@
 2. Identification on test A by the sequential method (UR5e doc sections 3-4), starting from a
    model whose drives are nominal guesses, so every drive parameter has to come from the log;
    with the realistic twin the friction model is chosen per joint (``friction="auto"``) and the
-   motor electrics and standby power come from the logged voltages and supply.
+   standing draw comes from the logged supply. The motors' R and k_b are the model's (a log has
+   no motor voltage: ``actual_joint_voltage`` is the joint's bus voltage).
 3. Validation on test A and the unseen test B (Tables V and VII), energy of both (Table VIII),
    each next to the twin's truth or the doc's values; with the realistic twin, a table of truth
    against identified values and the held-out error, with why it is not perfect; figures and
@@ -27,6 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from kinergy.checks import choice
+from kinergy.drives.electrics import back_emf_constants, winding_resistances
 from kinergy.files import output_folder
 from kinergy.friction.model import SMOOTHING
 from kinergy.identification.metrics import fit_metrics
@@ -84,8 +86,9 @@ def _pct(value: float, truth: float) -> str:
 
 def truth_tables(truth: Robot, model: Robot, held_out: IdentData) -> list[Table]:
     """The realistic twin's truth against the identified ``model``: per joint k_t, J_m + J_r,
-    the friction model chosen and the held-out current R² (``held_out``'s log) in one table, the
-    motor electrics R and k_b and the standby power in another."""
+    the friction model chosen and the held-out current R² (``held_out``'s log) in one table; the
+    motor electrics R and k_b the model carries (not identified) and the identified standing draw
+    in another."""
     pred = predict(model, held_out).current
     assert pred is not None and held_out.current is not None
     r2 = [m.r2 for m in fit_metrics(held_out.current, pred)]
@@ -104,8 +107,8 @@ def truth_tables(truth: Robot, model: Robot, held_out: IdentData) -> list[Table]
         electrics.append(
             [
                 mj.name,
-                _pct(m.winding_resistance or float("nan"), t.winding_resistance or float("nan")),
-                _pct(m.torque_constant / m.kt_over_kb, t.torque_constant / t.kt_over_kb),
+                _pct(float(winding_resistances(model)[j]), float(winding_resistances(truth)[j])),
+                _pct(float(back_emf_constants(model)[j]), float(back_emf_constants(truth)[j])),
             ]
         )
     headers = [
@@ -124,10 +127,14 @@ def truth_tables(truth: Robot, model: Robot, held_out: IdentData) -> list[Table]
             f"Identified (truth, error). {WHY_NOT_PERFECT}",
         ),
         Table(
-            "The twin is not the model: motor electrics, truth against identified",
+            "The twin is not the model: motor electrics, truth against the model's",
             ["joint", "R [ohm]", "k_b [V s/rad]"],
             electrics,
-            f"Identified (truth, error), from the logged voltages. Standby power {standby} W.",
+            "The model's (truth, error): not identified, since a log has no motor voltage "
+            "(actual_joint_voltage is each joint's bus voltage); R = (k_t / k_m)^2 and "
+            "k_b = k_t / (k_t/k_b) from the identified k_t and the robot file's k_m and k_t/k_b "
+            "(the UR5e doc's catalogue estimate). Standing draw identified from the logged "
+            f"supply: {standby} W.",
         ),
     ]
 
@@ -153,7 +160,7 @@ def _simulate_tests(
 
 def _identify(model: Robot, data: IdentData, realistic: bool) -> IdentificationResult:
     """The sequential method from guessed drives; with the realistic twin, friction chosen per
-    joint and the electrics and standby from the logged voltages and supply."""
+    joint and the standing draw from the logged supply."""
     if realistic:
         return identify_model(nominal_drives(model), [data], IdentifyOptions(friction=AUTO))
     return identify_sequential(nominal_drives(model), [data])

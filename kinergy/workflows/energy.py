@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -12,14 +13,23 @@ import numpy as np
 from kinergy import checks
 from kinergy.accounting.energy import EnergyAccumulator, EnergyReport, energy
 from kinergy.accounting.figures import EnergyFigures
+from kinergy.accounting.supply import standing_draw_notes
+from kinergy.accounting.trace import (
+    PowerSeries,
+    PowerSink,
+    TraceWriter,
+    supply_predicted,
+    trace_format,
+)
 from kinergy.arrays import Array
+from kinergy.files import atomic_open
 from kinergy.io.log import Log
-from kinergy.io.motion import iter_motion
+from kinergy.io.motion import iter_motion, motion_from_log
 from kinergy.io.urscript_reader import read_program
+from kinergy.logs.payload import PAYLOAD_SIGNALS, logged_loads
 from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
-from kinergy.optimize.program_samples import drive_by_payload
-from kinergy.predict import drive_state
+from kinergy.predict import DriveState, drive_by_payload, drive_state
 from kinergy.trajectory.motion import Motion, MotionSource
 from kinergy.trajectory.program_motion import payload_index, program_motion
 from kinergy.trajectory.program_path import program_path
@@ -32,6 +42,8 @@ __all__ = [
     "EnergyOptions",
     "LogEnergy",
     "energy_of_log",
+    "energy_with_outputs",
+    "log_energy_report",
     "program_energy",
     "unused_payload",
 ]
@@ -111,7 +123,13 @@ def _measured_power(log: Log) -> Array | None:
 
 
 #: the signals besides the motion that the energy of a log uses
-_EXTRAS = ("joint_temperatures", "actual_robot_voltage", "actual_robot_current", "segment")
+_EXTRAS = (
+    "joint_temperatures",
+    "actual_robot_voltage",
+    "actual_robot_current",
+    "segment",
+    *PAYLOAD_SIGNALS,
+)
 
 
 def _signals_used(log: CheckedLog, source: MotionSource) -> list[str] | None:
@@ -141,6 +159,18 @@ def _derived(signals: list[str] | None) -> str | None:
     if source == "target" and "target_qdd" not in signals:
         return "target_qdd not in the log: accelerations from a spline of target_qd"
     return None
+
+
+def _drive(robot: Robot, log: Log, motion: Motion) -> DriveState:
+    """The drive model over a chunk's motion, each sample with the payload the log says it
+    carried (:func:`kinergy.logs.payload.logged_loads`), else with the robot's own; friction at
+    the log's joint temperatures where it has them."""
+    temperature = _temperature(log, motion)
+    loads = logged_loads(log)
+    if loads is None:
+        return drive_state(robot, motion.q, motion.qd, motion.qdd, temperature=temperature)
+    m = motion
+    return drive_by_payload(robot, *loads, m.q, m.qd, m.qdd, temperature=temperature)
 
 
 #: how far past a joint's torque limit the modelled torque of a motion may go before the
@@ -203,6 +233,7 @@ def energy_of_log(
     options: EnergyOptions | None = None,
     *,
     rows: int = ENERGY_ROWS,
+    sinks: Sequence[PowerSink] = (),
 ) -> LogEnergy:
     """The energy of the motion in a log or motion file and what the log was (what ``kinergy
     energy`` prints: :class:`LogEnergy`): the log read in one
@@ -214,10 +245,15 @@ def energy_of_log(
     measured, ``actual_robot_voltage`` x ``actual_robot_current``, beside the predicted one);
     memory bounded by the chunk. Segments (a time gap or a ``segment`` change) are never
     integrated across. A URScript program (``*.script``) is run as the controller would, with
-    the loads it sets (:func:`program_energy`)."""
+    the loads it sets (:func:`program_energy`). Each of ``sinks`` gets the power of every chunk
+    (:class:`~kinergy.accounting.trace.PowerSink`: the supply's, predicted and measured, and each
+    motor's)."""
     options = options or EnergyOptions()
     source, recovery = options.source, options.recovery
     inputs = InputLogs()
+    reading = reading or LogReading()
+    robot = reading.loaded(robot)
+    inputs.notes.extend(standing_draw_notes(robot))
     if is_builtin(path) or os.fspath(path).endswith(".script"):
         if is_builtin(path):  # test-a, test-b: the motion as planned for the robot
             motion = paper_trajectory(robot, os.fspath(path))
@@ -225,6 +261,8 @@ def energy_of_log(
             report = energy(robot, motion, recovery=recovery)
         else:
             report = program_energy(robot, path, recovery=recovery)
+        for sink in sinks:
+            sink.add(report.t, supply_predicted(robot, report.drive), None, report.drive.power)
         said = _beyond_limits(robot, np.abs(report.drive.tau_sim).max(axis=0))
         if not is_builtin(path):
             said += unused_payload(robot, path)
@@ -232,17 +270,86 @@ def energy_of_log(
     acc = EnergyAccumulator(robot, recovery=recovery)
     measured = False
     peak = np.zeros(robot.n)
-    log = CheckedLog(path, robot, reading or LogReading(), rows=rows, ahead=True)
+    log = CheckedLog(path, robot, reading, rows=rows, ahead=True)
     log.select = _signals_used(log, source)
     for part in iter_motion(log.chunks(), n_joints=robot.n, source=source):
         m = part.motion
-        state = drive_state(robot, m.q, m.qd, m.qdd, temperature=_temperature(part.log, m))
+        state = _drive(robot, part.log, m)
         power = _measured_power(part.log)
         measured = power is not None
         acc.add(m.t, state, starts=part.starts, measured_power=power)
+        for sink in sinks:
+            sink.add(m.t, supply_predicted(robot, state), power, state.power)
         if len(m.t):
             peak = np.maximum(peak, np.abs(state.tau_sim).max(axis=0))
     inputs.add(log)
     if derived := _derived(log.select):
         inputs.notes.append(f"{log.path}: {derived}")
     return _with(acc.figures(measured=measured), inputs, _beyond_limits(robot, peak))
+
+
+def log_energy_report(
+    robot: Robot,
+    path: str | os.PathLike[str],
+    reading: LogReading | None = None,
+    *,
+    source: MotionSource = MotionSource.AUTO,
+) -> tuple[EnergyReport, InputLogs]:
+    """The energy of a log's motion with its time series (:class:`EnergyReport`, as the study
+    report plots it), each sample with the payload the log's controller logged (else the
+    robot's, or ``--payload``'s), and what the log was; the log read whole through its checks."""
+    reading = reading or LogReading()
+    robot = reading.loaded(robot)
+    checked = CheckedLog(path, robot, reading)
+    log = checked.read()
+    inputs = InputLogs()
+    inputs.add(checked)
+    motion = motion_from_log(log, n_joints=robot.n, source=source)
+    return energy(robot, motion, state=_drive(robot, log, motion)), inputs
+
+
+def energy_with_outputs(
+    robot: Robot,
+    path: str | os.PathLike[str],
+    reading: LogReading | None = None,
+    options: EnergyOptions | None = None,
+    *,
+    trace: str | os.PathLike[str] | None = None,
+    plot: str | os.PathLike[str] | None = None,
+) -> LogEnergy:
+    """:func:`energy_of_log`, writing the power trace to ``trace`` (CSV or Parquet by its
+    extension, :mod:`kinergy.accounting.trace`; streamed chunk by chunk, whole or not at all)
+    and the plot of the supply's power, predicted against measured, to ``plot`` (PNG,
+    :func:`kinergy.report.plots.supply_power`), each when given.
+
+    Raises
+    ------
+    KinergyError
+        A trace file that is neither ``.csv`` nor ``.parquet`` (before any work), and whatever
+        :func:`energy_of_log` raises; nothing is written then.
+    """
+    fmt = trace_format(trace) if trace is not None else None
+    series = PowerSeries() if plot is not None else None
+    with contextlib.ExitStack() as stack:
+        sinks: list[PowerSink] = [] if series is None else [series]
+        writer = None
+        if trace is not None and fmt is not None:
+            writer = TraceWriter(stack.enter_context(atomic_open(trace, binary=True)), robot, fmt)
+            sinks.append(writer)
+        result = energy_of_log(robot, path, reading, options, sinks=sinks)
+        if writer is not None:
+            writer.close()
+    if plot is not None and series is not None:
+        from kinergy.report.plots import save, supply_power  # matplotlib: only for a plot
+
+        measured = result.measured
+        figure = supply_power(
+            series.t,
+            series.predicted,
+            energy=result.supply.drawn,
+            measured=series.measured,
+            measured_energy=None if measured is None else measured.drawn,
+            standing=robot.standby_power,
+        )
+        save(figure, plot)
+    return result

@@ -63,7 +63,9 @@ def fleet_energy(
     and, with ``report``, the HTML fleet report into that folder. ROS 2 bags are read with their
     robot entry's ``topic`` and ``effort``, else ``reading.bag``'s. Every log passes the
     plausibility checks (:mod:`kinergy.logs.checks`) but those in ``reading.accept``; a log that
-    fails one is reported with the check's line as its error.
+    fails one is reported with the check's line as its error. ``reading.payload`` (``--payload``)
+    replaces each log's logged payload and its model's; ``reading.window`` (``--from``/``--to``)
+    cuts every log.
 
     Raises
     ------
@@ -75,7 +77,10 @@ def fleet_energy(
     reading = reading or LogReading()
     fleet = read_manifest(manifest)
     items = [
-        dataclasses.replace(i, accept=reading.accept) for i in fleet_logs(fleet, logs, reading.bag)
+        dataclasses.replace(
+            i, accept=reading.accept, payload=reading.payload, window=reading.window
+        )
+        for i in fleet_logs(fleet, logs, reading.bag)
     ]
     inputs = [Path(manifest), *(Path(i.path) for i in items)]
     inputs += [Path(m) for m in {i.model for i in items} if Path(m).is_file()]

@@ -18,11 +18,11 @@ import numpy as np
 
 from kinergy._version import __version__
 from kinergy.drives.bus import supply_power
-from kinergy.drives.electrics import electrical_power, equivalent_voltage, torque_constants
+from kinergy.drives.electrics import electrical_power, torque_constants
 from kinergy.drives.transmission import transmission_matrix
 from kinergy.errors import Code, KinergyError
 from kinergy.identification.chunks import LogChunks, Summary, data_history
-from kinergy.identification.electrics import ElectricsFit, ElectricsSums, with_electrics
+from kinergy.identification.electrics import BLOCK_SECONDS, StandingDraw, StandingDrawSums
 from kinergy.identification.full import full
 from kinergy.identification.nursing import nursing
 from kinergy.identification.options import CurrentOptions, IdentifyOptions, Method
@@ -41,9 +41,10 @@ from kinergy.messages import coded
 from kinergy.model import Robot, save_robot
 from kinergy.model.robot import Identified, InputRecord, Source
 from kinergy.predict import drive_state
-from kinergy.workflows.logs import chunked_logs
+from kinergy.workflows.logs import chunked_logs, one_payload
 
 __all__ = [
+    "MIN_MOTION_SHARE",
     "MIN_SECONDS",
     "PayloadRun",
     "identify_chunks",
@@ -51,6 +52,7 @@ __all__ = [
     "identify_model",
     "identify_payload_model",
     "measured_electrics",
+    "motion_share",
     "unsupported_fit",
 ]
 
@@ -84,8 +86,8 @@ def _checks(summaries: list[Summary]) -> None:
 def identify_chunks(
     robot: Robot, logs: LogChunks, options: IdentifyOptions | None = None
 ) -> IdentificationResult:
-    """Identify ``robot`` from ``logs`` as ``options`` say, then the motor electrics and the
-    standby power where the logs have voltages and the supply (:func:`measured_electrics`)."""
+    """Identify ``robot`` from ``logs`` as ``options`` say, then the bus voltage and the
+    standing draw where the logs measure them (:func:`measured_electrics`)."""
     options = options or IdentifyOptions()
     if options.method == Method.SEQUENTIAL:
         result = sequential(robot, logs, CurrentOptions(options.friction))
@@ -112,10 +114,24 @@ def identify_model(
     return identify_chunks(robot, LogChunks.of(datas, check=_checks), options)
 
 
-def unsupported_fit(result: IdentificationResult) -> str:
+#: the least share of their samples the logs must move on (any joint faster than
+#: :data:`~kinergy.identification.chunks.STILL_SPEED`) before a fit they do not support is
+#: blamed on their layout rather than on too little motion
+MIN_MOTION_SHARE = 0.25
+
+
+def motion_share(summary: Summary) -> float:
+    """The share of a log's samples some joint moves on (its most moving joint's)."""
+    moving = np.asarray(summary.forward + summary.backward, dtype=float)
+    return float(np.max(moving) / max(summary.samples, 1))
+
+
+def unsupported_fit(result: IdentificationResult, share: float = 1.0) -> str:
     """Why the identified model is not supported by its own logs, or "": no drive parameter
     identified, or an R^2 below 0 on the identification logs for a joint that moved (module
-    docstring of :mod:`kinergy.logs.checks`, check ``fit``)."""
+    docstring of :mod:`kinergy.logs.checks`, check ``fit``); logs that move on less than
+    :data:`MIN_MOTION_SHARE` of their samples (``share``) are told they hold too little motion,
+    not that their layout is wrong."""
     flags = [f for j in result.joints for k, f in j.flags.items()]
     if flags and all(f != IDENTIFIED for f in flags):
         return (
@@ -131,6 +147,13 @@ def unsupported_fit(result: IdentificationResult) -> str:
         for k, m in enumerate(metrics):
             if moved[k] and m.r2 < 0:
                 worst.append(f"{result.robot.joints[k].name} {unit} R^2 {m.r2:.2f}")
+    if worst and share < MIN_MOTION_SHARE:
+        return (
+            f"too little motion to identify from: the joints move on {100 * share:.0f} % of the "
+            f"logs' samples and the model fitted to them does not explain them "
+            f"({', '.join(worst)}); log more motion (kinergy excite designs it), or cut the logs "
+            "to where the arm moves (--from/--to)"
+        )
     if worst:
         return (
             f"the identified model does not explain its own logs ({', '.join(worst)}): the "
@@ -182,13 +205,17 @@ def identify_logs(
     reading = reading or LogReading()
     options = options or IdentifyOptions()
     with chunked_logs(logs, robot, reading, rows=max(rows, 2)) as (segments, inputs):
+        start = one_payload(reading.loaded(robot), segments, inputs.notes)
         chunks = LogChunks(segments, rows, check=_checks)
         try:
-            result = identify_chunks(robot, chunks, options)
+            result = identify_chunks(start, chunks, options)
+            share = motion_share(Summary.pooled(chunks.summaries))
         finally:
             chunks.close()
+    # the payload was the run's, not the arm's: the model keeps its file's own
+    result = dataclasses.replace(result, robot=result.robot.with_payload(robot.payload))
     accepted = [a for c in inputs.checks for a in c.accepted]
-    problem = unsupported_fit(result)
+    problem = unsupported_fit(result, share)
     if problem:
         if Check.FIT not in reading.accept:
             raise KinergyError(
@@ -198,7 +225,11 @@ def identify_logs(
         accepted.append(f"fit: {problem}")
     result = dataclasses.replace(result, inputs=inputs, accepted=tuple(accepted))
     if out is not None:
-        columns = compact_columns(reading.columns) if reading.columns else None
+        columns = None
+        if isinstance(reading.columns, tuple):
+            columns = compact_columns(reading.columns)
+        elif reading.columns is not None:
+            columns = str(reading.columns)
         model = _record(result.robot, inputs, options, columns, accepted)
         what = f"{robot.name} identified ({result.method} method)"
         save_robot(model, out, header=_header(what, [p.path for p in inputs.provenance]))
@@ -215,36 +246,15 @@ def _predicted_currents(robot: Robot, logs: LogChunks) -> list[np.ndarray]:
     return [current for (current,) in logs.currents[1]]  # type: ignore[misc]
 
 
-def _electrics_fits(
-    robot: Robot, logs: LogChunks, currents: list[np.ndarray], notes: list[str]
-) -> list[ElectricsFit | None]:
-    """Each motor's R and k_b from the logs' voltages, currents and motor speeds, the currents
-    ``robot`` predicts as the instrument (UR5e eq 19, :class:`ElectricsSums`); None where they
-    cannot separate the two, with a note."""
-    n_mat = transmission_matrix(robot)
-    motors = [ElectricsSums() for _ in range(robot.n)]
-    for (_, chunk), predicted in zip(logs.chunks(), currents, strict=True):
-        assert chunk.current is not None and chunk.voltage is not None
-        voltage, wm = equivalent_voltage(chunk.voltage), chunk.qd @ n_mat.T
-        for m, motor in enumerate(motors):
-            motor.add(chunk.current[:, m], voltage[:, m], wm[:, m], instrument=predicted[:, m])
-    fits: list[ElectricsFit | None] = []
-    for m, (joint, motor) in enumerate(zip(robot.joints, motors, strict=True)):
-        try:
-            fits.append(motor.fit())
-        except KinergyError as exc:
-            notes.append(f"joint {m + 1} ({joint.name}): electrics kept from the model: {exc}")
-            fits.append(None)
-    return fits
-
-
-def _standby(robot: Robot, logs: LogChunks, currents: list[np.ndarray] | None) -> float:
-    """The mean of the supply power less the motors' draw (W; UR5e eq 23 on the ``currents``
-    ``robot`` predicts, else on its :func:`~kinergy.predict.drive_state`;
-    :func:`~kinergy.identification.electrics.fit_standby`'s ``standby``)."""
+def _standing_draw(
+    robot: Robot, logs: LogChunks, currents: list[np.ndarray] | None
+) -> StandingDraw:
+    """The supply power less the motors' draw (UR5e eq 23 on the ``currents`` ``robot``
+    predicts, else on its :func:`~kinergy.predict.drive_state`), folded into
+    :class:`~kinergy.identification.electrics.StandingDrawSums`."""
     n_mat, kt = transmission_matrix(robot), torque_constants(robot)
     held = data_history(robot)
-    total, count = 0.0, 0
+    sums = StandingDrawSums()
     for c, (k, chunk) in enumerate(logs.chunks()):
         assert chunk.supply_voltage is not None and chunk.supply_current is not None
         if currents is not None:
@@ -255,50 +265,61 @@ def _standby(robot: Robot, logs: LogChunks, currents: list[np.ndarray] | None) -
             held.update(data, skip)
             power = state.power[skip:]
         supply = np.asarray(chunk.supply_voltage * chunk.supply_current, dtype=float)
-        total += float(np.sum(supply - supply_power(power).motors))
-        count += len(chunk)
+        sums.add(k, chunk.t, supply - supply_power(power).motors)
+    return sums.fit()
+
+
+def _bus_voltage(logs: LogChunks, name: str) -> float:
+    """The mean of a logged voltage (``supply_voltage`` or the joints' ``voltage``), V."""
+    total, count = 0.0, 0
+    for _, chunk in logs.chunks(name):
+        values = getattr(chunk, name)
+        total += float(np.sum(values))
+        count += values.size
     return total / count
 
 
 def measured_electrics(result: IdentificationResult, logs: LogChunks) -> IdentificationResult:
-    """``result`` with the motor electrics fitted to the logs' joint voltages (UR5e eq 19,
-    :class:`kinergy.identification.electrics.ElectricsSums`) and the standby power to their supply
-    power, when every log has them, the currents its robot predicts (friction held per log) as
-    the instrument and the motors' draw; the fit's notes say what was written into the model.
-    Unchanged for logs without them."""
+    """``result`` with the bus voltage and the standing draw the logs measure, when every log
+    has them: the bus voltage, the mean of ``actual_robot_voltage`` (else of
+    ``actual_joint_voltage``, each joint's supply, never a motor's voltage: ``R`` and ``k_b`` stay
+    the model's); the standing draw (:func:`_standing_draw`) from ``actual_robot_voltage`` x
+    ``actual_robot_current``, with its standard error. The fit's notes say what was written into
+    the model. Unchanged for logs without them."""
     robot, notes = result.robot, list[str]()
     sources = dict(robot.sources)
-    has_voltage = logs.every("voltage", "current")
     has_supply = logs.every("supply_voltage", "supply_current")
-    if not (has_voltage or has_supply):
+    which = "supply_voltage" if has_supply else "voltage" if logs.every("voltage") else None
+    if which is None:
         return result
-    currents = _predicted_currents(robot, logs) if has_voltage else None
-    if has_voltage:
-        assert currents is not None
-        fits = _electrics_fits(robot, logs, currents, notes)
-        robot = with_electrics(robot, fits)
-        ref = "kinergy identify: R and k_b from actual_joint_voltage (UR5e eq 19)"
-        sources["motor_constant"] = Source("identified", ref)
-        for j, motor in enumerate(fits):
-            if motor is not None:
-                notes.append(
-                    f"joint {j + 1} ({robot.joints[j].name}): R = {motor.resistance:.4g} ohm, "
-                    f"k_b = {motor.back_emf:.4g} V s/rad from the logged joint voltages (voltage "
-                    f"RMS error {motor.rms:.3g} V), written into the model"
-                )
+    bus = _bus_voltage(logs, which)
+    logged = "actual_robot_voltage" if has_supply else "actual_joint_voltage (each joint's supply)"
+    robot = dataclasses.replace(robot, bus_voltage=bus)
+    notes.append(
+        f"bus voltage {bus:.4g} V, the mean of the logged {logged}, written into the model; the "
+        "motors' R and k_b stay the model's (a log has no motor voltage: robot "
+        "import-calibration takes them from a UR calibration's U and I)"
+    )
+    draw = None
     if has_supply:
-        standby = max(_standby(robot, logs, currents), 0.0)
-        robot = dataclasses.replace(robot, standby_power=standby)
+        model = result.robot  # the currents its validation kept
+        currents = _predicted_currents(model, logs) if logs.every("current") else None
+        draw = _standing_draw(model, logs, currents)
+        robot = dataclasses.replace(robot, standby_power=max(draw.power, 0.0))
         sources["supply"] = Source(
-            "identified", "kinergy identify: standby power from actual_robot_current"
+            "identified",
+            f"kinergy identify: standing draw {draw.power:.4g} +- {draw.std:.2g} W (standard "
+            "error) from actual_robot_voltage x actual_robot_current less the motors' draw",
         )
         notes.append(
-            f"standby power {standby:.3g} W from the logged supply power (actual_robot_voltage "
+            f"standing draw {draw.power:.4g} W (standard error {draw.std:.2g} W, {draw.blocks} "
+            f"blocks of {BLOCK_SECONDS:g} s) from the logged supply power (actual_robot_voltage "
             "x actual_robot_current, less the motors' predicted draw), written into the model"
+            + (" as 0 W" if draw.power < 0 else "")
         )
     robot = dataclasses.replace(robot, sources=sources)
     fit = dataclasses.replace(result.fit, notes=(*result.fit.notes, *notes))
-    return dataclasses.replace(result, robot=robot, fit=fit)
+    return dataclasses.replace(result, robot=robot, fit=fit, standing_draw=draw)
 
 
 @dataclass(frozen=True, eq=False)

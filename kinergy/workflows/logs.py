@@ -12,12 +12,12 @@ import itertools
 import os
 from collections.abc import Iterator, Sequence
 
-from kinergy.arrays import Array
+from kinergy.errors import KinergyError
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
 from kinergy.io.motion import motion_from_log
-from kinergy.io.segments import segment_bounds
 from kinergy.io.urscript_reader import read_program
+from kinergy.logs.payload import PAYLOAD_SIGNALS, describe
 from kinergy.logs.prepare import (
     SIGNALS,
     STATE,
@@ -27,12 +27,21 @@ from kinergy.logs.prepare import (
     spill_log,
 )
 from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
+from kinergy.logs.samples import used_bounds
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion, MotionSource
 from kinergy.trajectory.program_motion import program_motion
 from kinergy.trajectory.program_path import program_path
 
-__all__ = ["MIN_SEGMENT", "InputLogs", "LogReading", "chunked_logs", "prepared_logs", "read_motion"]
+__all__ = [
+    "MIN_SEGMENT",
+    "InputLogs",
+    "LogReading",
+    "chunked_logs",
+    "one_payload",
+    "prepared_logs",
+    "read_motion",
+]
 
 
 MIN_SEGMENT = 1.0
@@ -40,30 +49,37 @@ MIN_SEGMENT = 1.0
 
 
 def _segments(
-    path: str | os.PathLike[str], t: Array, segment: Array | None, notes: list[str]
+    path: str | os.PathLike[str], state: Log, notes: list[str], cuts: Sequence[int] = ()
 ) -> list[tuple[str, tuple[int, int]]]:
-    """The segments of the log at ``path`` identified from (time stamps ``t``, its ``segment``
-    signal if any: :func:`~kinergy.io.segments.segment_bounds`), each with the name
-    :func:`~kinergy.io.segments.split_segments` gives it: those shorter than :data:`MIN_SEGMENT`
-    are left out. Where there are several segments, ``notes`` receives what was done with them."""
-    name, bounds = os.fspath(path), segment_bounds(t, segment)
-    if len(bounds) == 1:
-        kept = [(name, bounds[0])]
-    else:
-        parts = [(f"{name}#{k}", ab) for k, ab in enumerate(bounds)]
-        kept = [p for p in parts if t[p[1][1] - 1] - t[p[1][0]] >= MIN_SEGMENT] or [
-            max(parts, key=lambda p: p[1][1] - p[1][0])
-        ]
-        gaps = [t[b[0]] - t[a[1] - 1] for a, b in itertools.pairwise(bounds)]
+    """The segments of the log at ``path`` identified from (:func:`kinergy.logs.samples.used_bounds`
+    of its time stamps and state columns ``state``: its segments, cut where the robot does not
+    run and at ``cuts``, where the logged payload changes), each with the name :func:`~kinergy.io.segments.split_segments` gives it: those shorter
+    than :data:`MIN_SEGMENT` are left out. Where there are several segments, ``notes`` receives
+    what was done with them."""
+    name, t, bounds = os.fspath(path), state.t, used_bounds(state, cuts)
+    used = sum(b - a for a, b in bounds)
+    if used < len(t):
         notes.append(
-            f"{path}: {len(parts)} segments (gaps up to {max(gaps):.3f} s), each prepared on "
-            f"its own; {len(parts) - len(kept)} shorter than {MIN_SEGMENT:g} s left out"
+            f"{path}: {len(t) - used} of {len(t)} samples left out where the robot does not run "
+            "(robot_mode not 7, or safety_mode not 1 or 2)"
         )
+    if len(bounds) == 1:
+        return [(name, bounds[0])]
+    parts = [(f"{name}#{k}", ab) for k, ab in enumerate(bounds)]
+    kept = [p for p in parts if t[p[1][1] - 1] - t[p[1][0]] >= MIN_SEGMENT] or [
+        max(parts, key=lambda p: p[1][1] - p[1][0])
+    ]
+    gaps = [t[b[0]] - t[a[1] - 1] for a, b in itertools.pairwise(bounds)]
+    notes.append(
+        f"{path}: {len(parts)} segments (gaps up to {max(gaps):.3f} s), each prepared on "
+        f"its own; {len(parts) - len(kept)} shorter than {MIN_SEGMENT:g} s left out"
+    )
     return kept
 
 
-#: the signals a spill keeps: what identification uses, and the state that decides segments
-SPILLED = (*SIGNALS, *STATE)
+#: the signals a spill keeps: what identification uses, the state that decides segments and the
+#: logged payload
+SPILLED = (*SIGNALS, *STATE, *PAYLOAD_SIGNALS)
 
 
 def prepared_logs(
@@ -99,8 +115,8 @@ def chunked_logs(
             spill = spill_log(checked)
             stack.callback(spill.close)
             inputs.add(checked)
-            t, segment = spill.state.t, spill.state.signals.get("segment")
-            for name, ab in _segments(checked.path, t, segment, inputs.notes):
+            cuts = [start for start, _ in spill.loads[1:]]
+            for name, ab in _segments(checked.path, spill.state, inputs.notes, cuts):
                 prepared = prepare_segment(spill, ab, name, robot.n, reading.cutoff)
                 if prepared.grid is not None:
                     rows = prepared.rows.stop - prepared.rows.start
@@ -111,6 +127,36 @@ def chunked_logs(
                     )
                 segments.append(prepared)
         yield segments, inputs
+
+
+def one_payload(robot: Robot, segments: Sequence[PreparedSegment], notes: list[str]) -> Robot:
+    """``robot`` carrying the payload its logs' controller logged (:attr:`PreparedSegment.load`;
+    ``robot`` as it is where none is logged), for a method that fits one model to all of them;
+    ``notes`` says which payload was used.
+
+    Raises
+    ------
+    KinergyError
+        Segments that logged different payloads (name two), with what to do.
+    """
+    logged = {s.load.tobytes(): s for s in segments if s.load is not None}
+    if not logged:
+        return robot
+    if len(logged) > 1:
+        a, b = list(logged.values())[:2]
+        raise KinergyError(
+            f"the logs carry different payloads ({describe(a.robot(robot).payload)} in {a.path}, "
+            f"{describe(b.robot(robot).payload)} in {b.path}): identify from the samples of one "
+            "payload (--from/--to), or give the payload with --payload"
+        )
+    segment = next(iter(logged.values()))
+    loaded = segment.robot(robot)
+    where = ", ".join(sorted({s.path.split("#")[0] for s in segments if s.load is not None}))
+    notes.append(
+        f"{where}: the controller's logged payload, {describe(loaded.payload)}, is the "
+        "payload of the dynamics (--payload replaces it)"
+    )
+    return loaded
 
 
 def read_motion(

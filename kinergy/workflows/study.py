@@ -11,22 +11,24 @@ from pathlib import Path
 
 from kinergy._version import __version__
 from kinergy.accounting.energy import EnergyReport, energy
+from kinergy.accounting.trace import PowerSeries, SupplyTrace
 from kinergy.files import output_folder
 from kinergy.identification.chunks import Segment
 from kinergy.identification.result import IdentificationResult
 from kinergy.identification.validation import PLOT_SAMPLES, validation_report
 from kinergy.io.task import Task
-from kinergy.logs.prepare import IdentData
+from kinergy.logs.prepare import IdentData, PreparedSegment
 from kinergy.logs.reading import LogReading
 from kinergy.messages import Messages
 from kinergy.model.robot import Robot
 from kinergy.report.html import Section, Table, write_report
 from kinergy.report.study import Comparison, Study, Timing, study_sections
 from kinergy.trajectory.motion import Motion
-from kinergy.workflows.energy import program_energy
+from kinergy.workflows.energy import energy_of_log, log_energy_report, program_energy
 from kinergy.workflows.identify import identify_logs as identified
-from kinergy.workflows.logs import chunked_logs, read_motion
+from kinergy.workflows.logs import chunked_logs
 from kinergy.workflows.optimize import optimize_task
+from kinergy.workflows.twin import is_builtin
 
 __all__ = ["StudyReport", "optimal_timing", "run_study", "study_report", "write_study"]
 
@@ -54,7 +56,8 @@ def _comparisons(
     current: dict[str, Comparison] = {}
     for name, log in validation.items():
         say(f"validating on {name}")
-        found = validation_report(model, [log], plot_samples=PLOT_SAMPLES).logs[0]
+        loaded = log.robot(model) if isinstance(log, PreparedSegment) else model
+        found = validation_report(loaded, [log], plot_samples=PLOT_SAMPLES).logs[0]
         for key, out in (("torque", torque), ("current", current)):
             series, metrics = found.series.get(key), getattr(found, key)
             if series is not None and metrics is not None:
@@ -78,6 +81,7 @@ def run_study(
     paper: bool = False,
     task: Task | None = None,
     progress: Progress | None = None,
+    supply: Mapping[str, SupplyTrace] | None = None,
 ) -> Study:
     """Compute everything a study report shows (:class:`kinergy.report.study.Study`).
 
@@ -94,6 +98,8 @@ def run_study(
         See :class:`~kinergy.report.study.Study`.
     task : Task, optional
         A movej program whose energy-optimal timing and Pareto front the report shows.
+    supply : mapping of str to SupplyTrace, optional
+        Per log name, the supply's power to plot (:func:`supply_trace`).
     """
     say = progress or (lambda _msg: None)
     torque, current = _comparisons(model, validation or {}, say)
@@ -105,7 +111,7 @@ def run_study(
     if task is not None:
         say(f"optimising the timing of {task.name}")
         timing = optimal_timing(model, task)
-    return Study(model, result, truth, paper, torque, current, reports, timing)
+    return Study(model, result, truth, paper, torque, current, reports, timing, supply or {})
 
 
 def write_study(
@@ -128,6 +134,22 @@ def write_study(
         meta={**meta, "kinergy": __version__, "date": time.strftime("%Y-%m-%d %H:%M")},
     )
     return Path(path), tables
+
+
+def supply_trace(robot: Robot, path: str, reading: LogReading) -> SupplyTrace:
+    """The supply's power over the log at ``path`` for a plot, predicted and (where the log has
+    ``actual_robot_voltage`` and ``actual_robot_current``) measured, with their energies: one
+    more pass over the log (:func:`~kinergy.workflows.energy.energy_of_log`), memory bounded."""
+    series = PowerSeries()
+    figures = energy_of_log(robot, path, reading, sinks=[series])
+    return SupplyTrace(
+        series.t,
+        series.predicted,
+        series.measured,
+        figures.supply.drawn,
+        None if figures.measured is None else figures.measured.drawn,
+        robot.standby_power,
+    )
 
 
 def study_report(
@@ -158,21 +180,30 @@ def study_report(
         said.notes += result.notes
         said.warnings += result.warnings
         robot = result.robot
+    robot = reading.loaded(robot)  # --payload: of every log and motion
     motions: dict[str, Motion | EnergyReport] = {}
+    supply: dict[str, SupplyTrace] = {}
     for p in energy_logs:
         if p.endswith(".script"):  # run with the loads it sets
             motions[Path(p).name] = program_energy(robot, p)
             continue
-        motion, inputs = read_motion(p, robot, reading)
+        report, inputs = log_energy_report(robot, p, reading)
         said.notes += inputs.notes
         said.warnings += inputs.warnings
-        motions[Path(p).name] = motion
+        motions[Path(p).name] = report
+        if not is_builtin(p):
+            supply[Path(p).name] = supply_trace(robot, p, reading)
     with chunked_logs(validate_logs, robot, reading) as (segments, inputs):
         said.notes += inputs.notes
         said.warnings += inputs.warnings
         validation = {Path(s.path).name: s for s in segments}
         study = run_study(
-            robot, validation=validation, motions=motions, result=result, progress=progress
+            robot,
+            validation=validation,
+            motions=motions,
+            result=result,
+            progress=progress,
+            supply=supply,
         )
     with output_folder(out, prefix="kinergy-report") as (folder, target):
         _, tables = write_study(

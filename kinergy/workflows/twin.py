@@ -8,10 +8,13 @@ import os
 from dataclasses import dataclass
 from typing import TypeGuard
 
+import numpy as np
+
 from kinergy.checks import choice, integer, number
 from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 from kinergy.io.rtde import write_log
+from kinergy.io.segments import segment_bounds
 from kinergy.io.urscript_reader import read_program
 from kinergy.logs.reading import LogReading
 from kinergy.messages import Messages
@@ -52,6 +55,30 @@ def builtin_log(robot: Robot, name: str, seed: int = 0) -> Log:
     return simulate(truth, motion, TwinSettings.realistic(seed), name=name)
 
 
+def _unbroken(trajectory: str, motion: Motion) -> None:
+    """Refuse a motion whose sampling breaks (a gap, :func:`kinergy.io.segments.segment_bounds`):
+    the twin runs one unbroken motion, and would run the gap as motion (an hour's gap: an hour
+    of a log interpolated across it).
+
+    Raises
+    ------
+    KinergyError
+        Naming the file, the longest gap and where it is.
+    """
+    bounds = segment_bounds(motion.t)
+    if len(bounds) < 2:
+        return
+    starts = [a for a, _ in bounds[1:]]
+    gaps = [float(motion.t[a] - motion.t[a - 1]) for a in starts]
+    k = int(np.argmax(gaps))
+    at = starts[k]
+    raise KinergyError(
+        f"{trajectory}: the motion breaks off {len(starts)} time(s), the longest for "
+        f"{gaps[k]:.4g} s (from t = {motion.t[at - 1]:.6g} s to {motion.t[at]:.6g} s, sample "
+        f"{at + 1}): the twin runs one unbroken motion; simulate each part as its own file"
+    )
+
+
 def _target(robot: Robot, trajectory: str, reading: LogReading) -> tuple[Motion, Messages]:
     """The target motion of ``trajectory`` and what reading it said: the notes and warnings of
     a log's checks, and a warning for each load a URScript program sets (the twin carries the
@@ -60,6 +87,7 @@ def _target(robot: Robot, trajectory: str, reading: LogReading) -> tuple[Motion,
     if trajectory in TEST_TRAJECTORIES:
         return paper_trajectory(robot, trajectory), said
     motion, inputs = read_motion(trajectory, robot, reading, source="target")
+    _unbroken(trajectory, motion)
     said.notes += inputs.notes
     said.warnings += inputs.warnings
     if trajectory.endswith(".script"):

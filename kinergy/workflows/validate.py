@@ -52,9 +52,14 @@ def validate_logs(
     with ``plots``, also write the measured-against-predicted figures to that folder. A log the
     model was identified from is named in a warning."""
     sources = [builtin_log(robot, str(log)) if is_builtin(log) else log for log in logs]
-    with chunked_logs(sources, robot, reading or LogReading()) as (segments, inputs):
+    reading = reading or LogReading()
+    robot = reading.loaded(robot)
+    with chunked_logs(sources, robot, reading) as (segments, inputs):
         report = validation_report(
-            robot, segments, plot_samples=PLOT_SAMPLES if plots is not None else 0
+            robot,
+            segments,
+            plot_samples=PLOT_SAMPLES if plots is not None else 0,
+            robots=[s.robot(robot) for s in segments],
         )
         short = [
             f"{s.path}: {len(s)} samples over {(len(s) - 1) * s.dt:.3g} s: too short for these "
