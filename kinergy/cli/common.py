@@ -509,7 +509,12 @@ def json_result(result: Any) -> str:
             elif Path(path).is_file():
                 files.append(_file_record(path))
     files += logs.values()
-    options = {k: _plain(v) for k, v in ctx.params.items() if k != "as_json"}
+    types = {p.name: p.type for p in ctx.command.params}
+    options = {
+        k: _plain(getattr(types.get(k), "shown", lambda v: v)(v))  # a type's word for a value
+        for k, v in ctx.params.items()
+        if k != "as_json"
+    }
     out["kinergy"] = {"version": __version__, "command": ctx.command_path, "options": options}
     out["inputs"] = files
     return dumps(out)

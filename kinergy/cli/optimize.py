@@ -54,6 +54,10 @@ class CycleTime(click.ParamType):
         except ValueError:
             self.fail(f"expected seconds or 'same', got {value!r}", param, ctx)
 
+    def shown(self, value: float | None) -> float | str:
+        """The value as ``--json`` records the options given: ``same`` for None."""
+        return "same" if value is None else value
+
 
 def _moves_table(prog: ProgramResult, opt: ProgramResult) -> str:
     """Per move: ``v``, ``a``, duration and energy of the program as written and the optimum."""
