@@ -1,10 +1,10 @@
 """``kinergy optimize``: a robot program (a URScript program or a task) doing the same job with
 less energy at a cycle time.
 
-Parses the options into :class:`~kinergy.optimize.options.ProgramOptions`, runs
-:func:`kinergy.workflows.optimize.run_optimize` (the levers and the timing, all re-simulated at
-500 Hz, the Pareto front where asked, the URScript, plot and motion files) and prints its result
-as text or JSON.
+Parses the flags into :class:`~kinergy.optimize.options.ProgramOptions` (which checks them),
+runs :func:`kinergy.api.optimize_program` (the one optimiser: the levers and the timing, all
+re-simulated at 500 Hz, the Pareto front where asked, the URScript, plot and motion files) and
+prints its result as text or JSON.
 """
 
 from __future__ import annotations
@@ -15,8 +15,10 @@ from typing import Any, TypeVar
 
 import click
 
+from kinergy import api
 from kinergy.cli.common import (
-    Finite,
+    as_usage,
+    choice_of,
     json_result,
     load,
     output_file_option,
@@ -26,46 +28,34 @@ from kinergy.cli.common import (
     table,
     writes,
 )
-from kinergy.errors import KinergyError
 from kinergy.optimize import ParetoPoint, ProgramResult
 from kinergy.optimize.levers import Lever
-from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
-from kinergy.workflows.optimize import OptimizeRun, run_optimize
+from kinergy.optimize.options import MAX_CYCLE_TIME
 
-__all__ = ["lever_options", "optimize", "optimize_text", "program_options"]
+__all__ = ["CycleTime", "lever_options", "optimize", "optimize_text", "program_options"]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-#: the longest cycle time optimised, s (each is re-simulated at 500 Hz, Pareto points and all)
-MAX_CYCLE_TIME = 600.0
-#: the smallest and largest speed (rad/s) and acceleration (rad/s^2) caps taken (below 1e-3,
-#: 0.06 deg/s, a move takes longer than any cycle-time budget and its profile underflows)
-_MIN_CAP = 1e-3
-_MAX_CAP = {"--v-max": 100.0, "--a-max": 1e4}
-#: Pareto points when --plot asks for the front and --pareto-points does not say how many
-_PLOT_POINTS = 8
 
+class CycleTime(click.ParamType):
+    """``--cycle-time SECONDS|same``: a number of seconds, or ``same`` (None: the program's
+    own); the bounds are :class:`~kinergy.optimize.options.ProgramOptions`'."""
 
-def _cycle_time(text: str) -> float | None:
-    """``same`` -> None (the program's own); otherwise seconds > 0."""
-    if text.strip().lower() == "same":
-        return None
-    try:
-        value = float(text)
-    except ValueError:
-        raise KinergyError(f"--cycle-time: expected seconds or 'same', got {text!r}") from None
-    if not (math.isfinite(value) and 0.0 < value <= MAX_CYCLE_TIME):
-        raise KinergyError(
-            f"--cycle-time: must be > 0 and at most {MAX_CYCLE_TIME:g} s, got {text!r}"
-        )
-    return value
+    name = "seconds|same"
 
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if value is None or isinstance(value, float):
+            return value
+        if str(value).strip().lower() == "same":
+            return None
+        try:
+            return float(value)
+        except ValueError:
+            self.fail(f"expected seconds or 'same', got {value!r}", param, ctx)
 
-def _cap(name: str, value: float | None) -> None:
-    if value is not None and not (math.isfinite(value) and _MIN_CAP <= value <= _MAX_CAP[name]):
-        raise KinergyError(
-            f"{name}: must be at least {_MIN_CAP:g} and at most {_MAX_CAP[name]:g}, got {value:g}"
-        )
+    def shown(self, value: float | None) -> float | str:
+        """The value as ``--json`` records the options given: ``same`` for None."""
+        return "same" if value is None else value
 
 
 def _moves_table(prog: ProgramResult, opt: ProgramResult) -> str:
@@ -125,7 +115,7 @@ def _levers_table(levers: Sequence[Lever]) -> str:
     return table([*headers, "used", "note"], rows)
 
 
-def _saving(run: OptimizeRun) -> list[str]:
+def _saving(run: api.OptimizeRun) -> list[str]:
     """The saving against the supply and against the motors, the read-back, the solver."""
     result = run.result
     own, opt = result.program.result, result.optimized.result
@@ -151,7 +141,7 @@ def _saving(run: OptimizeRun) -> list[str]:
     return lines
 
 
-def optimize_text(run: OptimizeRun) -> str:
+def optimize_text(run: api.OptimizeRun) -> str:
     """The ``optimize`` report: per move, per lever, the saving, the targets, the Pareto front."""
     result = run.result
     own, opt = result.program.result, result.optimized.result
@@ -205,23 +195,23 @@ def lever_options(prefix: str = "") -> Callable[[F], F]:
     options = [
         click.option(
             "--configurations",
-            type=click.Choice([c.value for c in Configurations]),
-            default="keep",
+            type=choice_of(api.Configurations),
+            default=api.Configurations.KEEP.value,
             show_default=True,
             help=said("the IK branch of a movej's pose target (free: any of the eight)."),
         ),
         click.option(
             "--tool-symmetry",
             "tool_symmetry",
-            type=click.Choice([s.value for s in ToolSymmetry]),
-            default="none",
+            type=choice_of(api.ToolSymmetry),
+            default=api.ToolSymmetry.NONE.value,
             show_default=True,
             help=said("the tool may turn about its z axis (any angle, 180 or 90 deg)."),
         ),
         click.option(
             "--via",
-            type=click.Choice([v.value for v in ViaPoints]),
-            default="keep",
+            type=choice_of(api.ViaPoints),
+            default=api.ViaPoints.KEEP.value,
             show_default=True,
             help=said(
                 "joint-space via points (a movej's target followed by a movej, nothing "
@@ -232,7 +222,7 @@ def lever_options(prefix: str = "") -> Callable[[F], F]:
         click.option("--no-blends", is_flag=True, help=said("no blend radii on via points.")),
         click.option(
             "--standby",
-            type=Finite(min=0.0),
+            type=float,
             default=None,
             help=said("standby power (W) counted over the cycle time [default: the robot file's]."),
         ),
@@ -248,31 +238,24 @@ def lever_options(prefix: str = "") -> Callable[[F], F]:
 
 def program_options(
     *,
-    configurations: str,
-    tool_symmetry: str,
-    via: str,
+    configurations: api.Configurations,
+    tool_symmetry: api.ToolSymmetry,
+    via: api.ViaPoints,
     no_blends: bool,
     standby: float | None,
-    cycle_time: str,
+    cycle_time: float | None,
     v_max: float | None,
     a_max: float | None,
     fixed_shares: bool = False,
-) -> ProgramOptions:
-    """The options of a program's optimisation, parsed once into their types (one line naming
-    the flag for a bad value)."""
-    _cap("--v-max", v_max)
-    _cap("--a-max", a_max)
-    return ProgramOptions(
-        configurations=Configurations.parse(configurations),
-        tool_symmetry=ToolSymmetry.parse(tool_symmetry),
-        via=ViaPoints.parse(via),
-        blends=not no_blends,
-        fixed_shares=fixed_shares,
-        standby=standby,
-        cycle_time=_cycle_time(cycle_time),
-        v_max=v_max,
-        a_max=a_max,
-    )
+) -> api.ProgramOptions:
+    """The flags of the levers, the cycle time and the caps as the API's
+    :class:`~kinergy.optimize.options.ProgramOptions` (a value it refuses: a usage error)."""
+    with as_usage():
+        return api.ProgramOptions(
+            configurations=configurations, tool_symmetry=tool_symmetry, via=via,
+            blends=not no_blends, fixed_shares=fixed_shares, standby=standby,
+            cycle_time=cycle_time, v_max=v_max, a_max=a_max,
+        )  # fmt: skip
 
 
 @click.command()
@@ -281,10 +264,11 @@ def program_options(
 @click.option(
     "--cycle-time",
     "cycle_time",
+    type=CycleTime(),
     default="same",
     show_default=True,
     metavar="SECONDS|same",
-    help="Cycle-time budget; 'same': the program's own.",
+    help=f"Cycle-time budget (at most {MAX_CYCLE_TIME:g} s); 'same': the program's own.",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @output_file_option(
@@ -301,24 +285,24 @@ def program_options(
 @click.option(
     "--v-max",
     "v_max",
-    type=Finite(),
+    type=float,
     default=None,
     help="Cap on every joint's speed, rad/s [default: the program's own peak].",
 )
 @click.option(
     "--a-max",
     "a_max",
-    type=Finite(),
+    type=float,
     default=None,
     help="Cap on every joint's acceleration, rad/s^2 [default: the program's own peak].",
 )
 @click.option(
     "--pareto-points",
     "points",
-    type=click.IntRange(0, 50),
+    type=int,
     default=None,
-    help=f"Cycle times on the Pareto front (0: none) [default: {_PLOT_POINTS} with --plot, "
-    "else 0].",
+    help=f"Cycle times on the Pareto front, 0 (none) to {api.MAX_POINTS} [default: "
+    f"{api.PLOT_POINTS} with --plot, else 0].",
 )
 @click.option(
     "--fixed-shares",
@@ -337,7 +321,7 @@ def program_options(
 def optimize(
     model: str,
     task_name: str,
-    cycle_time: str,
+    cycle_time: float | None,
     as_json: bool,
     urscript: str | None,
     plot: str | None,
@@ -346,9 +330,9 @@ def optimize(
     a_max: float | None,
     points: int | None,
     fixed_shares: bool,
-    configurations: str,
-    tool_symmetry: str,
-    via: str,
+    configurations: api.Configurations,
+    tool_symmetry: api.ToolSymmetry,
+    via: api.ViaPoints,
     no_blends: bool,
     standby: float | None,
     motions: str | None,
@@ -374,18 +358,11 @@ def optimize(
         a_max=a_max,
         fixed_shares=fixed_shares,
     )
-    count = (_PLOT_POINTS if plot is not None else 0) if points is None else points
     with progress() as say:
-        run = run_optimize(
-            load(model, payload),
-            task_name,
-            options=options,
-            points=count,
-            urscript=urscript,
-            motions=motions,
-            plot=plot,
-            progress=say,
-        )
+        run = api.optimize_program(
+            load(model, payload), task_name, options, points=points, urscript=urscript,
+            motions=motions, plot=plot, progress=say,
+        )  # fmt: skip
     click.echo(json_result(run.to_dict()) if as_json else optimize_text(run))
     if not as_json:
         for path in run.written:
