@@ -162,7 +162,7 @@ def test_via_points_left_out_keep_every_job_target() -> None:
     text = program_script(free.written)
     assert "  movej(home, a=" in text and "home = [0.0, -1.75" not in text
     back = parse_program(text)
-    again = simulate_path(robot, program_path(robot, back))
+    again = simulate_path(robot, program_path(robot, back), standby=free.settings.standby)
     assert again.result.score == pytest.approx(free.optimized.result.score, rel=1e-3)
 
 
