@@ -55,7 +55,7 @@ from kinergy.model.robot import Friction, Joint, Robot, Source, Thermal
 from kinergy.predict import DriveState, drive_state
 from kinergy.trajectory.motion import Motion
 
-__all__ = ["MISMATCHES", "Mismatch", "TwinSettings", "realistic_truth", "simulate"]
+__all__ = ["Mismatch", "TwinSettings", "realistic_truth", "simulate"]
 
 
 class Mismatch(enum.StrEnum):
@@ -64,10 +64,6 @@ class Mismatch(enum.StrEnum):
 
     NONE = "none"
     REALISTIC = "realistic"
-
-
-#: what ``--mismatch`` takes, as text
-MISMATCHES = tuple(m.value for m in Mismatch)
 
 
 @dataclass(frozen=True)

@@ -238,7 +238,7 @@ def test_d_optimality_and_bad_options(ur5e: kinergy.Robot) -> None:
         ({"harmonics": 1}, "harmonics must be >= 2"),
         ({"harmonics": 0}, "harmonics must be >= 2"),
         ({"period": 0.0}, "period: must be a finite number > 0"),
-        ({"criterion": "e-opt"}, "unknown criterion"),
+        ({"criterion": "e-opt"}, "criterion: must be one of cond, dopt, got 'e-opt'"),
         ({"samples": 5}, "samples must be"),
         ({"limits": excitation_limits(kinergy.load_robot("panda"))}, "limits for 7 joints"),
     ):

@@ -18,6 +18,7 @@ import click
 from kinergy import api
 from kinergy.cli.common import (
     as_usage,
+    choice_of,
     json_result,
     output_file_option,
     progress,
@@ -25,7 +26,7 @@ from kinergy.cli.common import (
     seed_option,
     writes,
 )
-from kinergy.experiments.excitation_regression import CRITERIA
+from kinergy.experiments.excitation_regression import Criterion
 
 __all__ = ["excite", "excite_text"]
 
@@ -83,8 +84,8 @@ def excite_text(run: api.ExciteRun) -> str:
 )
 @click.option(
     "--criterion",
-    type=click.Choice(CRITERIA),
-    default="cond",
+    type=choice_of(Criterion),
+    default=Criterion.COND.value,
     show_default=True,
     help="Minimise the condition number or -log det (D-optimality) of the scaled regressor.",
 )
@@ -165,7 +166,7 @@ def excite(
     harmonics: int,
     period: float,
     periods: int,
-    criterion: str,
+    criterion: Criterion,
     seed: int,
     starts: int,
     maxiter: int,

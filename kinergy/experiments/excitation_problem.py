@@ -52,7 +52,7 @@ from kinergy.experiments.excitation_limits import (
     fit_into_limits,
 )
 from kinergy.experiments.excitation_regression import (
-    CRITERIA,
+    Criterion,
     ExcitationRegression,
     criterion,
     excitation_regression,
@@ -84,7 +84,7 @@ class ExcitationProblem:
     series : FourierParametrisation
         Harmonics ``L``, period ``T`` (s) and start pose.
     limits : ExcitationLimits
-    criterion : {"cond", "dopt"}
+    criterion : Criterion
     regression : ExcitationRegression
         The columns of the regression matrix ``W``.
     grid : SeriesGrid
@@ -100,7 +100,7 @@ class ExcitationProblem:
     robot: Robot
     series: FourierParametrisation
     limits: ExcitationLimits
-    criterion: str
+    criterion: Criterion
     regression: ExcitationRegression = field(repr=False)
     grid: SeriesGrid = field(repr=False)
     constraint_grid: SeriesGrid = field(repr=False)
@@ -161,7 +161,7 @@ class ExcitationProblem:
             zz = self.series.unknowns(z)
             if zz.tobytes() in self._last:  # the optimiser has just evaluated it
                 return self._last[zz.tobytes()]
-            return criterion(self._w_flat(zz), "cond")[2]
+            return criterion(self._w_flat(zz), Criterion.COND)[2]
         return scaled_condition(self._w_flat(z))[0]
 
     def d_criterion(self, z: ArrayLike) -> float:
@@ -207,8 +207,8 @@ class ExcitationProblem:
         return self.fit_into_limits(1e6 * zz, safety=0.999)  # from far outside: limits set the size
 
 
-def _check_options(harmonics: int, period: float, dt: float, criterion: str, samples: int) -> None:
-    """The scalar options: integers, positive times, a known criterion, enough grid points."""
+def _check_options(harmonics: int, period: float, dt: float, samples: int) -> None:
+    """The scalar options: integers, positive times, enough grid points."""
     if isinstance(harmonics, bool) or not isinstance(harmonics, int | np.integer):
         raise KinergyError(f"harmonics must be an integer, got {harmonics!r}")
     if harmonics < 2:
@@ -219,8 +219,6 @@ def _check_options(harmonics: int, period: float, dt: float, criterion: str, sam
     period = checks.number(period, "period", gt=0.0)
     if not (np.isfinite(dt) and 0 < dt < period):
         raise KinergyError(f"dt must be in (0, period), got {dt}")
-    if criterion not in CRITERIA:
-        raise KinergyError(f"unknown criterion {criterion!r} (known: {', '.join(CRITERIA)})")
     if isinstance(samples, bool) or not isinstance(samples, int | np.integer):
         raise KinergyError(f"samples must be an integer, got {samples!r}")
     if samples < 4 * harmonics:
@@ -246,7 +244,7 @@ def excitation_problem(
     limits: ExcitationLimits | None = None,
     harmonics: int = 5,
     period: float = 10.0,
-    criterion: str = "cond",
+    criterion: Criterion | str = Criterion.COND,
     include_drives: bool = True,
     samples: int = 200,
     dt: float = CONTROLLER_DT,
@@ -265,7 +263,7 @@ def excitation_problem(
         ``L`` of nursing eq 22, >= 2.
     period : float
         ``T = 2 pi / w_f``, s.
-    criterion : {"cond", "dopt"}
+    criterion : Criterion or its value
         Condition number or D-optimality of the column-scaled regression matrix.
     include_drives : bool
         Add the rotor-inertia and friction columns to the regression matrix.
@@ -279,7 +277,8 @@ def excitation_problem(
     KinergyError
         Bad options, limits of another robot.
     """
-    _check_options(harmonics, period, dt, criterion, samples)
+    _check_options(harmonics, period, dt, samples)
+    kind = checks.choice(criterion, Criterion, "criterion")
     limits = excitation_limits(robot) if limits is None else limits
     if limits.start.shape != (robot.n,):
         raise KinergyError(f"limits for {limits.start.size} joints, {robot.name} has {robot.n}")
@@ -295,7 +294,7 @@ def excitation_problem(
         robot=robot,
         series=series,
         limits=limits,
-        criterion=criterion,
+        criterion=kind,
         regression=regression,
         grid=grid,
         constraint_grid=constraint_grid,

@@ -32,6 +32,7 @@ nothing of size samples x n x 10 n x 3 n is built).
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -52,7 +53,7 @@ from kinergy.model.robot import Robot
 
 __all__ = [
     "COULOMB_SMOOTHING",
-    "CRITERIA",
+    "Criterion",
     "ExcitationRegression",
     "criterion",
     "excitation_regression",
@@ -60,8 +61,14 @@ __all__ = [
 ]
 
 
-#: optimisation criteria: condition number, D-optimality
-CRITERIA = ("cond", "dopt")
+class Criterion(enum.StrEnum):
+    """What the excitation design minimises (module docstring): the condition number of the
+    scaled regressor, or D-optimality."""
+
+    COND = "cond"
+    DOPT = "dopt"
+
+
 #: joint-side speed (rad/s) of the tanh that stands in for the Coulomb column's sign
 COULOMB_SMOOTHING = 0.05
 #: a drive column whose part independent of the link base columns is below this is dependent
@@ -155,7 +162,7 @@ class ExcitationRegression:
         return self.matrix(q, qd, qdd).reshape(q.size, -1)
 
     def criterion_gradient(
-        self, q: Array, qd: Array, qdd: Array, kind: str
+        self, q: Array, qd: Array, qdd: Array, kind: Criterion
     ) -> tuple[float, Array, float]:
         """The criterion of ``W`` on the states (N, n), its gradient with respect to them
         (3, N, n: ``q``, ``qd``, ``qdd``) and the condition number.
@@ -216,7 +223,7 @@ def excitation_regression(robot: Robot, *, include_drives: bool = True) -> Excit
     return ExcitationRegression(robot, base, drives, smoothing)
 
 
-def criterion(w: Array, kind: str) -> tuple[float, Array, float]:
+def criterion(w: Array, kind: Criterion) -> tuple[float, Array, float]:
     """Criterion of the column-scaled ``w`` (rows, m), its gradient with respect to ``w``, and
     the condition number.
 
@@ -231,7 +238,7 @@ def criterion(w: Array, kind: str) -> tuple[float, Array, float]:
     # milliseconds for their worker threads in every call of the optimisation loop
     lam, vec = scipy.linalg.eigh(np.einsum("ij,ik->jk", ws, ws))
     lam = np.maximum(lam, 1e-300 * max(float(lam[-1]), 1e-300))
-    if kind == "cond":
+    if kind == Criterion.COND:
         value = 0.5 * float(np.log(lam[-1]) - np.log(lam[0]))
         hi, lo = vec[:, -1], vec[:, 0]
         phi = np.outer(ws @ hi, hi) / lam[-1] - np.outer(ws @ lo, lo) / lam[0]

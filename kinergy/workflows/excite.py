@@ -32,7 +32,7 @@ from kinergy.experiments.excitation_design import (
 )
 from kinergy.experiments.excitation_limits import DEFAULT_RANGE, excitation_limits
 from kinergy.experiments.excitation_problem import ExcitationProblem, excitation_problem
-from kinergy.experiments.excitation_regression import CRITERIA
+from kinergy.experiments.excitation_regression import Criterion
 from kinergy.io.rtde import write_log
 from kinergy.io.urscript import servoj_program, write_script
 from kinergy.model.robot import Robot
@@ -105,7 +105,7 @@ class ExciteOptions:
         ``T``, s (0.01 to 600).
     periods : int
         Periods written to the motion file (1 to 100).
-    criterion : {"cond", "dopt"}
+    criterion : Criterion
     seed, starts, maxiter : int
         Seed of the random starts, their number, SLSQP iterations per start.
     samples : int
@@ -131,7 +131,7 @@ class ExciteOptions:
     harmonics: int = 5
     period: float = 10.0
     periods: int = 2
-    criterion: str = "cond"
+    criterion: Criterion = Criterion.COND
     seed: int = 0
     starts: int = 4
     maxiter: int = 100
@@ -158,9 +158,7 @@ class ExciteOptions:
         if self.floor is not None:
             floor = number(self.floor, "--floor", ge=-MAX_FLOOR, le=MAX_FLOOR)
             object.__setattr__(self, "floor", floor)
-        if self.criterion not in CRITERIA:
-            known = ", ".join(CRITERIA)
-            raise KinergyError(f"--criterion: must be one of {known}, got {self.criterion!r}")
+        object.__setattr__(self, "criterion", choice(self.criterion, Criterion, "--criterion"))
         object.__setattr__(
             self, "floor_frames", choice(self.floor_frames, FloorFrames, "floor_frames")
         )
