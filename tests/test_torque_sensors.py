@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -158,7 +159,8 @@ def test_link_side_model_is_fitted_without_rotor_terms(
     )
     result = identify_full(start, without_currents(torque_logs), target="torque")
     for j, kept in zip(result.joints, start.joints, strict=True):
-        assert j.rotor_inertia == kept.drive.rotor_inertia and j.flags["rotor_inertia"] == "kept"
+        assert j.rotor_inertia == pytest.approx(kept.drive.rotor_inertia, rel=1e-12)
+        assert j.flags["rotor_inertia"] == "kept"
         assert j.rotor_inertia_std is None and not j.rotor_inertia_merged
     assert not any(p.group == "rotor" and p.flag == "identified" for p in result.fit.parameters)
     assert not result.fit.merged  # kept, not "merged into" the links
@@ -186,29 +188,42 @@ def _write(path: Path, truth: kinergy.Robot, seed: int, scale: float = 1.0) -> P
 
 
 def test_negative_torque_fit_is_refused_then_accepted(
-    tmp_path: Path, truth: kinergy.Robot, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path,
+    truth: kinergy.Robot,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
+    # least squares with an offset column cannot fit a joint worse than its mean: what does is
+    # the physically consistent refit or a value kept from the model (the issue's joint 7 at
+    # R^2 -0.90); the identification is made to report wrist 3's measured-torque R^2 as -0.9
+    import kinergy.workflows.identify as workflow
+
+    real = workflow.identify_chunks
+
+    def worse(*args: Any, **kwargs: Any) -> Any:
+        result = real(*args, **kwargs)
+        fit = result.fit
+        assert fit.joint_torque is not None
+        bad = (*fit.joint_torque[:5], dataclasses.replace(fit.joint_torque[5], r2=-0.9))
+        return dataclasses.replace(result, fit=dataclasses.replace(fit, joint_torque=bad))
+
+    monkeypatch.setattr(workflow, "identify_chunks", worse)
     log = _write(tmp_path / "run.csv", truth, 31)
-    # joint 6's sensor logged with the wrong sign: no model explains it (R^2 < 0 on its own log)
-    data = np.loadtxt(log, skiprows=1)
-    header = log.read_text().splitlines()[0]
-    column = header.split().index("actual_joint_torque_5")
-    data[:, column] *= -1.0
-    np.savetxt(log, data, header=header, comments="", fmt="%.9g")
     out = tmp_path / "model.toml"
     robot = tmp_path / "ur5e-vc.toml"
     save_robot(with_sensors(truth, "link", (0.0,) * 6), robot)
     args = ["-q", "identify", str(log), "--robot", str(robot), "--method", "full"]
-    args += ["--target", "torque", "--out", str(out), "--accept", "robot"]  # the sign check
+    args += ["--target", "torque", "--out", str(out)]
     capsys.readouterr()
     assert main(args) == 1 and not out.exists()
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1, lines
-    assert "wrist_3 measured joint torque R^2 -" in lines[0] and "--accept fit" in lines[0]
-    assert main([*args, "--accept", "fit", "--json"]) == 0
+    assert "(wrist_3 measured joint torque R^2 -0.90)" in lines[0], lines[0]
+    assert "no model written (if the logs are right, --accept fit)" in lines[0]
+    assert main([*args, "--accept", "fit", "--json"]) == 0 and out.exists()
     report = json.loads(capsys.readouterr().out)
-    assert report["fit"]["joint_torque"][5]["r2"] < 0
-    assert any(a.startswith("fit: ") for a in report["accepted"]) and out.exists()
+    assert report["fit"]["joint_torque"][5]["r2"] == -0.9
+    assert any("wrist_3 measured joint torque R^2 -0.90" in a for a in report["accepted"])
 
 
 def test_validate_plots_draw_measured_torque_with_residuals(
