@@ -6,8 +6,8 @@ import dataclasses
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_folder
 from kinergy.identification.validation import (
@@ -131,7 +131,7 @@ PLOTTED = (
 
 
 def _plots(robot: Robot, logs: Sequence[LogValidation], out: Path) -> None:
-    errors: dict[str, dict[str, Any]] = {key: {} for key, _, _ in PLOTTED}
+    errors: dict[str, dict[str, Array]] = {key: {} for key, _, _ in PLOTTED}
     for log, stem in zip(logs, _stems([log.log for log in logs]), strict=True):
         for key, unit, label in PLOTTED:
             series = log.series.get(key)
