@@ -211,7 +211,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     type=choice_of(Target),
     default=Target.AUTO.value,
     show_default=True,
-    help="Full method: regress against target_moment, currents or measured torques.",
+    help="Full method: regress against target_moment, currents or measured torques (as the "
+    "robot file's torque_sensor says they are measured, with each sensor's offset).",
 )
 @click.option(
     "--solver",
