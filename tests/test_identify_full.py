@@ -29,7 +29,7 @@ from kinergy.identification.physical import (
     pseudo_inertia,
     standard_from_base,
 )
-from kinergy.identification.result import IdentificationResult, validation_metrics
+from kinergy.identification.result import KEPT, IdentificationResult, validation_metrics
 from kinergy.io.log import Log
 from kinergy.logs.filtering import lowpass
 from kinergy.logs.prepare import IdentData, prepare
@@ -586,7 +586,7 @@ def test_panda_predicts_held_out_measured_torques() -> None:
     # link-side torque sensors see no rotor inertia: kept from the model, not fitted
     for j, model in zip(result.joints, robot.joints, strict=True):
         assert j.rotor_inertia == pytest.approx(model.drive.rotor_inertia, rel=1e-12)
-        assert j.flags["rotor_inertia"] == "kept"
+        assert j.flags["rotor_inertia"] == KEPT
     # the offsets of joints 1-4 and 6 are determined (-0.18 -0.15 0.05 -0.22 0.08 N m), those of
     # joints 5 and 7 are not (kept at 0)
     offsets = [j.torque_sensor_offset for j in result.joints]

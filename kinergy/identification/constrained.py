@@ -178,6 +178,8 @@ def _active(
             )
     extra = x[cols.n_link :]
     for k, (value, low, high) in enumerate(zip(extra, lo, hi, strict=True)):
+        if cols.n_link + k in cols.fixed:  # not an unknown: the model's value, not a bound's
+            continue
         size = max(abs(float(cols.prior[cols.n_link + k])), 1e-9)
         if np.isfinite(low) and value <= low + 1e-6 * size:
             phrases.append(f"{cols.names[cols.n_link + k]} at its lower bound {low:.4g}")
