@@ -31,12 +31,12 @@ from kinergy.drives.electrics import (
     torque_constants,
     winding_resistances,
 )
-from kinergy.drives.transmission import reflected_inertia, transmission_matrix
+from kinergy.drives.transmission import reflected_inertia, rotor_inertia, transmission_matrix
 from kinergy.dynamics.chain import check_state
 from kinergy.dynamics.rnea import gravity_torque, rnea
 from kinergy.model.robot import Payload, Robot
 
-__all__ = ["DriveState", "drive_by_payload", "drive_state", "payload_robots"]
+__all__ = ["DriveState", "drive_by_payload", "drive_state", "payload_robots", "sensor_torque"]
 
 
 @dataclass(frozen=True)
@@ -138,6 +138,31 @@ def drive_state(
         voltage=voltage,
         power=power,
     )
+
+
+def sensor_torque(robot: Robot, state: DriveState) -> Array:
+    """What each joint's torque sensor reads (``actual_joint_torque``), N m, shape like
+    ``state.tau_m``.
+
+    With ``N`` the transmission, ``J = J_m + J_r`` the rotor inertias (motor side), ``F`` the
+    drives' friction (motor side, ``state.tau_friction``) and ``tau_link`` the links' rigid-body
+    torques (RNEA)::
+
+        motor side:  tau_s = N^T tau_m + offset
+                           = tau_link + N^T diag(J) N qdd + N^T F + offset
+        link side:   tau_s = tau_link + N^T F + offset
+
+    A link-side sensor sits between the gear's output and the link: the rotor's inertia torque
+    (UR5e eq 2's second term) is spent before the gear and never reaches it. The friction it
+    sees is the joint's model, which a model identified from link-side torques holds as the
+    friction between the sensor and the link (:class:`kinergy.model.robot.TorqueSensor`). The
+    offset is the sensor's (no energy includes it).
+    """
+    n_mat = transmission_matrix(robot)
+    rotor = (rotor_inertia(robot) * state.dwm) @ n_mat
+    link = np.array([not j.torque_sensor.sees_rotor for j in robot.joints])
+    offset = np.array([j.torque_sensor.offset for j in robot.joints])
+    return np.asarray(state.tau_m @ n_mat - link * rotor + offset, dtype=float)
 
 
 def drive_by_payload(

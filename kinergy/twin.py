@@ -21,7 +21,11 @@ motion is sampled (the controller's 500 Hz), the RTDE signals the UR5e doc works
 - ``joint_temperatures``: each joint warmed by its losses and its share of the arm's standby
   power (:mod:`kinergy.drives.thermal`), when the true robot has thermal models;
   temperature-dependent friction follows them;
-- ``robot_mode`` 7 (running) and ``runtime_state`` 2 (playing), as a program run logs them.
+- ``robot_mode`` 7 (running) and ``runtime_state`` 2 (playing), as a program run logs them;
+- ``actual_joint_torque`` (with :attr:`TwinSettings.torque_sensors`): what each joint's torque
+  sensor reads on the real motion, :func:`kinergy.predict.sensor_torque` (link side: the links'
+  torques and friction, no rotor inertia; the sensor's offset from the true robot's
+  ``torque_sensor``), plus noise.
 
 The twin is not the model: :func:`realistic_truth` makes a true robot that differs from a model
 the way a real arm differs from its data sheet (``kinergy simulate --mismatch realistic``, the
@@ -52,7 +56,7 @@ from kinergy.friction.model import SMOOTHING
 from kinergy.friction.power_law import speed_power
 from kinergy.io.log import Log
 from kinergy.model.robot import Friction, Joint, Robot, Source, Thermal
-from kinergy.predict import DriveState, drive_state
+from kinergy.predict import DriveState, drive_state, sensor_torque
 from kinergy.trajectory.motion import Motion
 
 __all__ = ["Mismatch", "TwinSettings", "realistic_truth", "simulate"]
@@ -92,6 +96,10 @@ class TwinSettings:
         Air temperature, deg C; the joints start at it unless ``initial_temperature`` is given.
     initial_temperature : float or None
         The joints' temperature at the start, deg C (a warm robot).
+    torque_sensors : bool
+        Log ``actual_joint_torque``, as an arm with joint torque sensors does.
+    torque_noise : float
+        Standard deviation of the measured joint torques' noise, N m.
     """
 
     lag: float = 0.004
@@ -104,9 +112,12 @@ class TwinSettings:
     ripple: float = 0.0
     ambient: float = 25.0
     initial_temperature: float | None = None
+    torque_sensors: bool = False
+    torque_noise: float = 0.0
 
     def __post_init__(self) -> None:
         for name in (
+            "torque_noise",
             "lag",
             "speed_noise",
             "position_noise",
@@ -242,6 +253,9 @@ def simulate(
     }
     if temperature is not None:
         signals["joint_temperatures"] = temperature
+    if settings.torque_sensors:  # drawn last: the other signals stay those the seed gave
+        noise = settings.torque_noise * rng.standard_normal((big_n, n))
+        signals["actual_joint_torque"] = sensor_torque(robot, actual) + noise
     return Log(name, np.asarray(target.t, dtype=float), signals)
 
 

@@ -154,6 +154,11 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     ]
     samples = result.fit.samples
     headers = ["joint", "J_m+J_r [kg m^2]", "J_m [kg m^2]", "k_t [N m/A]"]
+    offsets = [getattr(j, "torque_sensor_offset", None) for j in result.joints]
+    if any(o is not None for o in offsets):  # against measured torques: the sensors' offsets
+        headers.append("sensor offset [N m]")
+        for row, j, o in zip(rows, result.joints, offsets, strict=True):
+            row.append("-" if o is None else _with_std(j, "torque_sensor_offset", o, ".4f"))
     lines = [
         f"{result.robot.name}: {result.method} identification from {logs} log(s), {samples} samples",
         table(headers, rows),
@@ -206,7 +211,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     type=choice_of(Target),
     default=Target.AUTO.value,
     show_default=True,
-    help="Full method: regress against target_moment, currents or measured torques.",
+    help="Full method: regress against target_moment, currents or measured torques (as the "
+    "robot file's torque_sensor says they are measured, with each sensor's offset).",
 )
 @click.option(
     "--solver",

@@ -7,7 +7,14 @@ columns, in this order:
 - reflected rotor inertias: motor ``m``'s column on joint ``j`` is ``N[m, j] (N qdd)_m``
   (UR5e eq 2, ``i^2 qdd`` for a UR joint);
 - friction: ``N^T F(wm)``, ``F`` each motor's friction columns
-  (:meth:`kinergy.friction.model.FrictionModel.friction_columns`) at the motor speeds ``wm = N qd``.
+  (:meth:`kinergy.friction.model.FrictionModel.friction_columns`) at the motor speeds ``wm = N qd``;
+- against measured joint torques, each joint's torque sensor offset (N m): a column that is 1 on
+  its own joint's rows and 0 elsewhere.
+
+A link-side torque sensor (:class:`kinergy.model.robot.TorqueSensor`) does not see the rotors'
+inertia torque (:func:`kinergy.predict.sensor_torque`): against measured torques, the rotor block
+is zero on the rows of link-side joints, and a rotor column zero on every row is not an unknown
+(:attr:`Columns.fixed`: the model's value is kept, and not reported as merged).
 
 Against currents alone a common scale of every parameter and of the torque constants cannot be
 told apart; :func:`scale_row` measures it against the model's published masses.
@@ -32,6 +39,7 @@ from kinergy.dynamics.regressor import BaseParameters, inertial_parameters, regr
 from kinergy.friction.model import FrictionModel
 from kinergy.friction.none import MODEL as NO_FRICTION
 from kinergy.friction.power_flow import MODEL as POWER_FLOW
+from kinergy.friction.viscous_coulomb import MODEL as VISCOUS_COULOMB
 from kinergy.identification.chunks import History, LogChunks
 from kinergy.identification.drive_steps import _Signals, rotor_columns, signal_history
 from kinergy.identification.options import Target
@@ -49,6 +57,7 @@ __all__ = [
     "joint_frictions",
     "power_flow_load",
     "scale_row",
+    "sees_rotor",
 ]
 
 
@@ -75,6 +84,13 @@ class Columns:
         Number of link base columns ``b``; the rotor columns follow, one per motor.
     fric_at : ndarray of int, shape (n + 1,)
         Motor ``m``'s friction columns are ``fric_at[m]:fric_at[m + 1]``.
+    offset_at : int or None
+        Against measured torques: joint ``j``'s sensor offset is column ``offset_at + j``
+        (group ``"offset"``, N m); else None.
+    fixed : ndarray of int
+        Columns that are not unknowns, kept at the model's values: rotor inertias the target
+        does not see (behind link-side torque sensors), and sensor offsets the logs do not
+        determine (:mod:`kinergy.identification.offsets`).
     """
 
     names: list[str]
@@ -82,6 +98,15 @@ class Columns:
     prior: Array
     n_link: int
     fric_at: NDArray[np.intp]
+    offset_at: int | None = None
+    fixed: NDArray[np.intp] = dataclasses.field(default_factory=lambda: np.zeros(0, dtype=np.intp))
+
+    def joint_of(self, k: int) -> int:
+        """The joint (motor) of rotor or offset column ``k``, 0-based."""
+        if self.group[k] == "offset":
+            assert self.offset_at is not None
+            return k - self.offset_at
+        return k - self.n_link
 
     def friction(self, x: Array, m: int) -> Array:
         """Motor ``m``'s friction levels in the unknowns ``x`` (p,)."""
@@ -94,10 +119,15 @@ def joint_frictions(
     """Each motor's friction model in the regression and its starting parameters.
 
     ``friction`` replaces every joint's model (shape parameters from defaults unless the model is
-    the joint's own); against the commanded motion (``target_moment``, no friction) the models are
+    the joint's own); a joint without friction (``none``, e.g. a URDF without ``<dynamics>``)
+    is fitted with Coulomb + viscous friction (framework Table 1): a real motion's torque has
+    friction; against the commanded motion (``target_moment``, no friction) the models are
     ``none`` and the parameters the model's, kept.
     """
-    models = [friction or j.drive.friction.model for j in robot.joints]
+    models = [
+        friction or (VISCOUS_COULOMB if model is NO_FRICTION else model)
+        for model in (j.drive.friction.model for j in robot.joints)
+    ]
     params = [
         model.start(j.drive.friction.model, j.drive.friction.params)
         for model, j in zip(models, robot.joints, strict=True)
@@ -107,32 +137,56 @@ def joint_frictions(
     return models, params
 
 
+def sees_rotor(robot: Robot, target: Target) -> NDArray[np.bool_]:
+    """Per joint, whether ``target`` carries the rotors' inertia torque (n,): measured torques
+    only where the joint's sensor is on the motor side (:func:`kinergy.predict.sensor_torque`),
+    the reference torques and the currents always."""
+    if target != Target.TORQUE:
+        return np.ones(robot.n, dtype=bool)
+    return np.array([j.torque_sensor.sees_rotor for j in robot.joints])
+
+
 def columns(
     robot: Robot,
     base: BaseParameters,
     models: list[FrictionModel],
     params: list[dict[str, float]],
+    target: Target = Target.TORQUE,
 ) -> Columns:
-    """Name, group and prior of every column: base parameters, rotor inertias, friction levels."""
+    """Name, group and prior of every column: base parameters, rotor inertias, friction levels
+    and, against measured torques (``target``), the sensors' offsets."""
     n = robot.n
     widths = [len(m.linear) for m in models]
     short = [base.names[k] for k in base.independent]
     joint = [f"joint {m + 1} ({j.name})" for m, j in enumerate(robot.joints)]
+    offsets = target == Target.TORQUE
     prior = np.concatenate(
         [
             base.project(inertial_parameters(robot)),
             [j.drive.rotor_inertia for j in robot.joints],
             *[models[m].values_of(params[m]) for m in range(n)],
+            [j.torque_sensor.offset for j in robot.joints] if offsets else [],
         ]
     )
+    fric_at = base.size + n + np.cumsum([0, *widths])
+    n_mat = transmission_matrix(robot)
+    # motor m's rotor reaches joint j through N[m, j]: unseen when every such joint's sensor is
+    # on the link side
+    unseen = np.flatnonzero(~np.any((n_mat != 0.0) & sees_rotor(robot, target)[None, :], axis=1))
     return Columns(
         names=[f"base parameter {s}" for s in short]
         + [f"rotor inertia of {joint[m]}" for m in range(n)]
-        + [f"friction {p} of {joint[m]}" for m in range(n) for p in models[m].linear],
-        group=["link"] * base.size + ["rotor"] * n + ["friction"] * sum(widths),
+        + [f"friction {p} of {joint[m]}" for m in range(n) for p in models[m].linear]
+        + ([f"torque sensor offset of {joint[j]}" for j in range(n)] if offsets else []),
+        group=["link"] * base.size
+        + ["rotor"] * n
+        + ["friction"] * sum(widths)
+        + ["offset"] * (n if offsets else 0),
         prior=prior,
         n_link=base.size,
-        fric_at=base.size + n + np.cumsum([0, *widths]),
+        fric_at=fric_at,
+        offset_at=int(fric_at[-1]) if offsets else None,
+        fixed=(base.size + unseen).astype(np.intp),
     )
 
 
@@ -282,6 +336,11 @@ class Regression:
         assert y3 is not None
         return np.asarray(y3, dtype=float)
 
+    @property
+    def sees_rotor(self) -> NDArray[np.bool_]:
+        """Per joint, whether the target carries the rotors' inertia torque (:func:`sees_rotor`)."""
+        return sees_rotor(self.robot, self.target)
+
     def histories(self) -> list[History[_Signals]]:
         """Per motor, what its friction held through standstill needs of earlier chunks."""
         return [signal_history(float(p.get("standstill", 0.0))) for p in self.params]
@@ -313,6 +372,9 @@ class Regression:
                 a = np.empty((len(part), n, cols.prior.size))
                 a[:, :, : cols.n_link] = self.base.regressor(regressor(self.robot, q, qd, qdd))
                 a[:, :, cols.n_link : n_fixed] = rotor_columns(n_mat, dwm)
+                a[:, ~self.sees_rotor, cols.n_link : n_fixed] = 0.0  # link-side sensors
+                if cols.offset_at is not None:
+                    a[:, :, cols.offset_at :] = np.eye(n)[None, :, :]
                 if not self.needs_load:
                     previous = np.zeros_like(q)
                 elif loads is None:

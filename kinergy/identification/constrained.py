@@ -178,6 +178,8 @@ def _active(
             )
     extra = x[cols.n_link :]
     for k, (value, low, high) in enumerate(zip(extra, lo, hi, strict=True)):
+        if cols.n_link + k in cols.fixed:  # not an unknown: the model's value, not a bound's
+            continue
         size = max(abs(float(cols.prior[cols.n_link + k])), 1e-9)
         if np.isfinite(low) and value <= low + 1e-6 * size:
             phrases.append(f"{cols.names[cols.n_link + k]} at its lower bound {low:.4g}")
@@ -313,6 +315,9 @@ def physical_fit(
     constraints, _ = _lmi(pi, payload, t)
     s_extra = red.scale[n_link:]
     constraints += _within(z_extra, lo * s_extra, hi * s_extra)
+    fixed = cols.fixed - n_link  # not unknowns: kept at the model's values
+    if fixed.size:
+        constraints.append(z_extra[fixed] == z_prior[n_link:][fixed])
     solver = _solve(cp.Problem(cp.Minimize(objective), constraints))
     if solver is None or v.value is None or z_extra.value is None:
         return None
@@ -322,6 +327,7 @@ def physical_fit(
     x = np.empty(p)
     x[:n_link] = p_mat @ pi_hat
     x[n_link:] = np.clip(np.asarray(z_extra.value) / s_extra, lo, hi)
+    x[cols.fixed] = cols.prior[cols.fixed]  # exactly, not to the solver's tolerance
     chi2 = float(np.sum((metric @ (x * red.scale - z_hat)) ** 2))
     phrases, at_bound = _active(x, cols, lo, hi, pi_hat, payload, names)
     return ConstrainedFit(pi_hat, x, chi2, tuple(phrases), tuple(at_bound), solver)

@@ -76,6 +76,7 @@ from kinergy import checks
 from kinergy.dynamics.regressor import BaseParameters, base_parameters, inertial_parameters
 from kinergy.errors import Code, KinergyError
 from kinergy.friction.model import FrictionModel
+from kinergy.friction.none import MODEL as NO_FRICTION
 from kinergy.identification.chunks import LogChunks, Summary, one_blas_thread
 from kinergy.identification.columns import (
     LOAD_DEPENDENT,
@@ -86,6 +87,7 @@ from kinergy.identification.columns import (
 )
 from kinergy.identification.drive_steps import FrictionChoice
 from kinergy.identification.metrics import JointMetrics, MetricSums
+from kinergy.identification.offsets import fixed_notes, weak_offsets, with_fixed
 from kinergy.identification.options import (
     CurrentOptions,
     FrictionOption,
@@ -116,6 +118,7 @@ from kinergy.identification.result import (
     fit_fields,
 )
 from kinergy.identification.sequential import DrivesFromCurrents, drives_from_currents
+from kinergy.identification.smoothing import Smoothing, search_smoothing
 from kinergy.identification.writeback import WriteBack, write_back
 from kinergy.jsonable import OPTIONAL
 from kinergy.logs.prepare import IdentData
@@ -184,6 +187,8 @@ class FullJoint(DriveEstimate):
     rotor_inertia_std: float | None = None
     rotor_inertia_merged: bool = False
     friction_std: dict[str, float | None] = field(default_factory=dict)
+    torque_sensor_offset: float | None = field(default=None, metadata=OPTIONAL)
+    torque_sensor_offset_std: float | None = field(default=None, metadata=OPTIONAL)
 
 
 @dataclass(frozen=True)
@@ -335,7 +340,7 @@ def _regression(
     logs can identify its columns (:func:`_diagnose`)."""
     commanded = target == Target.MOMENT
     frictions = joint_frictions(robot, friction, commanded)
-    cols = columns(robot, base, *frictions)
+    cols = columns(robot, base, *frictions, target)
     _diagnose(robot, logs.summary(), commanded, cols.prior.size)
     return Regression(robot, base, cols, *frictions, target, logs.every("temperature"))
 
@@ -475,14 +480,22 @@ def _joints(
             std = {"rotor_inertia": std["rotor_inertia"], **drives.std[m]}
         fields = drive_fields(joint, rotor_inertia=float(written.x[col]))
         names = joint.drive.friction.model.linear
+        offset = offset_std = None
+        if cols.offset_at is not None:
+            at = cols.offset_at + m
+            offset, offset_std = float(written.x[at]), _optional(solved.std[at])
+            flags = {**flags, "torque_sensor_offset": written.flags[at]}
+            std = {**std, "torque_sensor_offset": offset_std}
         out.append(
             FullJoint(
                 **fields,
                 rotor_inertia_std=std["rotor_inertia"],
-                rotor_inertia_merged=bool(col in solved.dropped),
+                rotor_inertia_merged=bool(col in solved.dropped and col not in cols.fixed),
                 flags=flags,
                 std=std,
                 friction_std={name: std.get(name) for name in names},
+                torque_sensor_offset=offset,
+                torque_sensor_offset_std=offset_std,
             )
         )
     return tuple(out)
@@ -516,6 +529,7 @@ class _Steps:
     drives: DrivesFromCurrents | None
     robot: Robot
     choice: tuple[FrictionChoice | None, ...] | None
+    smoothing: Smoothing
 
 
 def _fit(logs: LogChunks, steps: _Steps, *, solver: Solver, ridge: float) -> FullFit:
@@ -530,6 +544,18 @@ def _fit(logs: LogChunks, steps: _Steps, *, solver: Solver, ridge: float) -> Ful
     if steps.drives is not None:
         said.extend(steps.drives.said)
     said.extend(steps.merging.said)
+    bare = [
+        str(m + 1)
+        for m, (model, joint) in enumerate(zip(reg.models, reg.robot.joints, strict=True))
+        if joint.drive.friction.model is NO_FRICTION and model is not NO_FRICTION
+    ]
+    if bare:
+        said.note(
+            f"joint(s) {', '.join(bare)} had no friction in the model: fitted with "
+            f"{reg.models[int(bare[0]) - 1].name} friction"
+        )
+    said.notes += fixed_notes(cols)
+    said.notes += [n for n in (steps.smoothing.note(),) if n]
     said.extend(written.said)
     weighted = solved.weights is not None
     b = cols.n_link
@@ -694,8 +720,15 @@ def full(
         start, choice, current = first.robot, first.choice, CurrentOptions()
     base = base_parameters(start)
     reg = _regression(start, base, logs, target, current.family)
-    flow = fit_power_flow(reg, logs, base.expressions())
+    flow, smoothing = fit_power_flow(reg, logs, base.expressions()), Smoothing(None, ())
+    if target == Target.TORQUE:  # the friction's smoothing too: its shape is rarely measured
+        reg, flow, smoothing = search_smoothing(reg, logs, base.expressions())
     solved = solve(flow.ols, reg.cols.prior, options.solver, options.ridge)
+    weak = weak_offsets(reg, logs, flow, solved)
+    if weak.size:  # fitted again with the offsets the logs do not determine fixed
+        reg = with_fixed(reg, weak)
+        flow = fit_power_flow(reg, logs, base.expressions())
+        solved = solve(flow.ols, reg.cols.prior, options.solver, options.ridge)
     merging = merged_columns(flow.ols, reg.cols)
     written = write_back(start, base, solved, reg, target == Target.MOMENT, merging.rotor)
     evaluation = _evaluate(reg, logs, flow, solved, written)
@@ -707,7 +740,7 @@ def full(
     if with_currents and target == Target.CURRENT:  # the common scale from the published masses
         gravity = scale_row(robot, base, evaluation.q) @ base.project(inertial_parameters(out))
         out = rescaled(out, 1.0 / float(gravity))
-    steps = _Steps(reg, flow, solved, merging, written, evaluation, drives, out, choice)
+    steps = _Steps(reg, flow, solved, merging, written, evaluation, drives, out, choice, smoothing)
     fit = _fit(logs, steps, solver=options.solver, ridge=options.ridge)
     joints = _joints(out, written, solved, reg, drives)
     return IdentificationResult(out, "full", joints, fit)

@@ -48,7 +48,7 @@ from kinergy.identification.physical import inertia_vector, link_from_standard
 from kinergy.linalg import Reduced, scaled_solution
 from kinergy.logs.prepare import IdentData
 from kinergy.model.robot import Payload, Robot
-from kinergy.predict import drive_state
+from kinergy.predict import drive_state, sensor_torque
 
 __all__ = [
     "BLOCKS",
@@ -381,6 +381,9 @@ def _residuals(
             if data.torque is None:
                 raise KinergyError(f"{data.path}: no measured joint torques")
             measured = data.torque[skip:]
+            # what the sensors read: no rotor inertia on the link side, their offsets
+            with_friction = dataclasses.replace(state, tau_m=state.tau_load + loaded)
+            predicted = sensor_torque(bare, with_friction)
     y = regressor(bare, q, qd, qdd)
     return y[:, :, 10 * (n - 1) :].reshape(-1, 10), (measured - predicted).reshape(-1)
 

@@ -146,7 +146,7 @@ def fit_ols(
     red = _together(joints)
     if check_links:
         check_link_rank(red.r[:n_link, :n_link], expressions)
-    dropped = n_link + dependent_extras(red.r[n_link:n_cols, n_link:n_cols])
+    dropped = np.union1d(n_link + dependent_extras(red.r[n_link:n_cols, n_link:n_cols]), cols.fixed)
     kept = np.setdiff1d(np.arange(n_cols), dropped)
     ols = solve_reduced(red.r_a[:, kept], _fixed_target(red, dropped, cols.prior), red.rows)
     if ols.cond > MAX_CONDITION:
@@ -358,8 +358,10 @@ def _merge_note(k: int, cols: Columns, kept: Index, coef: Array | None) -> tuple
 
 def merged_columns(ols: OlsFit, cols: Columns) -> Merging:
     """Each dropped column of the OLS fit as a combination of the kept ones (least squares on the
-    reduced triangle, in the unknowns' own units)."""
-    red, kept, dropped, n_link = ols.reduced, ols.kept, ols.dropped, cols.n_link
+    reduced triangle, in the unknowns' own units); the columns the target does not see
+    (:attr:`Columns.fixed`) are not merged, only kept."""
+    red, kept, n_link = ols.reduced, ols.kept, cols.n_link
+    dropped = np.setdiff1d(ols.dropped, cols.fixed)
     if not dropped.size:
         return Merging((), Messages(), {})
     coef_s = np.linalg.lstsq(red.r_a[:, kept], red.r_a[:, dropped], rcond=None)[0]

@@ -21,7 +21,6 @@ from typing import Any, TypedDict
 
 from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
-from kinergy.drives.transmission import joint_torque
 from kinergy.identification.chunks import LogChunks, data_history
 from kinergy.identification.electrics import StandingDraw
 from kinergy.identification.metrics import JointMetrics, MetricSums
@@ -30,7 +29,7 @@ from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs
 from kinergy.messages import Messages
 from kinergy.model.robot import Friction, Joint, Robot
-from kinergy.predict import drive_state
+from kinergy.predict import drive_state, sensor_torque
 
 __all__ = [
     "AT_BOUND",
@@ -192,7 +191,7 @@ class Prediction:
 
     ``torque`` is the controller's reference torque (UR5e eq 7, against ``target_moment``),
     ``current`` the motor current (eq 17, against ``actual_current``), ``joint_torque`` the torque
-    at the joints with friction (against measured joint torques), ``supply`` (N,) what the arm
+    a torque sensor reads (:func:`~kinergy.predict.sensor_torque`, against measured joint torques), ``supply`` (N,) what the arm
     draws from its supply, W (the bus model with the standing draw, :mod:`kinergy.drives.bus`;
     against ``actual_robot_voltage x actual_robot_current``).
     """
@@ -218,7 +217,7 @@ def predict(robot: Robot, data: IdentData) -> Prediction:
     if data.current is not None or data.torque is not None or measures:
         state = drive_state(robot, data.q, data.qd, data.qdd, temperature=data.temperature)
         current = state.current if data.current is not None else None
-        joint = joint_torque(robot, state.tau_m) if data.torque is not None else None
+        joint = sensor_torque(robot, state) if data.torque is not None else None
         supply = supply_power(state.power, robot.standby_power).supply if measures else None
     return Prediction(torque, current, joint, supply)
 

@@ -258,8 +258,8 @@ def _flags(cols: Columns, problem: Solved, written: _Links) -> tuple[Flag, ...]:
 def _with_drive(
     m: int, joint: Joint, reg: Regression, x: Array, commanded: bool, said: Messages
 ) -> Joint:
-    """``joint`` with motor ``m``'s rotor inertia and friction (not ``commanded``) from the
-    unknowns ``x``."""
+    """``joint`` with motor ``m``'s rotor inertia, friction (not ``commanded``) and, against
+    measured torques, joint ``m``'s torque sensor offset from the unknowns ``x``."""
     cols = reg.cols
     drive = _with_rotor(m, joint, float(x[cols.n_link + m]), said)
     joint = dataclasses.replace(joint, drive=drive)
@@ -267,6 +267,9 @@ def _with_drive(
         friction = (reg.models[m], reg.params[m])
         drive = _with_friction(m, joint, friction, cols.friction(x, m), said)
         joint = dataclasses.replace(joint, drive=drive)
+    if cols.offset_at is not None:  # against measured torques: joint m's sensor offset
+        sensor = dataclasses.replace(joint.torque_sensor, offset=float(x[cols.offset_at + m]))
+        joint = dataclasses.replace(joint, torque_sensor=sensor)
     return joint
 
 

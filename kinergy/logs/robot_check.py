@@ -31,7 +31,13 @@ from kinergy.logs.verdicts import Check, Findings, first, joint_label
 from kinergy.messages import Message
 from kinergy.model.library import library_names, load_robot
 from kinergy.model.robot import Payload, Robot
-from kinergy.predict import DriveState, drive_by_payload, drive_state, payload_robots
+from kinergy.predict import (
+    DriveState,
+    drive_by_payload,
+    drive_state,
+    payload_robots,
+    sensor_torque,
+)
 
 __all__ = [
     "LOADS",
@@ -176,7 +182,9 @@ def _model_signal(
     every = np.ones(robot.n, dtype=bool)
     if name == "target_moment":
         return state.tau_sim, torque, moving, every
-    if name in ("actual_joint_torque", "actual_current_as_torque"):
+    if name == "actual_joint_torque":
+        return sensor_torque(robot, state), torque, moving, every
+    if name == "actual_current_as_torque":
         return joint_torque(robot, state.tau_m), torque, moving, every
     rigid = state.tau_load.std(axis=0) >= RIGID_SHARE * state.tau_friction.std(axis=0)
     return state.current, rated_current(robot), moving, rigid

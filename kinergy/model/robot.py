@@ -42,8 +42,10 @@ __all__ = [
     "Link",
     "Payload",
     "Robot",
+    "SensorSide",
     "Source",
     "Thermal",
+    "TorqueSensor",
     "inertia_matrix",
     "transmission_matrix",
 ]
@@ -110,6 +112,7 @@ MAGNITUDES = {
     "gravity": 100.0,  # m/s^2, about 10 g
     "standby_power": 1e6,  # W
     "bus_voltage": 1e4,  # V
+    "torque_sensor.offset": 1e4,  # N m
 }
 
 
@@ -362,6 +365,61 @@ class Drive:
         return self.motor_inertia + self.reducer_inertia
 
 
+class SensorSide(enum.StrEnum):
+    """Where a joint's torque sensor sits in its drive train (:class:`TorqueSensor`).
+
+    ``LINK``: between the gear's output and the link (the Panda, KUKA's LBR, Kinova's Gen3 and
+    most torque-controlled arms); ``MOTOR``: before the gear, so that it carries the rotor's and
+    the gear's inertia and friction too (or a joint torque the controller reckons from the motor
+    current).
+    """
+
+    LINK = "link"
+    MOTOR = "motor"
+
+
+@dataclass(frozen=True)
+class TorqueSensor:
+    """A joint's torque sensor: where it sits and what it reads at zero torque.
+
+    What it measures, joint side (N m), with ``tau_rb`` the links' rigid-body torques (RNEA),
+    ``N`` the transmission (``wm = N qd``), ``J = J_m + J_r`` the rotor inertias and ``F(wm)``
+    the drives' friction (motor side), as :func:`kinergy.predict.sensor_torque` computes it::
+
+        link side:   tau_s = tau_rb(q, qd, qdd) + N^T F(wm)                      + offset
+        motor side:  tau_s = tau_rb(q, qd, qdd) + N^T F(wm) + N^T diag(J) N qdd  + offset
+
+    A link-side sensor carries the link, and whatever rubs between the sensor and the link, but
+    not the rotor: the rotor's inertia torque ``J wm_dot`` is spent before the gear, on the
+    motor side of the sensor, so the sensor cannot see it (UR5e eq 2's second term is missing
+    from its reading). Of the drive's friction it sees only the part between the sensor and the
+    link (output bearings, seals); kinergy's joint holds one friction, so a model identified
+    from link-side sensors holds that part (the motor's and the gear's are invisible to the
+    sensor, and their energy is not in it: identify from currents for them).
+
+    Attributes
+    ----------
+    side : SensorSide
+        Given as a SensorSide or its name (``"link"``, ``"motor"``); default link.
+    offset : float
+        What the sensor reads at zero torque, N m (identified with ``--target torque``); it is
+        the sensor's, not the joint's: no energy or current includes it.
+    """
+
+    side: SensorSide = SensorSide.LINK
+    offset: float = 0.0
+
+    def __post_init__(self) -> None:
+        side = checks.choice(self.side, SensorSide, "torque_sensor.side")
+        object.__setattr__(self, "side", side)
+        object.__setattr__(self, "offset", _number(self.offset, "torque_sensor.offset", low=None))
+
+    @property
+    def sees_rotor(self) -> bool:
+        """Whether the rotors' inertia torque is in the reading (a motor-side sensor)."""
+        return self.side == SensorSide.MOTOR
+
+
 @dataclass(frozen=True, eq=False)
 class Limits:
     """Joint limits, joint side.
@@ -406,10 +464,12 @@ class Limits:
 
 @dataclass(frozen=True, eq=False)
 class Joint:
-    """One revolute joint, the link it moves, its drive and limits.
+    """One revolute joint, the link it moves, its drive, limits and torque sensor.
 
     ``d``, ``a``, ``alpha``, ``offset`` follow the robot's convention (:data:`CONVENTIONS`); for
-    ``mdh`` ``a`` and ``alpha`` are a_{i-1} and alpha_{i-1}. m and rad.
+    ``mdh`` ``a`` and ``alpha`` are a_{i-1} and alpha_{i-1}. m and rad. ``torque_sensor`` says
+    what a logged joint torque of this joint measures (:class:`TorqueSensor`; default a
+    link-side sensor without offset).
     """
 
     name: str
@@ -420,11 +480,14 @@ class Joint:
     link: Link
     drive: Drive
     limits: Limits
+    torque_sensor: TorqueSensor = field(default_factory=TorqueSensor)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise KinergyError(f"joint name must be a non-empty string, got {self.name!r}")
         checks.plain_text(self.name, "joint name")
+        if not isinstance(self.torque_sensor, TorqueSensor):
+            raise KinergyError("torque_sensor must be a TorqueSensor")
         for name in ("d", "a", "alpha", "offset"):
             object.__setattr__(self, name, _number(getattr(self, name), name))
 

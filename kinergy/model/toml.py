@@ -47,6 +47,9 @@ version :data:`ROBOT_SCHEMA`); :func:`robot_from_dict` reads it back from any of
     speed = 3.141592653589793
     torque = 150.0
     continuous = true                 # optional: no end stop (positions beyond the range are fine)
+    [joints.torque_sensor]            # optional: what a logged joint torque of this joint measures
+    side = "link"                     # "link" (default: between gear and link) or "motor"
+    offset = 0.0                      # N m, what it reads at zero torque (identify --target torque)
 
 Every error names the file and the field, e.g.
 ``ur5e.toml: joints[4] (wrist_2).inertia: ... violates the triangle inequality``.
@@ -76,8 +79,10 @@ from kinergy.model.robot import (
     Link,
     Payload,
     Robot,
+    SensorSide,
     Source,
     Thermal,
+    TorqueSensor,
 )
 
 __all__ = [
@@ -111,7 +116,20 @@ _ROBOT_KEYS = {
     "standby_power",
     "bus_voltage",
 }
-_JOINT_KEYS = {"name", "d", "a", "alpha", "offset", "mass", "com", "inertia", "drive", "limits"}
+_JOINT_KEYS = {
+    "name",
+    "d",
+    "a",
+    "alpha",
+    "offset",
+    "mass",
+    "com",
+    "inertia",
+    "drive",
+    "limits",
+    "torque_sensor",
+}
+_SENSOR_KEYS = ("side", "offset")
 #: a drive's numbers every file gives, in the order files list them
 _DRIVE_NUMBERS = (
     "gear_ratio",
@@ -227,7 +245,20 @@ def _joint_from_dict(data: Any, index: int) -> Joint:
     )
     limits = _at(where, lambda: Limits(**limit_fields))
     joint_fields = _fields(data, where, ("name", "d", "a", "alpha"), {"offset": 0.0})
-    return _at(where, lambda: Joint(**joint_fields, link=link, drive=drive, limits=limits))
+    sensor = _sensor_from_dict(data.get("torque_sensor"), where)
+    return _at(
+        where,
+        lambda: Joint(**joint_fields, link=link, drive=drive, limits=limits, torque_sensor=sensor),
+    )
+
+
+def _sensor_from_dict(data: Any, where: str) -> TorqueSensor:
+    """A joint's ``torque_sensor`` table (absent: a link-side sensor without offset)."""
+    if data is None:
+        return TorqueSensor()
+    data = _known(data, _SENSOR_KEYS, f"{where}.torque_sensor")
+    fields = _fields(data, where, (), {"side": SensorSide.LINK, "offset": 0.0})
+    return _at(where, lambda: TorqueSensor(**fields))
 
 
 def _thermal_from_dict(data: Any, where: str) -> Thermal | None:
@@ -405,20 +436,22 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
             limits["acceleration"] = j.limits.acceleration
         if j.limits.continuous:
             limits["continuous"] = True
-        joints.append(
-            {
-                "name": j.name,
-                "d": j.d,
-                "a": j.a,
-                "alpha": j.alpha,
-                "offset": j.offset,
-                "mass": j.link.mass,
-                "com": _floats(j.link.com),
-                "inertia": _floats(j.link.inertia),
-                "drive": drive,
-                "limits": limits,
-            }
-        )
+        joint: dict[str, Any] = {
+            "name": j.name,
+            "d": j.d,
+            "a": j.a,
+            "alpha": j.alpha,
+            "offset": j.offset,
+            "mass": j.link.mass,
+            "com": _floats(j.link.com),
+            "inertia": _floats(j.link.inertia),
+            "drive": drive,
+            "limits": limits,
+        }
+        if j.torque_sensor != TorqueSensor():
+            sensor = j.torque_sensor
+            joint["torque_sensor"] = {"side": sensor.side.value, "offset": sensor.offset}
+        joints.append(joint)
     out["joints"] = joints
     return out
 

@@ -191,6 +191,28 @@ def _joint_grid(fig: Figure, n: int) -> list[Axes]:
     return axes
 
 
+def _residual_grid(fig: Figure, n: int) -> tuple[list[Axes], list[Axes]]:
+    """``n`` joint panels, each with a residual panel a third its height below it, on the grid
+    of :func:`_joint_grid` (every panel shares the x axis): the panels and their residuals."""
+    ncols = _ncols(n)
+    nrows = math.ceil(n / ncols)
+    spec = fig.add_gridspec(2 * nrows, ncols, height_ratios=[3.0, 1.0] * nrows)
+    axes: list[Axes] = []
+    below: list[Axes] = []
+    for j in range(n):
+        r, c = divmod(j, ncols)
+        top = fig.add_subplot(spec[2 * r, c], sharex=axes[0] if axes else None)
+        bottom = fig.add_subplot(spec[2 * r + 1, c], sharex=top)
+        top.xaxis.set_tick_params(labelbottom=False)
+        if j + ncols < n:  # a panel below in the same column carries the time axis
+            bottom.xaxis.set_tick_params(labelbottom=False)
+        else:
+            bottom.set_xlabel("Time [s]", fontsize=_LABEL)
+        axes.append(top)
+        below.append(bottom)
+    return axes, below
+
+
 def _grid_size(n: int) -> tuple[float, float]:
     """Figure size, inches, for ``n`` joint panels: 11 x 8 for six."""
     ncols = _ncols(n)
@@ -212,8 +234,10 @@ def time_series(
     unit: str,
     measured_label: str = "measured",
     predicted_label: str = "model",
+    residual: bool = False,
 ) -> Figure:
-    """Measured against predicted signal per joint over time, with R² per joint.
+    """Measured against predicted signal per joint over time, with R² per joint (and, with
+    ``residual``, each joint's residual ``measured - predicted`` in a panel below it).
 
     One panel per joint (a 3 x 2 grid for six joints) sharing the time axis, the measured signal
     solid and the prediction dashed on top of it, as in UR5e Figs 8-9 (``target_moment`` against
@@ -234,11 +258,13 @@ def time_series(
         Its unit, e.g. ``"N m"`` or ``"A"``.
     measured_label, predicted_label : str
         Legend entries of the two signals.
+    residual : bool
+        Add a residual panel (``measured - predicted``, in ``unit``) below each joint's.
 
     Returns
     -------
     matplotlib.figure.Figure
-        ``n`` axes, in joint order.
+        ``n`` axes in joint order (with ``residual``, each followed by its residual's).
 
     Raises
     ------
@@ -250,8 +276,18 @@ def time_series(
     n = len(names)
     r2 = r_squared(y, p)
 
-    fig = _figure(*_grid_size(n))
-    axes = _joint_grid(fig, n)
+    width, height = _grid_size(n)
+    fig = _figure(width, height * (4.0 / 3.0 if residual else 1.0))
+    if residual:
+        axes, below = _residual_grid(fig, n)
+        for j, ax in enumerate(below):
+            ax.plot(ts, y[:, j] - p[:, j], color="tab:red", linewidth=0.6)
+            ax.axhline(0.0, color="black", linewidth=0.5)
+            if j % _ncols(n) == 0:
+                ax.set_ylabel(f"residual [{unit}]", fontsize=_LABEL)
+            _style(ax)
+    else:
+        axes = _joint_grid(fig, n)
     for j, ax in enumerate(axes):
         ax.plot(ts, y[:, j], label=measured_label, **_MEASURED)
         ax.plot(ts, p[:, j], label=predicted_label, **_PREDICTED)

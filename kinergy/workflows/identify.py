@@ -25,7 +25,7 @@ from kinergy.identification.chunks import LogChunks, Summary, data_history
 from kinergy.identification.electrics import BLOCK_SECONDS, StandingDraw, StandingDrawSums
 from kinergy.identification.full import full
 from kinergy.identification.nursing import nursing
-from kinergy.identification.options import CurrentOptions, IdentifyOptions, Method
+from kinergy.identification.options import CurrentOptions, IdentifyOptions, Method, Target
 from kinergy.identification.payload import PayloadEstimate, payload
 from kinergy.identification.result import IDENTIFIED, IdentificationResult, validation_metrics
 from kinergy.identification.sanity import check_motion
@@ -128,7 +128,8 @@ def motion_share(summary: Summary) -> float:
 
 def unsupported_fit(result: IdentificationResult, share: float = 1.0) -> str:
     """Why the identified model is not supported by its own logs, or "": no drive parameter
-    identified, or an R^2 below 0 on the identification logs for a joint that moved (module
+    identified, or an R^2 below 0 on the identification logs for a joint that moved, of the
+    reference torque, the current or (identified from them) the measured joint torque (module
     docstring of :mod:`kinergy.logs.checks`, check ``fit``); logs that move on less than
     :data:`MIN_MOTION_SHARE` of their samples (``share``) are told they hold too little motion,
     not that their layout is wrong."""
@@ -140,7 +141,10 @@ def unsupported_fit(result: IdentificationResult, share: float = 1.0) -> str:
         )
     moved = [getattr(j, "identified", True) for j in result.joints]
     worst = []
-    for key, unit in (("torque", "target_moment"), ("current", "actual_current")):
+    signals = [("torque", "target_moment"), ("current", "actual_current")]
+    if getattr(result.fit, "target", "") == Target.TORQUE.value:  # the full method's target
+        signals.append(("joint_torque", "measured joint torque"))
+    for key, unit in signals:
         metrics = getattr(result.fit, key)
         if metrics is None:
             continue

@@ -112,8 +112,9 @@ def _stems(names: Sequence[str]) -> list[str]:
 def write_validation_plots(
     robot: Robot, logs: Sequence[LogValidation], folder: str | os.PathLike[str]
 ) -> None:
-    """Per log (or segment), measured against predicted torque and current (``STEM_torque.png``,
-    ``STEM_current.png``, :func:`_stems`) from its :attr:`~kinergy.identification.validation.LogValidation.series`;
+    """Per log (or segment), measured against predicted reference torque, current and measured
+    joint torque, each joint with its residual below (``STEM_torque.png``, ``STEM_current.png``,
+    ``STEM_joint_torque.png``, :func:`_stems`) from its :attr:`~kinergy.identification.validation.LogValidation.series`;
     over all logs, the error box plots (``torque_errors.png``, ...). The folder is built
     beside ``folder`` and replaces it whole (:func:`kinergy.files.atomic_folder`: refused when
     it holds a file kinergy did not write)."""
@@ -121,13 +122,18 @@ def write_validation_plots(
         _plots(robot, logs, out)
 
 
+#: the signals ``validate --plots`` draws: its key, unit and what the log calls the measurement
+PLOTTED = (
+    ("torque", "N m", "target_moment"),
+    ("current", "A", "actual_current"),
+    ("joint_torque", "N m", "actual_joint_torque"),
+)
+
+
 def _plots(robot: Robot, logs: Sequence[LogValidation], out: Path) -> None:
-    errors: dict[str, dict[str, Array]] = {"torque": {}, "current": {}}
+    errors: dict[str, dict[str, Array]] = {key: {} for key, _, _ in PLOTTED}
     for log, stem in zip(logs, _stems([log.log for log in logs]), strict=True):
-        for key, unit, label in (
-            ("torque", "N m", "target_moment"),
-            ("current", "A", "actual_current"),
-        ):
+        for key, unit, label in PLOTTED:
             series = log.series.get(key)
             if series is None:
                 continue
@@ -140,10 +146,11 @@ def _plots(robot: Robot, logs: Sequence[LogValidation], out: Path) -> None:
                 unit=unit,
                 measured_label=label,
                 predicted_label="model",
+                residual=True,
             )
             save(fig, out / f"{stem}_{key}.png")
             errors[key][stem] = series.measured - series.predicted
-    for key, unit in (("torque", "N m"), ("current", "A")):
+    for key, unit, _ in PLOTTED:
         if errors[key]:
             fig = error_boxplot(errors[key], joint_names=robot.joint_names, quantity=key, unit=unit)
             save(fig, out / f"{key}_errors.png")
