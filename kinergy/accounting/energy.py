@@ -42,6 +42,7 @@ import numpy as np
 
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy
+from kinergy.accounting.uncertainty import EnergyIntervals, Sensitivity
 from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
 from kinergy.drives.transmission import transmission_matrix
@@ -131,9 +132,13 @@ class EnergyAccumulator:
     ``acc.figures()``.
     """
 
-    def __init__(self, robot: Robot, *, recovery: bool = True) -> None:
+    def __init__(self, robot: Robot, *, recovery: bool = True, intervals: bool = True) -> None:
         self.robot = robot
         self.recovery = recovery
+        self.sensitivity = (
+            Sensitivity(robot) if intervals and robot.uncertainty is not None else None
+        )
+        self.base = 0  # the integrands' columns before the sensitivities
         n = robot.n
         self._k = 6 * n + 4  # p_mech, p_elec, 4 parts (n each), totals, motors, shunt
         self.sums: Array | None = None
@@ -146,7 +151,9 @@ class EnergyAccumulator:
         self.current_sq = np.zeros(n)
         self.peak_current = np.zeros(n)
 
-    def _integrands(self, state: DriveState, measured: Array | None) -> Array:
+    def _integrands(
+        self, state: DriveState, measured: Array | None, temperature: Array | None = None
+    ) -> Array:
         """The chunk's integrands (N, K): every power the report integrates."""
         p_mech, p_elec = state.p_mech, state.power
         parts = part_powers(self.robot, state)
@@ -163,6 +170,9 @@ class EnergyAccumulator:
         if measured is not None:
             self.measured_peak = max(self.measured_peak, float(measured.max()))
             cols.append(measured[:, None])
+        self.base = 6 * self.robot.n + 4 + (measured is not None)
+        if self.sensitivity is not None:
+            cols.append(self.sensitivity.columns(state, temperature))
         return np.hstack(cols)
 
     def add(
@@ -172,6 +182,7 @@ class EnergyAccumulator:
         *,
         starts: list[int],
         measured_power: Array | None = None,
+        temperature: Array | None = None,
     ) -> None:
         """Account the chunk at times ``t`` (s, (N,)) with drive state ``state``.
 
@@ -185,8 +196,11 @@ class EnergyAccumulator:
             continue the previous one's segment; the first chunk always begins one).
         measured_power : ndarray, shape (N,), optional
             The log's measured supply power (voltage x current), W; in every chunk or none.
+        temperature : ndarray, shape (N, n), optional
+            The joint temperatures the drive state was computed at (deg C), for the intervals'
+            gradients (:mod:`kinergy.accounting.uncertainty`).
         """
-        y = self._integrands(state, measured_power)
+        y = self._integrands(state, measured_power, temperature)
         if self.sums is None:
             self.sums = np.zeros(y.shape[1])
             self.first_t = float(t[0])
@@ -230,6 +244,11 @@ class EnergyAccumulator:
         if measured:
             used = float(s[6 * n + 4])
             meas = MeasuredSupply(used, used / d if d else float("nan"), self.measured_peak)
+        intervals = None
+        if self.sensitivity is not None:
+            values = (drawn, motors, s[n : 2 * n])
+            gradient = s[self.base :]
+            intervals = EnergyIntervals.of(self.sensitivity.uncertainty, gradient, d, values)
         return EnergyFigures(
             robot=self.robot.name,
             joints=self.robot.joint_names,
@@ -250,6 +269,7 @@ class EnergyAccumulator:
             total_e_elec=float(s[6 * n + 1]),
             supply=supply,
             measured=meas,
+            intervals=intervals,
         )
 
 
@@ -288,7 +308,8 @@ def energy(
     if state is None:
         state = drive_state(robot, motion.q, motion.qd, motion.qdd, temperature=temperature)
     acc = EnergyAccumulator(robot, recovery=recovery)
-    acc.add(motion.t, state, starts=[a for a, _ in segment_bounds(motion.t)])
+    starts = [a for a, _ in segment_bounds(motion.t)]
+    acc.add(motion.t, state, starts=starts, temperature=temperature)
     figures = acc.figures()
     p_mech, p_elec = state.p_mech, state.power
     if not recovery:
