@@ -138,7 +138,8 @@ class EnergyAccumulator:
         self.sensitivity = (
             Sensitivity(robot) if intervals and robot.uncertainty is not None else None
         )
-        self.base = 0  # the integrands' columns before the sensitivities
+        self.gradient: Array | None = None  # the sensitivities' integrals (2p,)
+        self.last_rows: Array | None = None  # the previous sample's sensitivities
         n = robot.n
         self._k = 6 * n + 4  # p_mech, p_elec, 4 parts (n each), totals, motors, shunt
         self.sums: Array | None = None
@@ -151,9 +152,7 @@ class EnergyAccumulator:
         self.current_sq = np.zeros(n)
         self.peak_current = np.zeros(n)
 
-    def _integrands(
-        self, state: DriveState, measured: Array | None, temperature: Array | None = None
-    ) -> Array:
+    def _integrands(self, state: DriveState, measured: Array | None) -> Array:
         """The chunk's integrands (N, K): every power the report integrates."""
         p_mech, p_elec = state.p_mech, state.power
         parts = part_powers(self.robot, state)
@@ -170,9 +169,6 @@ class EnergyAccumulator:
         if measured is not None:
             self.measured_peak = max(self.measured_peak, float(measured.max()))
             cols.append(measured[:, None])
-        self.base = 6 * self.robot.n + 4 + (measured is not None)
-        if self.sensitivity is not None:
-            cols.append(self.sensitivity.columns(state, temperature))
         return np.hstack(cols)
 
     def add(
@@ -200,7 +196,7 @@ class EnergyAccumulator:
             The joint temperatures the drive state was computed at (deg C), for the intervals'
             gradients (:mod:`kinergy.accounting.uncertainty`).
         """
-        y = self._integrands(state, measured_power, temperature)
+        y = self._integrands(state, measured_power)
         if self.sums is None:
             self.sums = np.zeros(y.shape[1])
             self.first_t = float(t[0])
@@ -208,19 +204,29 @@ class EnergyAccumulator:
         elif y.shape[1] != self.sums.size:
             raise KinergyError("measured supply columns in some chunks of a log only")
         cuts = sorted(starts)
+        rows = None if self.sensitivity is None else self.sensitivity.rows(state, temperature)
         if self.last is not None and (not cuts or cuts[0] != 0):
             t0, y0 = self.last  # the previous chunk's segment goes on: the step between them
             self.sums += 0.5 * (t[0] - t0) * (y0 + y[0])
             self.duration += float(t[0] - t0)
+            if rows is not None and self.last_rows is not None:
+                self._gradient(0.5 * (t[0] - t0) * (self.last_rows + rows[:, 0]))
         edges = [0, *(c for c in cuts if c > 0), t.size]
         for a, b in itertools.pairwise(edges):
-            self.sums += np.sum(trapezoid_weights(t[a:b])[:, None] * y[a:b], axis=0)
+            weights = trapezoid_weights(t[a:b])
+            self.sums += np.sum(weights[:, None] * y[a:b], axis=0)
             self.duration += float(t[b - 1] - t[a])
+            if rows is not None:
+                self._gradient(rows[:, a:b] @ weights)
+        self.last_rows = None if rows is None else rows[:, -1].copy()
         self.segments += len(starts)
         self.samples += t.size
         self.last = (float(t[-1]), y[-1].copy())
         self.current_sq += np.sum(state.current**2, axis=0)
         self.peak_current = np.maximum(self.peak_current, np.abs(state.current).max(axis=0))
+
+    def _gradient(self, add: Array) -> None:
+        self.gradient = add if self.gradient is None else self.gradient + add
 
     def figures(self, measured: bool = False) -> EnergyFigures:
         """The figures of everything added (:class:`EnergyFigures`), with the measured supply
@@ -245,10 +251,9 @@ class EnergyAccumulator:
             used = float(s[6 * n + 4])
             meas = MeasuredSupply(used, used / d if d else float("nan"), self.measured_peak)
         intervals = None
-        if self.sensitivity is not None:
+        if self.sensitivity is not None and self.gradient is not None:
             values = (drawn, motors, s[n : 2 * n])
-            gradient = s[self.base :]
-            intervals = EnergyIntervals.of(self.sensitivity.uncertainty, gradient, d, values)
+            intervals = EnergyIntervals.of(self.sensitivity.uncertainty, self.gradient, d, values)
         return EnergyFigures(
             robot=self.robot.name,
             joints=self.robot.joint_names,

@@ -10,11 +10,8 @@ weights, same segments, one pass, memory bounded by the chunk)::
     dE_motors / dtheta_i = int 1[sum_j W_j > 0] dW_j/dtheta_i dt         (the bus: UR5e eq 23 summed)
     dE_drawn / dtheta_i  = dE_motors / dtheta_i  (+ duration for standby_power)
 
-``dW_j/dtheta_i`` by central differences of the drive model from the load torque on (the link
-torques do not depend on ``theta``; a rotor inertia moves the load torque by ``dJ * dwm``),
-exact for the power's quadratic dependence on the motor torque. A joint's power depends on its
-own parameters only, so one evaluation moves one parameter of every joint at once: a chunk costs
-``2 x`` (the most parameters of any joint) evaluations of friction and electrics, never of the
+``dW_j/dtheta_i`` analytic (:class:`Sensitivity`): the link torques do not depend on ``theta``,
+so a chunk costs one evaluation of each joint's friction columns and a few products, never the
 rigid-body dynamics. The interval is then the delta method's (``|D g|``, Student's t).
 """
 
@@ -26,9 +23,9 @@ from typing import Any
 import numpy as np
 
 from kinergy.arrays import Array
-from kinergy.drives.electrics import electrical_power, friction_torques
+from kinergy.drives.electrics import motor_constants
 from kinergy.model.robot import Robot
-from kinergy.model.uncertainty import Interval, Uncertainty, interval, perturbed
+from kinergy.model.uncertainty import Interval, Uncertainty, interval
 from kinergy.predict import DriveState
 
 __all__ = ["NO_UNCERTAINTY", "EnergyIntervals", "Sensitivity", "interval_dict"]
@@ -38,8 +35,6 @@ NO_UNCERTAINTY = (
     "the model carries no parameter errors (a built-in or data-sheet model): no interval; "
     "identify a model from logs for one"
 )
-#: a parameter is moved by this fraction of its standard deviation for its derivative
-_STEP = 1e-3
 
 
 def _joint(name: str) -> int | None:
@@ -48,7 +43,12 @@ def _joint(name: str) -> int | None:
 
 class Sensitivity:
     """The per-sample gradients of the joints' powers over ``robot.uncertainty``'s parameters
-    (module docstring).
+    (module docstring), analytic: with ``h = dW/dtau_m = 2 tau_m / k_m^2 + wm / (k_t/k_b)``,
+    a rotor inertia's is ``h dwm`` (the load torque moves by ``dJ dwm``; a friction that
+    depends on the load is taken at the nominal load), a friction level's ``h`` times its
+    regressor column (the friction is linear in its levels), a torque constant's
+    ``-2 R tau_m^2 / k_t^3`` where the drive gives its winding resistance (else the power does
+    not depend on it: ``R = (k_t / k_m)^2``).
 
     Parameters
     ----------
@@ -58,53 +58,57 @@ class Sensitivity:
 
     def __init__(self, robot: Robot) -> None:
         assert robot.uncertainty is not None
+        self.robot = robot
         self.uncertainty = robot.uncertainty
         names = self.uncertainty.parameters
         self.p = len(names)
-        self.joint = [_joint(name) for name in names]
-        std = self.uncertainty.std
-        self.step = np.where(std > 0, _STEP * std, 0.0)
-        # group the parameters so that each group moves at most one per joint
-        groups: list[list[int]] = []
-        for i, j in enumerate(self.joint):
-            if j is None or self.step[i] == 0.0:
+        # per joint: (parameter index, what: -1 rotor inertia, -2 torque constant, else the
+        # friction level's column)
+        self.by_joint: dict[int, list[tuple[int, int]]] = {}
+        for i, name in enumerate(names):
+            j = _joint(name)
+            if j is None:
                 continue
-            free = [g for g in groups if all(self.joint[k] != j for k in g)]
-            if free:
-                free[0].append(i)
-            else:
-                groups.append([i])
-        self.groups = groups
-        self.moved = [
-            tuple(perturbed(robot, {names[i]: s * self.step[i] for i in g}) for s in (1.0, -1.0))
-            for g in groups
-        ]
-        self.rotor = [
-            np.array(
-                [
-                    sum(self.step[i] for i in g if self.joint[i] == j and "rotor" in names[i])
-                    for j in range(robot.n)
-                ]
-            )
-            for g in groups
-        ]
+            what = name.split(".", 1)[1]
+            linear = robot.joints[j].drive.friction.model.linear
+            code = {"rotor_inertia": -1, "torque_constant": -2}.get(what)
+            if code is None:
+                code = linear.index(what.removeprefix("friction."))
+            self.by_joint.setdefault(j, []).append((i, code))
+        self.km2 = motor_constants(robot) ** 2
+        self.kt_over_kb = np.array([joint.drive.kt_over_kb for joint in robot.joints])
 
-    def columns(self, state: DriveState, temperature: Array | None = None) -> Array:
-        """The chunk's gradient integrands (N, 2p): ``dW_j(i)/dtheta_i`` then the same where
-        the bus draws (``sum_j W_j > 0``), W per parameter unit."""
-        out = np.zeros((state.wm.shape[0], 2 * self.p))
+    def rows(self, state: DriveState, temperature: Array | None = None) -> Array:
+        """The chunk's gradient integrands (2p, N), one row per parameter: ``dW_j(i)/dtheta_i``,
+        then the same where the bus draws (``sum_j W_j > 0``), W per parameter unit."""
+        n_samples = state.wm.shape[0]
+        out = np.zeros((2 * self.p, n_samples))
+        h = (2.0 * state.tau_m / self.km2 + state.wm / self.kt_over_kb).T.copy()  # (n, N)
+        dwm, tau_m = state.dwm.T, state.tau_m.T
+        for j, params in self.by_joint.items():
+            drive = self.robot.joints[j].drive
+            friction = drive.friction
+            cols = None
+            for i, code in params:
+                if code == -1:  # rotor inertia
+                    np.multiply(h[j], dwm[j], out=out[i])
+                elif code == -2:  # torque constant
+                    if drive.winding_resistance is not None:
+                        kt = drive.torque_constant
+                        out[i] = -2.0 * drive.winding_resistance * tau_m[j] ** 2 / kt**3
+                else:
+                    if cols is None:
+                        temp = None if temperature is None else temperature[:, j]
+                        cols = friction.model.friction_columns(
+                            friction.params,
+                            state.wm[:, j],
+                            state.tau_load[:, j],
+                            state.dwm[:, j],
+                            temperature=temp,
+                        ).T.copy()
+                    np.multiply(h[j], cols[code], out=out[i])
         drawing = state.power.sum(axis=1) > 0.0
-        for g, moved, rotor in zip(self.groups, self.moved, self.rotor, strict=True):
-            powers = []
-            for robot, sign in zip(moved, (1.0, -1.0), strict=True):
-                tau_load = state.tau_load + sign * rotor * state.dwm
-                tau_f = friction_torques(robot, state.wm, tau_load, state.dwm, temperature)
-                powers.append(electrical_power(robot, tau_load + tau_f, state.wm))
-            for i in g:
-                j = self.joint[i]
-                d = (powers[0][:, j] - powers[1][:, j]) / (2.0 * self.step[i])
-                out[:, i] = d
-                out[:, self.p + i] = np.where(drawing, d, 0.0)
+        np.multiply(out[: self.p], drawing, out=out[self.p :])
         return out
 
 
@@ -138,7 +142,7 @@ class EnergyIntervals:
         duration: float,
         values: tuple[float, float, Array],
     ) -> EnergyIntervals:
-        """From the integrated gradient columns ``sums`` (2p,) of :meth:`Sensitivity.columns`,
+        """From the integrated gradient rows ``sums`` (2p,) of :meth:`Sensitivity.rows`,
         the duration (s) and the figures ``(drawn, motors, e_elec)``."""
         names = uncertainty.parameters
         p = len(names)

@@ -54,6 +54,7 @@ def _supply_lines(report: dict[str, Any]) -> list[str]:
         f"{report['duration']:.1f} s{share}); {sup['shunt']:.1f} J of braking burnt in the shunt, "
         f"not drawn. Mean {sup['mean_power']:.1f} W, peak {sup['peak_power']:.1f} W.",
     ]
+    lines += _interval_lines(report)
     measured = report.get("measured")
     if measured is not None:
         error = measured.get("error")
@@ -66,6 +67,26 @@ def _supply_lines(report: dict[str, Any]) -> list[str]:
     if measured is not None:
         lines.append(f"  measured: {MEASURED_INCLUDES}.")
     return lines
+
+
+def _interval_lines(report: dict[str, Any]) -> list[str]:
+    """The 95 % intervals from the model's parameter errors, or why there are none."""
+    iv = report.get("intervals") or {}
+    if "drawn" not in iv:
+        return [f"95 % interval: none: {iv['note']}."] if "note" in iv else []
+    drawn, motors = iv["drawn"], iv["motors"]
+    half = 0.5 * (drawn["high"] - drawn["low"])
+    share = (
+        f" (+-{100 * half / report['supply']['drawn']:.1f} %)" if report["supply"]["drawn"] else ""
+    )
+    joints = ", ".join(
+        f"{j['name']} {e['low']:.1f}..{e['high']:.1f}"
+        for j, e in zip(report["joints"], iv["e_elec"], strict=True)
+    )
+    return [
+        f"95 % interval: drawn {drawn['low']:.1f}..{drawn['high']:.1f} J{share}, motors "
+        f"{motors['low']:.1f}..{motors['high']:.1f} J; E_elec {joints} J ({iv['method']}).",
+    ]
 
 
 def energy_text(report: dict[str, Any]) -> str:

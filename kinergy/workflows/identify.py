@@ -278,7 +278,7 @@ def _standing_draw(
             held.update(data, skip)
             power = state.power[skip:]
             if sensitivity is not None:
-                cols = sensitivity.columns(state, data.temperature)[skip:, sensitivity.p :]
+                cols = sensitivity.rows(state, data.temperature)[sensitivity.p :, skip:].T
                 fold_gradients(gradients, sums, k, chunk.t, cols)
         supply = np.asarray(chunk.supply_voltage * chunk.supply_current, dtype=float)
         sums.add(k, chunk.t, supply - supply_power(power).motors)
