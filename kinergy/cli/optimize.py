@@ -13,6 +13,7 @@ from typing import Any, TypeVar
 
 import click
 
+from kinergy.accounting.uncertainty import NO_UNCERTAINTY
 from kinergy.cli.common import (
     Finite,
     flag_of,
@@ -26,6 +27,7 @@ from kinergy.cli.common import (
     writes,
 )
 from kinergy.errors import KinergyError
+from kinergy.model.uncertainty import Interval
 from kinergy.optimize import ParetoPoint, ProgramResult, TimingResult
 from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
 from kinergy.optimize.programs import Lever, supply
@@ -170,6 +172,21 @@ def optimize_text(run: OptimizeRun) -> str:
     return "\n".join(lines)
 
 
+def _saving_interval(iv: Interval | None) -> str:
+    """The saving's 95 % interval, and how to read it (or why there is none)."""
+    if iv is None:
+        return f"Saving's 95 % interval: none: {NO_UNCERTAINTY}."
+    verdict = (
+        "not established: the interval includes 0"
+        if iv.low <= 0.0 <= iv.high
+        else "established: the interval excludes 0"
+    )
+    return (
+        f"Saving's 95 % interval: {100 * iv.low:.1f} % .. {100 * iv.high:.1f} % ({verdict}; the "
+        "program and the optimised one on the same parameter errors)"
+    )
+
+
 def _levers_table(levers: Sequence[Lever]) -> str:
     rows = [
         [
@@ -208,6 +225,7 @@ def program_text(run: ProgramRun) -> str:
         f"Saving: {100 * result.saving:.1f} % of the supply energy ({supply(own):.1f} J -> "
         f"{supply(opt):.1f} J); the written program read back and simulated again: "
         f"{run.readback:.1f} J ({100 * (run.readback / supply(opt) - 1.0):+.2f} %)",
+        _saving_interval(result.saving_interval),
         f"Targets: {len(stops)} stops, worst {1e3 * max(c.distance for c in stops):.3f} mm, "
         f"{math.degrees(max(c.angle for c in stops)):.3f} deg, joint speed "
         f"{max(c.speed for c in stops):.2g} rad/s; "

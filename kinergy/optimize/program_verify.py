@@ -27,6 +27,7 @@ from kinergy.accounting.energy import energy
 from kinergy.arrays import Array
 from kinergy.dynamics.poses import tcp_pose
 from kinergy.model.robot import Robot
+from kinergy.model.uncertainty import Uncertainty
 from kinergy.optimize.constraints import limit_violations
 from kinergy.optimize.objectives import Objective, SupplyEnergy
 from kinergy.optimize.options import ToolSymmetry
@@ -42,36 +43,45 @@ __all__ = ["PathRun", "TargetCheck", "simulate_path", "target_errors"]
 
 @dataclass(frozen=True, eq=False)
 class PathRun:
-    """A program re-simulated at 500 Hz: the result, the motion and its schedule."""
+    """A program re-simulated at 500 Hz: the result, the motion and its schedule; where the
+    model carries parameter errors (``errors``), the gradient of the motors' supply energy
+    ``result.e_elec`` over them (J per parameter unit, :mod:`kinergy.accounting.uncertainty`)."""
 
     result: ProgramResult
     motion: Motion
     schedule: Schedule
     path: ProgramPath
+    gradient: Array | None = None
+    errors: Uncertainty | None = None
 
 
 def _energy(
     robot: Robot, path: ProgramPath, motion: Motion, sched: Schedule
-) -> tuple[float, dict[str, float], DriveState]:
-    """Clipped bus energy (J), its breakdown and the drive state over the motion, each stretch
-    of samples with its own load."""
+) -> tuple[float, dict[str, float], DriveState, Array | None]:
+    """Clipped bus energy (J), its breakdown, the drive state over the motion, each stretch
+    of samples with its own load, and the energy's gradient over the model's parameter errors
+    (None without them)."""
     load = payload_index(path, sched, motion.t)[0]
     cuts = np.flatnonzero(np.diff(load)) + 1
     bounds = np.concatenate([[0], cuts, [motion.t.size]])
     total = 0.0
     parts: dict[str, float] = {}
     states = []
+    gradient: Array | None = None
     for i in range(bounds.size - 1):
         lo, hi = int(bounds[i]), int(bounds[i + 1])
         stretch = motion.sliced(max(lo - 1, 0), hi)  # one shared sample: the integrals add up
         report = energy(robot.with_payload(path.payloads[int(load[lo])]), stretch, recovery=False)
         total += report.total_e_elec
+        if report.intervals is not None:
+            g = report.intervals.gradients["motors"]
+            gradient = g if gradient is None else gradient + g
         for key, value in report.breakdown.items():
             parts[key] = parts.get(key, 0.0) + float(value.sum())
         skip = 1 if lo > 0 else 0
         states.append({f: getattr(report.drive, f)[skip:] for f in DriveState.__dataclass_fields__})
     drive = DriveState(**{f: np.vstack([s[f] for s in states]) for f in states[0]})
-    return total, parts, drive
+    return total, parts, drive, gradient
 
 
 def simulate_path(
@@ -107,7 +117,7 @@ def simulate_path(
     """
     objective = SupplyEnergy() if objective is None else objective
     motion, sched = program_motion(robot, path)
-    e_bus, breakdown, drive = _energy(robot, path, motion, sched)
+    e_bus, breakdown, drive, gradient = _energy(robot, path, motion, sched)
     samples = grid_path_samples(robot, path, sched, motion)
     score, parts = objective(samples)
     check = limit_violations(
@@ -128,7 +138,7 @@ def simulate_path(
         predicted=predicted,
         score=float(score[0]),
     )
-    return PathRun(result, motion, sched, path)
+    return PathRun(result, motion, sched, path, gradient, robot.uncertainty)
 
 
 @dataclass(frozen=True)
