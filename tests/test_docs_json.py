@@ -335,6 +335,10 @@ def documents(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[tuple[
                 "optimize", "ur5e", str(ROOT / "tests" / "programs" / "small.script"),
                 "--pareto-points", "0", "--json",
             ],
+            "URScript, an identified model": [
+                "optimize", str(folder / "auto.toml"),
+                str(ROOT / "tests" / "programs" / "small.script"), "--json",
+            ],
         },
         "json-place": {
             "a small grid": [

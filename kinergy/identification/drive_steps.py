@@ -117,7 +117,7 @@ FOLDS = 5
 #: contiguous time blocks of the jackknife that gives the parameters' errors (without ``auto``)
 JACKKNIFE_BLOCKS = 10
 #: samples per triangle of step 2 (:func:`rotor_problem`), grouped into the jackknife's blocks
-PIECE = 1000
+PIECE = 200
 
 
 def joined(problems: Sequence[Reduced]) -> Reduced:

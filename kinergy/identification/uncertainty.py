@@ -92,7 +92,7 @@ def jackknife_uncertainty(
     rotor_joints = [j for j, f in enumerate(flags) if f.get("rotor_inertia") == IDENTIFIED]
     if rotor_pieces and rotor_joints:
         reps = _rotor_replicates(identified, rotor_pieces, rotor_joints, blocks)
-        if reps is not None:
+        if reps is not None and (not counts or reps.shape[0] == blocks):
             for c, j in enumerate(rotor_joints):
                 names.append(f"joints[{j}].rotor_inertia")
                 columns.append(reps[:, c])
