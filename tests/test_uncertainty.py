@@ -137,3 +137,15 @@ def test_saving_interval_from_the_same_parameter_draws(ur5e):
         moved = perturbed(robot, dict(zip(u.parameters, delta, strict=True)))
         change = saving(moved) - found.saving
         assert change == pytest.approx(g @ delta, rel=0.02, abs=1e-7)
+
+
+def test_uncertainty_survives_the_urdf_export(ur5e, tmp_path):
+    from kinergy.model.library import read_robot_file
+    from kinergy.model.urdf_export import robot_to_urdf
+
+    robot = _with_errors(ur5e, 4)
+    path = tmp_path / "robot.urdf"
+    path.write_text(robot_to_urdf(robot).text, encoding="utf-8")
+    back = read_robot_file(path)
+    assert back.uncertainty is not None
+    np.testing.assert_allclose(back.uncertainty.modes, robot.uncertainty.modes)
