@@ -328,11 +328,18 @@ def documents(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[tuple[
         "json-validate": {
             "joint torques": ["validate", "ur5e", logs["torque"], "--accept", "robot", "--json"],
         },
-        "json-energy": {"a gap": ["energy", "ur5e", logs["gap"], "--json"]},
+        "json-energy": {
+            "a gap": ["energy", "ur5e", logs["gap"], "--json"],
+            "an identified model": ["energy", str(folder / "auto.toml"), logs["a"], "--json"],
+        },
         "json-optimize": {
             "URScript": [
                 "optimize", "ur5e", str(ROOT / "tests" / "programs" / "small.script"),
                 "--pareto-points", "0", "--json",
+            ],
+            "URScript, an identified model": [
+                "optimize", str(folder / "auto.toml"),
+                str(ROOT / "tests" / "programs" / "small.script"), "--json",
             ],
         },
         "json-place": {

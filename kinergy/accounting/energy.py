@@ -42,6 +42,7 @@ import numpy as np
 
 from kinergy.accounting.figures import EnergyFigures
 from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy
+from kinergy.accounting.uncertainty import EnergyIntervals, Sensitivity
 from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
 from kinergy.drives.transmission import transmission_matrix
@@ -131,9 +132,14 @@ class EnergyAccumulator:
     ``acc.figures()``.
     """
 
-    def __init__(self, robot: Robot, *, recovery: bool = True) -> None:
+    def __init__(self, robot: Robot, *, recovery: bool = True, intervals: bool = True) -> None:
         self.robot = robot
         self.recovery = recovery
+        self.sensitivity = (
+            Sensitivity(robot) if intervals and robot.uncertainty is not None else None
+        )
+        self.gradient: Array | None = None  # the sensitivities' integrals (2p,)
+        self.last_rows: Array | None = None  # the previous sample's sensitivities
         n = robot.n
         self._k = 6 * n + 4  # p_mech, p_elec, 4 parts (n each), totals, motors, shunt
         self.sums: Array | None = None
@@ -172,6 +178,7 @@ class EnergyAccumulator:
         *,
         starts: list[int],
         measured_power: Array | None = None,
+        temperature: Array | None = None,
     ) -> None:
         """Account the chunk at times ``t`` (s, (N,)) with drive state ``state``.
 
@@ -185,6 +192,9 @@ class EnergyAccumulator:
             continue the previous one's segment; the first chunk always begins one).
         measured_power : ndarray, shape (N,), optional
             The log's measured supply power (voltage x current), W; in every chunk or none.
+        temperature : ndarray, shape (N, n), optional
+            The joint temperatures the drive state was computed at (deg C), for the intervals'
+            gradients (:mod:`kinergy.accounting.uncertainty`).
         """
         y = self._integrands(state, measured_power)
         if self.sums is None:
@@ -194,19 +204,29 @@ class EnergyAccumulator:
         elif y.shape[1] != self.sums.size:
             raise KinergyError("measured supply columns in some chunks of a log only")
         cuts = sorted(starts)
+        rows = None if self.sensitivity is None else self.sensitivity.rows(state, temperature)
         if self.last is not None and (not cuts or cuts[0] != 0):
             t0, y0 = self.last  # the previous chunk's segment goes on: the step between them
             self.sums += 0.5 * (t[0] - t0) * (y0 + y[0])
             self.duration += float(t[0] - t0)
+            if rows is not None and self.last_rows is not None:
+                self._gradient(0.5 * (t[0] - t0) * (self.last_rows + rows[:, 0]))
         edges = [0, *(c for c in cuts if c > 0), t.size]
         for a, b in itertools.pairwise(edges):
-            self.sums += np.sum(trapezoid_weights(t[a:b])[:, None] * y[a:b], axis=0)
+            weights = trapezoid_weights(t[a:b])
+            self.sums += np.sum(weights[:, None] * y[a:b], axis=0)
             self.duration += float(t[b - 1] - t[a])
+            if rows is not None:
+                self._gradient(rows[:, a:b] @ weights)
+        self.last_rows = None if rows is None else rows[:, -1].copy()
         self.segments += len(starts)
         self.samples += t.size
         self.last = (float(t[-1]), y[-1].copy())
         self.current_sq += np.sum(state.current**2, axis=0)
         self.peak_current = np.maximum(self.peak_current, np.abs(state.current).max(axis=0))
+
+    def _gradient(self, add: Array) -> None:
+        self.gradient = add if self.gradient is None else self.gradient + add
 
     def figures(self, measured: bool = False) -> EnergyFigures:
         """The figures of everything added (:class:`EnergyFigures`), with the measured supply
@@ -230,6 +250,10 @@ class EnergyAccumulator:
         if measured:
             used = float(s[6 * n + 4])
             meas = MeasuredSupply(used, used / d if d else float("nan"), self.measured_peak)
+        intervals = None
+        if self.sensitivity is not None and self.gradient is not None:
+            values = (drawn, motors, s[n : 2 * n])
+            intervals = EnergyIntervals.of(self.sensitivity.uncertainty, self.gradient, d, values)
         return EnergyFigures(
             robot=self.robot.name,
             joints=self.robot.joint_names,
@@ -250,6 +274,7 @@ class EnergyAccumulator:
             total_e_elec=float(s[6 * n + 1]),
             supply=supply,
             measured=meas,
+            intervals=intervals,
         )
 
 
@@ -288,7 +313,8 @@ def energy(
     if state is None:
         state = drive_state(robot, motion.q, motion.qd, motion.qdd, temperature=temperature)
     acc = EnergyAccumulator(robot, recovery=recovery)
-    acc.add(motion.t, state, starts=[a for a, _ in segment_bounds(motion.t)])
+    starts = [a for a, _ in segment_bounds(motion.t)]
+    acc.add(motion.t, state, starts=starts, temperature=temperature)
     figures = acc.figures()
     p_mech, p_elec = state.p_mech, state.power
     if not recovery:

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from kinergy.accounting.supply import MeasuredSupply, SupplyEnergy
+from kinergy.accounting.uncertainty import NO_UNCERTAINTY, EnergyIntervals
 from kinergy.arrays import Array
 from kinergy.jsonable import to_jsonable
 
@@ -47,6 +48,9 @@ class EnergyFigures:
         J.
     supply : SupplyEnergy
     measured : MeasuredSupply or None
+    intervals : EnergyIntervals or None
+        95 % intervals of ``supply.drawn``, ``supply.motors`` and each ``e_elec`` from the model's
+        parameter errors (None: the model carries none, :mod:`kinergy.accounting.uncertainty`).
     """
 
     robot: str
@@ -68,6 +72,7 @@ class EnergyFigures:
     total_e_elec: float
     supply: SupplyEnergy
     measured: MeasuredSupply | None = None
+    intervals: EnergyIntervals | None = None
 
     @property
     def efficiency(self) -> Array:
@@ -122,6 +127,9 @@ class EnergyFigures:
             },
             "supply": to_jsonable(self.supply),
             **({"measured": self.measured_dict()} if self.measured is not None else {}),
+            "intervals": (
+                self.intervals.to_dict() if self.intervals is not None else {"note": NO_UNCERTAINTY}
+            ),
         }
 
     def measured_dict(self) -> dict[str, Any]:

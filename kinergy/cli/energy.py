@@ -8,6 +8,7 @@ import math
 import click
 
 from kinergy import api
+from kinergy.accounting.uncertainty import NO_UNCERTAINTY
 from kinergy.cli.common import (
     as_usage,
     choice_of,
@@ -56,6 +57,7 @@ def _supply_lines(result: api.LogEnergy) -> list[str]:
         f"{result.duration:.1f} s{share}); {sup.shunt:.1f} J of braking burnt in the shunt, "
         f"not drawn. Mean {sup.mean_power:.1f} W, peak {sup.peak_power:.1f} W.",
     ]
+    lines += _interval_lines(result)
     if measured is not None:
         error = result.measured_dict().get("error")
         lines.append(
@@ -67,6 +69,24 @@ def _supply_lines(result: api.LogEnergy) -> list[str]:
     if measured is not None:
         lines.append(f"  measured: {measured.includes}.")
     return lines
+
+
+def _interval_lines(result: api.LogEnergy) -> list[str]:
+    """The 95 % intervals from the model's parameter errors, or why there are none."""
+    iv = result.intervals
+    if iv is None:
+        return [f"95 % interval: none: {NO_UNCERTAINTY}."]
+    drawn, motors = iv.drawn, iv.motors
+    total = result.supply.drawn
+    share = f" (+-{100 * drawn.half_width / total:.1f} %)" if total else ""
+    joints = ", ".join(
+        f"{name} {e.low:.1f}..{e.high:.1f}"
+        for name, e in zip(result.joints, iv.e_elec, strict=True)
+    )
+    return [
+        f"95 % interval: drawn {drawn.low:.1f}..{drawn.high:.1f} J{share}, motors "
+        f"{motors.low:.1f}..{motors.high:.1f} J; E_elec {joints} J ({drawn.method}).",
+    ]
 
 
 def energy_text(result: api.LogEnergy) -> str:

@@ -16,6 +16,7 @@ from typing import Any, TypeVar
 import click
 
 from kinergy import api
+from kinergy.accounting.uncertainty import NO_UNCERTAINTY
 from kinergy.cli.common import (
     as_usage,
     choice_of,
@@ -28,6 +29,7 @@ from kinergy.cli.common import (
     table,
     writes,
 )
+from kinergy.model.uncertainty import Interval
 from kinergy.optimize import ParetoPoint, ProgramResult
 from kinergy.optimize.levers import Lever
 from kinergy.optimize.options import MAX_CYCLE_TIME
@@ -97,6 +99,21 @@ def _pareto_table(front: Sequence[ParetoPoint]) -> str:
     return table(["cycle [s]", "optimized [J]", "uniform [J]"], rows)
 
 
+def _saving_interval(iv: Interval | None) -> str:
+    """The saving's 95 % interval, and how to read it (or why there is none)."""
+    if iv is None:
+        return f"Saving's 95 % interval: none: {NO_UNCERTAINTY}."
+    verdict = (
+        "not established: the interval includes 0"
+        if iv.low <= 0.0 <= iv.high
+        else "established: the interval excludes 0"
+    )
+    return (
+        f"Saving's 95 % interval: {100 * iv.low:.1f} % .. {100 * iv.high:.1f} % ({verdict}; the "
+        "program and the optimised one on the same parameter errors)"
+    )
+
+
 def _levers_table(levers: Sequence[Lever]) -> str:
     rows = [
         [
@@ -160,6 +177,7 @@ def optimize_text(run: api.OptimizeRun) -> str:
         _levers_table(result.levers),
         "",
         *_saving(run),
+        _saving_interval(result.saving_interval),
     ]
     if stops:
         lines.append(

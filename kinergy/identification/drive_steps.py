@@ -62,15 +62,19 @@ __all__ = [
     "AUTO_CANDIDATES",
     "FOLDS",
     "HOLDINGS",
+    "JACKKNIFE_BLOCKS",
     "STILL_SPEED",
     "CurrentStats",
     "FrictionChoice",
+    "block_edges",
     "candidates",
     "current_step",
+    "grouped",
     "holdings_of",
     "joined",
     "motor_signals",
     "per_motor",
+    "replicates",
     "rotor_columns",
     "rotor_problem",
     "rotor_solution",
@@ -110,6 +114,10 @@ BASELINE = MODELS["viscous_coulomb"]
 MIN_TEMPERATURE_SPAN = 3.0
 #: contiguous blocks of the cross-validation that chooses a friction model
 FOLDS = 5
+#: contiguous time blocks of the jackknife that gives the parameters' errors (without ``auto``)
+JACKKNIFE_BLOCKS = 10
+#: samples per triangle of step 2 (:func:`rotor_problem`), grouped into the jackknife's blocks
+PIECE = 200
 
 
 def joined(problems: Sequence[Reduced]) -> Reduced:
@@ -132,20 +140,34 @@ def rotor_columns(n_mat: Array, dwm: Array) -> Array:
     return n_mat.T[None, :, :] * dwm[:, None, :]
 
 
-def rotor_problem(robot: Robot, logs: LogChunks) -> Reduced | None:
-    """Step 2's least squares (UR5e eqs 7-9) folded into a triangle (:class:`Reduced`), every
+def rotor_problem(robot: Robot, logs: LogChunks) -> list[Reduced] | None:
+    """Step 2's least squares (UR5e eqs 7-9) folded into triangles (:class:`Reduced`), every
     motor's column: ``tau_ref - f_link = N^T diag(J) N qdd`` with ``N`` the transmission matrix,
-    linear in J; rows (sample, joint) of every chunk with ``target_moment`` (None: there is
-    none)."""
+    linear in J; rows (sample, joint) of every chunk with ``target_moment``, one triangle per
+    :data:`PIECE` consecutive samples (:func:`joined` gives the whole problem, groups of them
+    the jackknife's blocks); None: there is none."""
     n_mat = transmission_matrix(robot)
-    problem, seen = Reduced.empty(robot.n), False
+    pieces: list[Reduced] = []
     for _, chunk in logs.chunks("tau_ref"):
         assert chunk.tau_ref is not None
         f_link = rnea(robot, chunk.q_cmd, chunk.qd_cmd, chunk.qdd_cmd)
         # rows (sample, joint), column m: contribution of J_m, n_mat[m, j] * (N qdd)_m
-        a = rotor_columns(n_mat, chunk.qdd_cmd @ n_mat.T).reshape(-1, robot.n)
-        problem, seen = problem.stack(a, (chunk.tau_ref - f_link).reshape(-1)), True
-    return problem if seen else None
+        a = rotor_columns(n_mat, chunk.qdd_cmd @ n_mat.T)
+        y = chunk.tau_ref - f_link
+        for lo in range(0, y.shape[0], PIECE):
+            rows = slice(lo, lo + PIECE)
+            piece = Reduced.empty(robot.n).stack(a[rows].reshape(-1, robot.n), y[rows].reshape(-1))
+            pieces.append(piece)
+    return pieces or None
+
+
+def grouped(pieces: Sequence[Reduced], blocks: int) -> list[Reduced]:
+    """Consecutive ``pieces`` joined into ``blocks`` groups of about equal rows (fewer when
+    there are fewer pieces)."""
+    rows = np.cumsum([p.rows for p in pieces])
+    cut = np.searchsorted(rows, np.linspace(0, rows[-1], blocks + 1)[1:-1], side="right")
+    edges = [0, *sorted(set(cut.tolist()) - {0, len(pieces)}), len(pieces)]
+    return [joined(pieces[a:b]) for a, b in itertools.pairwise(edges)]
 
 
 def rotor_solution(
@@ -508,6 +530,22 @@ def candidates(summary: Summary, m: int) -> list[FrictionModel]:
     return [c for c in AUTO_CANDIDATES if spans or not c.needs_temperature]
 
 
+def replicates(fit: _CurrentFit, blocks: _Blocks, kt_prior: float) -> Array | None:
+    """Delete-one-block jackknife replicates of eq 18's drive, shape (K, 1 + k): each row the
+    torque constant (N m/A) and the friction levels ``fit``'s model (shape and hold held)
+    gives without block k (:mod:`kinergy.identification.uncertainty`); a torque constant held
+    at the model's stays held. None with fewer than 3 blocks."""
+    if len(blocks.parts) < 3:
+        return None
+    rows = []
+    for k in range(len(blocks.parts)):
+        train = joined([p for i, p in enumerate(blocks.parts) if i != k])
+        x = solve_current(fit.model, fit.params, train, kt_prior).x
+        kt = 1.0 / fit.x[0] if fit.fixed else 1.0 / x[0]
+        rows.append(np.concatenate([[kt], x[1:] / x[0]]))
+    return np.array(rows)
+
+
 def _cv_errors(fit: _CurrentFit, blocks: _Blocks, kt_prior: float) -> Array:
     """Squared current error (A^2) of each block, ``fit``'s model (its shape and hold held)
     fitted on the others, shape (blocks,)."""
@@ -533,7 +571,7 @@ def _gain(
 
 def _auto_fit(
     m: int, joint: Joint, models: list[FrictionModel], holdings: Sequence[float], samples: int
-) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, FrictionChoice | None]]:
+) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, FrictionChoice | None, _Blocks]]:
     """``friction="auto"``: every candidate model fitted with its own standstill hold and scored
     by cross-validation; the lowest held-out RMS wins unless it beats Coulomb + viscous by no
     more than the standard error of that gain. Candidates whose regression is singular on these
@@ -546,7 +584,7 @@ def _auto_fit(
         if fit.cond <= MAX_CONDITION:
             fits[model], errors[model] = fit, _cv_errors(fit, blocks, kt)
     if not fits:  # every candidate singular: as the first (refused, naming it)
-        return tried[0][0], None
+        return tried[0][0], None, tried[0][1]
     scores = {c: float(np.sqrt(e.sum() / samples)) for c, e in errors.items()}
     ranked = sorted(scores, key=scores.__getitem__)
     best, gain, std = ranked[0], None, None
@@ -563,14 +601,14 @@ def _auto_fit(
         margin=100.0 * (1.0 - scores[best] / scores[others[0]]) if others else None,
         gain_std=std,
     )
-    return fits[best], choice
+    return fits[best], choice, dict(zip(models, tried, strict=True))[best][1]
 
 
 def _fixed_fit(
     m: int, joint: Joint, model: FrictionModel, holdings: Sequence[float]
-) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, FrictionChoice | None]]:
-    fit, _ = yield from _fit_model(m, joint, model, holdings)
-    return fit, None
+) -> Asks[_Trial, _Blocks, tuple[_CurrentFit, FrictionChoice | None, _Blocks]]:
+    fit, blocks = yield from _fit_model(m, joint, model, holdings)
+    return fit, None, blocks
 
 
 @dataclass(frozen=True)
@@ -582,6 +620,7 @@ class CurrentStats:
     friction_std: dict[str, float] | None = None
     condition_current: float | None = None
     flags: dict[str, Flag] = field(default_factory=dict)
+    replicates: Array | None = field(default=None, repr=False)
 
 
 def _unsupported(model: FrictionModel, values: Array, kt: float) -> str | None:
@@ -597,7 +636,7 @@ def _unsupported(model: FrictionModel, values: Array, kt: float) -> str | None:
 
 
 def _apply_current_fit(
-    m: int, joint: Joint, fit: _CurrentFit, said: Messages
+    m: int, joint: Joint, fit: _CurrentFit, said: Messages, jackknife: Array | None = None
 ) -> tuple[Joint, CurrentStats]:
     """``joint`` with the torque constant and friction of ``fit``, and their standard errors;
     a fit that is not a physical drive is not written (the model's values, flagged)."""
@@ -635,14 +674,18 @@ def _apply_current_fit(
         friction_std={name: float(s) for name, s in zip(names, value_std, strict=True)},
         condition_current=fit.cond,
         flags=flags,
+        replicates=jackknife,
     )
     return dataclasses.replace(joint, drive=drive), stats
 
 
-def _folds(logs: LogChunks) -> list[int]:
+def block_edges(logs: LogChunks, folds: bool) -> list[int]:
     """Where the cross-validation's blocks of the samples of the logs with currents (stacked)
-    begin and end: each log, when there are 3 or more, else :data:`FOLDS` contiguous blocks."""
+    begin and end: each log, when there are 3 or more, else :data:`FOLDS` contiguous blocks;
+    without ``auto`` (``folds=False``), :data:`JACKKNIFE_BLOCKS` contiguous blocks."""
     sizes = [logs.summaries[k].samples for k in logs.which("current")]
+    if not folds:
+        return np.linspace(0, sum(sizes), JACKKNIFE_BLOCKS + 1).astype(int).tolist()
     if len(sizes) >= 3:
         return [0, *np.cumsum(sizes).tolist()]
     return np.linspace(0, sum(sizes), FOLDS + 1).astype(int).tolist()
@@ -665,7 +708,7 @@ def current_step(
     active = [m for m in range(staged.n) if m not in problems]
     models = [options.family or j.drive.friction.model for j in staged.joints]
     summary = logs.summary("current")
-    edges = _folds(logs) if options.auto else [0, summary.samples]
+    edges = block_edges(logs, options.auto)
     several = options.auto or any(models[m].search for m in active)  # passes: keep the signals
     passes = _Passes(logs, staged, rotor, edges, several)
     if options.auto:
@@ -687,10 +730,11 @@ def current_step(
             held.append(None)
             chosen.append(None)
             continue
-        fit, choice = fits[m]
+        fit, choice, blocks = fits[m]
         held.append(float(fit.params.get("holding", 0.0)))
         chosen.append(choice)
-        new, stat = _apply_current_fit(m, joint, fit, said)
+        jackknife = replicates(fit, blocks, joint.drive.torque_constant)
+        new, stat = _apply_current_fit(m, joint, fit, said, jackknife)
         joints.append(new)
         stats.append(stat)
     return staged.with_joints(joints), stats, tuple(held), tuple(chosen)

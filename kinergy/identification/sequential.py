@@ -38,6 +38,7 @@ from kinergy.identification.drive_steps import (
     CurrentStats,
     FrictionChoice,
     current_step,
+    joined,
     rotor_problem,
     rotor_step,
     with_rotor_inertias,
@@ -54,6 +55,7 @@ from kinergy.identification.result import (
     drive_fields,
     fit_fields,
 )
+from kinergy.identification.uncertainty import jackknife_uncertainty
 from kinergy.jsonable import OPTIONAL
 from kinergy.logs.prepare import IdentData
 from kinergy.messages import Messages
@@ -174,7 +176,7 @@ def _joints(
     out = []
     for j, joint in enumerate(identified.joints):
         flags, errors = _drive_flags(joint, float(inertia[j]), float(std[j]), stats[j])
-        fields = {k: v for k, v in vars(stats[j]).items() if k != "flags"}
+        fields = {k: v for k, v in vars(stats[j]).items() if k not in ("flags", "replicates")}
         out.append(
             SequentialJoint(
                 **drive_fields(joint),
@@ -237,7 +239,8 @@ def sequential(
     """The sequential identification (module docstring) by passes over ``logs``' chunks; as
     :func:`identify_sequential`, ``options`` saying how step 3 fits the currents."""
     options = options or CurrentOptions()
-    rotor_triangle = rotor_problem(robot, logs)  # the first pass, when none was made yet
+    rotor_pieces = rotor_problem(robot, logs)  # the first pass, when none was made yet
+    rotor_triangle = None if rotor_pieces is None else joined(rotor_pieces)
     problems = motion_problems(robot, logs.summary())
     said = Messages([f"{text}; kept the model's values" for text in problems.values()])
     has_ref, has_current = logs.any("tau_ref"), logs.any("current")
@@ -272,6 +275,8 @@ def sequential(
         friction_choice=choices if options.auto else None,
     )
     joints = _joints(identified, (rotor, rotor_std), problems, stats)
+    errors = jackknife_uncertainty(identified, rotor_pieces, [j.flags for j in joints], stats)
+    identified = dataclasses.replace(identified, uncertainty=errors)
     return IdentificationResult(identified, "sequential", joints, fit)
 
 

@@ -26,6 +26,7 @@ from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.friction.model import FrictionModel
 from kinergy.friction.registry import get_model
+from kinergy.model.uncertainty import Uncertainty, parameter_value
 
 __all__ = [
     "CONVENTIONS",
@@ -586,6 +587,9 @@ class Robot:
         DC bus voltage the joints are supplied from, V (48 V on UR e-Series).
     identified : Identified or None
         Where the model was identified from, when it was (``kinergy identify`` writes it).
+    uncertainty : Uncertainty or None
+        The identified parameters' errors (:mod:`kinergy.model.uncertainty`); None for a model
+        that carries none (a built-in one, a data sheet).
     """
 
     name: str
@@ -601,6 +605,7 @@ class Robot:
     standby_power: float = 0.0
     bus_voltage: float = 48.0
     identified: Identified | None = None
+    uncertainty: Uncertainty | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -656,6 +661,11 @@ class Robot:
         for cat in SOURCE_CATEGORIES:
             sources.setdefault(cat, Source("user"))
         object.__setattr__(self, "sources", sources)
+        if self.uncertainty is not None and not _resolves(self, self.uncertainty):
+            raise KinergyError(
+                "uncertainty.parameters: names a parameter this robot does not have "
+                f"({', '.join(self.uncertainty.parameters)})"
+            )
 
     @property
     def n(self) -> int:
@@ -674,7 +684,21 @@ class Robot:
         """A copy of this robot with other joints (same count)."""
         if len(joints) != self.n:
             raise KinergyError(f"expected {self.n} joints, got {len(joints)}")
-        return dataclasses.replace(self, joints=tuple(joints))
+        out = dataclasses.replace(self, joints=tuple(joints), uncertainty=None)
+        if self.uncertainty is not None and _resolves(out, self.uncertainty):
+            out = dataclasses.replace(out, uncertainty=self.uncertainty)
+        return out
+
+
+def _resolves(robot: Robot, uncertainty: Uncertainty) -> bool:
+    """Whether every parameter ``uncertainty`` names is one of ``robot``'s (a joint's friction
+    family changed, its errors no longer apply: :meth:`Robot.with_joints` drops them)."""
+    try:
+        for name in uncertainty.parameters:
+            parameter_value(robot, name)
+    except (KinergyError, IndexError, KeyError):
+        return False
+    return True
 
 
 def transmission_matrix(robot: Robot) -> Array:

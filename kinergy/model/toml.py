@@ -9,6 +9,11 @@ version :data:`ROBOT_SCHEMA`); :func:`robot_from_dict` reads it back from any of
     gravity = [0.0, 0.0, -9.81]       # optional
     standby_power = 0.0               # optional, W: the arm's electronics and brakes, drawn whatever the motion
     bus_voltage = 48.0                # optional, V: DC bus of the joints
+    [uncertainty]                     # optional: identified parameters' errors (model/uncertainty.py)
+    method = "jackknife over 10 time blocks"
+    dof = 9
+    parameters = ["joints[0].rotor_inertia", "joints[0].torque_constant", "standby_power"]
+    modes = [[...], ...]              # K rows x p: the covariance is modes^T modes
     description = "..."               # optional
     coupling = [[...], ...]           # optional, n x n (differential joints)
     [flange]                          # optional: pose of the flange in the last link frame
@@ -84,6 +89,7 @@ from kinergy.model.robot import (
     Thermal,
     TorqueSensor,
 )
+from kinergy.model.uncertainty import uncertainty_from_dict, uncertainty_to_dict
 
 __all__ = [
     "ROBOT_SCHEMA",
@@ -115,6 +121,7 @@ _ROBOT_KEYS = {
     "joints",
     "standby_power",
     "bus_voltage",
+    "uncertainty",
 }
 _JOINT_KEYS = {
     "name",
@@ -313,6 +320,7 @@ def robot_from_dict(data: Mapping[str, Any]) -> Robot:
     flange = _pose_from_dict(data["flange"], "flange") if "flange" in data else np.eye(4)
     base = _pose_from_dict(data["base"], "base") if "base" in data else np.eye(4)
     identified = _identified(data["identified"]) if "identified" in data else None
+    uncertainty = uncertainty_from_dict(data["uncertainty"]) if "uncertainty" in data else None
     return Robot(
         name=_take(data, "name", "robot"),
         convention=_take(data, "convention", "robot"),
@@ -327,6 +335,7 @@ def robot_from_dict(data: Mapping[str, Any]) -> Robot:
         standby_power=data.get("standby_power", 0.0),
         bus_voltage=data.get("bus_voltage", 48.0),
         identified=identified,
+        uncertainty=uncertainty,
     )
 
 
@@ -419,6 +428,8 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
     }
     if robot.identified is not None:
         out["identified"] = identified_to_dict(robot.identified)
+    if robot.uncertainty is not None:
+        out["uncertainty"] = uncertainty_to_dict(robot.uncertainty)
     joints = []
     for j in robot.joints:
         drive: dict[str, Any] = {key: getattr(j.drive, key) for key in _DRIVE_NUMBERS}

@@ -38,8 +38,11 @@ from typing import Any
 
 import numpy as np
 
+from kinergy.accounting.uncertainty import NO_UNCERTAINTY
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.model.robot import Robot
+from kinergy.model.uncertainty import Interval, interval
 from kinergy.optimize.levers import (
     Lever,
     LeverSearch,
@@ -186,6 +189,41 @@ class ProgramOptimization:
         return 1.0 - self.optimized.result.e_elec / self.program.result.e_elec
 
     @property
+    def saving_gradient(self) -> Array | None:
+        """The saving's gradient over the model's parameter errors: of ``1 - S_o / S_p``,
+        ``(S_o g_p / S_p - g_o) / S_p`` with the program's and the optimised one's supply
+        energies ``S`` and their gradients ``g`` on the same parameters, so that errors both
+        share cancel; None when the model carries none (:mod:`kinergy.model.uncertainty`)."""
+        p, o = self.program, self.optimized
+        if p.errors is None or p.gradient is None or o.gradient is None:
+            return None
+        g_p, g_o = p.gradient.copy(), o.gradient.copy()
+        if "standby_power" in p.errors.parameters and self.settings.options.standby is None:
+            k = p.errors.parameters.index("standby_power")
+            g_p[k] += p.result.cycle_time
+            g_o[k] += o.result.cycle_time
+        s_p, s_o = p.result.e_supply, o.result.e_supply
+        return (s_o * g_p / s_p - g_o) / s_p
+
+    @property
+    def saving_interval(self) -> Interval | None:
+        """The saving's 95 % interval (0-1) from :attr:`saving_gradient` (None without errors)."""
+        g = self.saving_gradient
+        return None if g is None else interval(self.program.errors, self.saving, g)
+
+    def _interval_dict(self) -> dict[str, Any]:
+        iv = self.saving_interval
+        if iv is None:
+            return {"note": NO_UNCERTAINTY}
+        return {
+            "low": iv.low,
+            "high": iv.high,
+            "std": iv.std,
+            "level": iv.level,
+            "method": iv.method,
+        }
+
+    @property
     def targets_met(self) -> bool:
         """Every stop within 1 mm and 0.5 deg of its target and at rest."""
         dist, angle, speed = TARGET_TOL
@@ -208,6 +246,7 @@ class ProgramOptimization:
             "targets_met": self.targets_met,
             "settings": self.settings.to_dict(),
             "pareto": [p.to_dict() for p in self.pareto],
+            "saving_interval": self._interval_dict(),
         }
 
 

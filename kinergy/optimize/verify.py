@@ -28,6 +28,7 @@ from kinergy.accounting.energy import energy
 from kinergy.arrays import Array
 from kinergy.dynamics.poses import tcp_pose
 from kinergy.model.robot import Robot
+from kinergy.model.uncertainty import Uncertainty
 from kinergy.optimize.constraints import LimitCheck, limit_violations
 from kinergy.optimize.objectives import Objective, SupplyEnergy
 from kinergy.optimize.options import ToolSymmetry
@@ -146,12 +147,16 @@ class ProgramResult:
 
 @dataclass(frozen=True, eq=False)
 class PathRun:
-    """A program re-simulated at 500 Hz: the result, the motion and its schedule."""
+    """A program re-simulated at 500 Hz: the result, the motion and its schedule; where the
+    model carries parameter errors (``errors``), the gradient of the motors' supply energy
+    ``result.e_elec`` over them (J per parameter unit, :mod:`kinergy.accounting.uncertainty`)."""
 
     result: ProgramResult
     motion: Motion
     schedule: Schedule
     path: ProgramPath
+    gradient: Array | None = None
+    errors: Uncertainty | None = None
 
 
 def simulate_path(
@@ -221,7 +226,8 @@ def simulate_path(
         score=float(score[0]),
         standby=standby,
     )
-    return PathRun(result, motion, sched, path)
+    gradient = None if report.intervals is None else report.intervals.gradients["motors"]
+    return PathRun(result, motion, sched, path, gradient, robot.uncertainty)
 
 
 @dataclass(frozen=True)

@@ -279,7 +279,8 @@ def energy_of_log(
         state = _drive(robot, part.log, m)
         power = _measured_power(part.log)
         measured = power is not None
-        acc.add(m.t, state, starts=part.starts, measured_power=power)
+        temperature = _temperature(part.log, m)
+        acc.add(m.t, state, starts=part.starts, measured_power=power, temperature=temperature)
         for sink in sinks:
             sink.add(m.t, supply_predicted(robot, state), power, state.power)
         if len(m.t):

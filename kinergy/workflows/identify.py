@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from kinergy._version import __version__
+from kinergy.accounting.uncertainty import Sensitivity
 from kinergy.drives.bus import supply_power
 from kinergy.drives.electrics import electrical_power, torque_constants
 from kinergy.drives.transmission import transmission_matrix
@@ -30,6 +31,11 @@ from kinergy.identification.payload import PayloadEstimate, payload
 from kinergy.identification.result import IDENTIFIED, IdentificationResult, validation_metrics
 from kinergy.identification.sanity import check_motion
 from kinergy.identification.sequential import sequential
+from kinergy.identification.uncertainty import (
+    fold_gradients,
+    supply_calibration,
+    with_standing_draw,
+)
 from kinergy.io.columns import compact_columns
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
@@ -252,25 +258,35 @@ def _predicted_currents(robot: Robot, logs: LogChunks) -> list[np.ndarray]:
 
 def _standing_draw(
     robot: Robot, logs: LogChunks, currents: list[np.ndarray] | None
-) -> StandingDraw:
+) -> tuple[StandingDraw, float | None]:
     """The supply power less the motors' draw (UR5e eq 23 on the ``currents`` ``robot``
     predicts, else on its :func:`~kinergy.predict.drive_state`), folded into
-    :class:`~kinergy.identification.electrics.StandingDrawSums`."""
+    :class:`~kinergy.identification.electrics.StandingDrawSums`; and, when ``robot`` carries
+    parameter errors, their calibration factor on the same blocks
+    (:func:`~kinergy.identification.uncertainty.supply_calibration`; else None)."""
     n_mat, kt = transmission_matrix(robot), torque_constants(robot)
     held = data_history(robot)
     sums = StandingDrawSums()
+    sensitivity = None if robot.uncertainty is None else Sensitivity(robot)
+    gradients: dict[tuple[int, int], np.ndarray] = {}
     for c, (k, chunk) in enumerate(logs.chunks()):
         assert chunk.supply_voltage is not None and chunk.supply_current is not None
-        if currents is not None:
+        if currents is not None and sensitivity is None:
             power = electrical_power(robot, currents[c] * kt, chunk.qd @ n_mat.T)
         else:
             data, skip = held.ahead(k, chunk)
             state = drive_state(robot, data.q, data.qd, data.qdd, temperature=data.temperature)
             held.update(data, skip)
             power = state.power[skip:]
+            if sensitivity is not None:
+                cols = sensitivity.rows(state, data.temperature)[sensitivity.p :, skip:].T
+                fold_gradients(gradients, sums, k, chunk.t, cols)
         supply = np.asarray(chunk.supply_voltage * chunk.supply_current, dtype=float)
         sums.add(k, chunk.t, supply - supply_power(power).motors)
-    return sums.fit()
+    draw = sums.fit()
+    if sensitivity is None:
+        return draw, None
+    return draw, supply_calibration(sensitivity.uncertainty, sums, gradients, draw.power)
 
 
 def _bus_voltage(logs: LogChunks, name: str) -> float:
@@ -308,8 +324,11 @@ def measured_electrics(result: IdentificationResult, logs: LogChunks) -> Identif
     if has_supply:
         model = result.robot  # the currents its validation kept
         currents = _predicted_currents(model, logs) if logs.every("current") else None
-        draw = _standing_draw(model, logs, currents)
+        draw, factor = _standing_draw(model, logs, currents)
         robot = dataclasses.replace(robot, standby_power=max(draw.power, 0.0))
+        if np.isfinite(draw.std) and robot.uncertainty is not None:
+            errors = with_standing_draw(robot.uncertainty, draw.std, factor)
+            robot = dataclasses.replace(robot, uncertainty=errors)
         sources["supply"] = Source(
             "identified",
             f"kinergy identify: standing draw {draw.power:.4g} +- {draw.std:.2g} W (standard "
