@@ -9,15 +9,32 @@ on stderr (``kinergy: note: ...``, ``kinergy: warning: ...``; ``--quiet`` drops 
 A message is a :class:`Message`: its text, and a :class:`~kinergy.errors.Code` where a caller
 must pick it out (``PayloadRun.lacks`` takes the warnings coded ``PAYLOAD_MISSING``), so that no
 caller searches the text.
+
+Long work says how far it is through a :class:`Say` hook: a step's name, and where the step has
+parts (placements, logs, starts) how many of them are done, so that a terminal shows a fraction
+and the time left (the command line's progress bar; nothing on a pipe).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Protocol
 
 from kinergy.errors import Code
 
-__all__ = ["Message", "Messages", "coded"]
+__all__ = ["Message", "Messages", "Say", "coded", "silent"]
+
+
+class Say(Protocol):
+    """A progress hook: ``say(message)`` starts a step; ``say(message, done=k, total=n)``
+    starts or advances a step of ``n`` parts, ``k`` of them done (``0 <= k <= n``)."""
+
+    def __call__(self, message: str, *, done: int | None = None, total: int | None = None) -> None:
+        """Say where the work is."""
+
+
+def silent(message: str, *, done: int | None = None, total: int | None = None) -> None:
+    """A :class:`Say` hook that says nothing."""
 
 
 class Message(str):

@@ -18,6 +18,7 @@ from kinergy.cli.common import (
     payload_option,
     prose,
     repair_option,
+    swapped,
     table,
     tell,
     topic_option,
@@ -155,6 +156,7 @@ def energy(
     with --columns), a motion file, a URScript program (.script) or a built-in motion (test-a,
     test-b: the UR5e doc's tests A and B planned for MODEL).
     """
+    swapped(model, [motion_path])
     r = load(model, None)
     reading = log_reading(
         r,

@@ -123,7 +123,7 @@ def excite_options(robot: Robot, flags: Mapping[str, Any]) -> ExciteOptions:
 
 
 def _fmt_margins(margins: Mapping[str, float]) -> str:
-    units = {"position": "rad", "speed": "rad/s", "acceleration": "rad/s^2", "floor": "m"}
+    units = {"position": "rad", "speed": "rad/s", "acceleration": "rad/s²", "floor": "m"}
     return ", ".join(f"{k} {margins[k]:.4g} {u}" for k, u in units.items() if k in margins)
 
 
@@ -227,7 +227,7 @@ def excite_text(run: ExciteRun) -> str:
     "--acceleration",
     type=Finite(),
     default=None,
-    help="Acceleration limit, rad/s^2 [the robot's; 2/s times the speed limit where it has none].",
+    help="Acceleration limit, rad/s² [the robot's; 2/s times the speed limit where it has none].",
 )
 @click.option(
     "--no-drives",

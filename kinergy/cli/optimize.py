@@ -85,7 +85,7 @@ def _moves_table(prog: ProgramResult, opt: ProgramResult) -> str:
         ]
         for k in range(prog.speeds.size)
     ]
-    headers = ["move", "v [rad/s]", "a [rad/s^2]", "t [s]", "E [J]", "v opt", "a opt", "t opt"]
+    headers = ["move", "v [rad/s]", "a [rad/s²]", "t [s]", "E [J]", "v opt", "a opt", "t opt"]
     return table([*headers, "E opt"], rows)
 
 
@@ -103,7 +103,7 @@ def _totals_table(result: TimingResult) -> str:
         for label, p in (
             ("program as written", result.program),
             ("uniform scaling", result.uniform),
-            ("optimized", result.optimized),
+            ("optimised", result.optimized),
         )
     ]
     headers = ["", "cycle [s]", "E_elec [J]", *(f"{k} [J]" for k in _PARTS), "within limits"]
@@ -145,7 +145,7 @@ def _pareto_table(front: Sequence[ParetoPoint]) -> str:
         ]
         for p in front
     ]
-    return table(["cycle [s]", "optimized [J]", "uniform [J]"], rows)
+    return table(["cycle [s]", "optimised [J]", "uniform [J]"], rows)
 
 
 def optimize_text(run: OptimizeRun) -> str:
@@ -358,7 +358,7 @@ def program_options(
     "a_max",
     type=Finite(),
     default=None,
-    help="Cap on every joint's acceleration, rad/s^2 [default: the model's limits; a UR model "
+    help="Cap on every joint's acceleration, rad/s² [default: the model's limits; a UR model "
     "has none, so the torque limits bound it].",
 )
 @click.option(

@@ -337,7 +337,7 @@ def _merge_note(k: int, cols: Columns, kept: Index, coef: Array | None) -> tuple
     """Warning text and entry for the dropped column ``k`` (``coef``: its column as a combination
     of the kept columns, ``None`` when it is zero)."""
     name, value = cols.names[k], float(cols.prior[k])
-    unit = " kg m^2" if cols.group[k] == "rotor" else " (motor side)"
+    unit = " kg m²" if cols.group[k] == "rotor" else " (motor side)"
     if coef is None:
         text = f"{name} is not excited by the logs (its column is zero): kept the model's {value:.4g}{unit}"
         return text, MergedColumn(name, value, ())

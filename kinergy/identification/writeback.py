@@ -195,10 +195,10 @@ def _with_rotor(m: int, joint: Joint, rotor: float, said: Messages) -> Drive:
     # the identified one (arms with link-side torque sensors see about 0)
     reducer = max(rotor, 0.0)
     said.note(
-        f"joint {m + 1} ({joint.name}): identified rotor inertia {rotor:.3g} kg m^2 is "
+        f"joint {m + 1} ({joint.name}): identified rotor inertia {rotor:.3g} kg m² is "
         + ("not positive" if rotor <= 0.0 else "below the model's reducer inertia")
         + f" ({drive.reducer_inertia:.3g}): motor inertia set to 0 and reducer inertia "
-        f"to {reducer:.3g} kg m^2"
+        f"to {reducer:.3g} kg m²"
     )
     return dataclasses.replace(drive, motor_inertia=0.0, reducer_inertia=reducer)
 

@@ -149,7 +149,7 @@ def unsupported_fit(result: IdentificationResult, share: float = 1.0) -> str:
             continue
         for k, m in enumerate(metrics):
             if moved[k] and m.r2 < 0:
-                worst.append(f"{result.robot.joints[k].name} {unit} R^2 {m.r2:.2f}")
+                worst.append(f"{result.robot.joints[k].name} {unit} R² {m.r2:.2f}")
     if worst and share < MIN_MOTION_SHARE:
         return (
             f"too little motion to identify from: the joints move on {100 * share:.0f} % of the "
@@ -311,7 +311,7 @@ def measured_electrics(result: IdentificationResult, logs: LogChunks) -> Identif
         robot = dataclasses.replace(robot, standby_power=max(draw.power, 0.0))
         sources["supply"] = Source(
             "identified",
-            f"kinergy identify: standing draw {draw.power:.4g} +- {draw.std:.2g} W (standard "
+            f"kinergy identify: standing draw {draw.power:.4g} ± {draw.std:.2g} W (standard "
             "error) from actual_robot_voltage x actual_robot_current less the motors' draw",
         )
         notes.append(

@@ -22,7 +22,7 @@ from kinergy.trajectory.programs import TEST_TRAJECTORIES, paper_trajectory
 from kinergy.twin import Mismatch, TwinSettings, realistic_truth, simulate
 from kinergy.workflows.logs import read_motion
 
-__all__ = ["builtin_log", "is_builtin", "simulate_to_file", "twin_truth"]
+__all__ = ["builtin_log", "check_source", "is_builtin", "simulate_to_file", "twin_truth"]
 
 
 def twin_truth(robot: Robot, mismatch: Mismatch | str, seed: int) -> Robot:
@@ -35,6 +35,23 @@ def twin_truth(robot: Robot, mismatch: Mismatch | str, seed: int) -> Robot:
 def is_builtin(name: object) -> TypeGuard[str]:
     """Whether ``name`` names a built-in motion (``test-a``, ``test-b``) rather than a file."""
     return isinstance(name, str) and name in TEST_TRAJECTORIES and not os.path.exists(name)
+
+
+def check_source(name: str | os.PathLike[str] | Log) -> None:
+    """Refuse a log or motion named ``name`` that is neither a file or folder nor a built-in
+    motion, listing the built-in motions (``test-c`` is a slip for ``test-a`` or ``test-b``).
+
+    Raises
+    ------
+    KinergyError
+        ``test-c: no such file or folder, nor a built-in motion (test-a, test-b)``.
+    """
+    if isinstance(name, Log) or is_builtin(name) or os.path.lexists(name):
+        return
+    raise KinergyError(
+        f"{os.fspath(name)}: no such file or folder, nor a built-in motion "
+        f"({', '.join(TEST_TRAJECTORIES)})"
+    )
 
 
 def builtin_log(robot: Robot, name: str, seed: int = 0) -> Log:
