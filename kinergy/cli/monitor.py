@@ -42,7 +42,9 @@ def monitor(
 ) -> None:
     """Energy of every program cycle, live: the supply's (voltage x current) against the model's.
 
-    Cycles are found from the repeating commanded joint angles; Ctrl-C stops.
+    Cycles are found from the repeating commanded joint angles (a cycle is reported once the
+    motion has repeated); until the first one, a line a second on stderr says how much has come.
+    Ctrl-C stops.
     """
     robot = load(model, None)
     shown: list[CycleEnergy] = []
@@ -54,6 +56,14 @@ def monitor(
         if not as_json:
             click.echo(_line(cycle))
 
+    def waiting(seconds: float, samples: int, period: float | None) -> None:
+        found = "period not found yet" if period is None else f"period {fmt(period)} s"
+        click.echo(
+            f"waiting for the first cycle: {seconds:.1f} s of controller time, {samples} "
+            f"samples, {found}",
+            err=True,
+        )
+
     with progress() as say:
         tracker = monitor_cycles(
             address,
@@ -63,6 +73,7 @@ def monitor(
             on_cycle=show,
             status=say,
             accept=parse_accept(accept),
+            waiting=waiting,
         )
     period = "not found" if tracker.period is None else f"{fmt(tracker.period)} s"
     if as_json:

@@ -24,13 +24,13 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from kinergy.errors import KinergyError
+from kinergy.messages import Say, silent
 from kinergy.model.robot import Robot
 from kinergy.optimize.options import ProgramOptions
 from kinergy.optimize.programs import ProgramOptimization, optimize_program
@@ -307,7 +307,7 @@ def place_program(
     grid: PlacementGrid,
     options: ProgramOptions | None = None,
     *,
-    progress: Callable[[str], None] | None = None,
+    progress: Say | None = None,
 ) -> PlacementSearch:
     """Every placement of ``grid`` and today's, each checked and optimised (module docstring).
 
@@ -320,8 +320,8 @@ def place_program(
     options : ProgramOptions, optional
         The levers (as :func:`kinergy.optimize.programs.optimize_program`); the cycle time and
         caps default to today's program's own and hold for every candidate.
-    progress : callable, optional
-        Called with a line before each candidate.
+    progress : Say, optional
+        Told each step, and before each candidate how many of them are done.
 
     Raises
     ------
@@ -329,7 +329,7 @@ def place_program(
         Today's program cannot run; no candidate reaches every pose within every limit (one line
         with the commonest reason).
     """
-    say = progress if progress is not None else (lambda _: None)
+    say = progress if progress is not None else silent
     options = ProgramOptions() if options is None else options
     placements = grid.placements()
     say(f"checking the reach of {len(placements)} placements")
@@ -352,7 +352,7 @@ def place_program(
         if isinstance(moved, Candidate):
             candidates.append(moved)
             continue
-        say(f"placement {i + 1}/{len(placements)}: {placement.label()}")
+        say(f"placement {placement.label()}", done=i, total=len(placements))
         found = today if placement.today else _optimised(robot, moved, placement, fixed)
         if found.reachable and (best is None or _better(found, best)):
             best = found  # the only one whose optimisation is kept, besides today's
