@@ -185,3 +185,22 @@ def _numbers(value: object) -> list[float]:
     if isinstance(value, list):
         return [x for v in value for x in _numbers(v)]
     return [float(value) if isinstance(value, int | float) else 0.0]
+
+
+@real
+def test_a_window_on_a_converted_bag_is_the_window_on_the_csv(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--from/--to on a bag: seconds from its first stamp (the CSV's 1141.591 s): the energy of
+    a window of the bag is the energy of the same window of the CSV."""
+    bag = str(tmp_path / "ptp")
+    _run(["convert", str(PTP), "--to", "bag", bag, "--robot", "ur10e", "--columns", FULL], capsys)
+    start = float(read_log(PTP, columns=ONLY).t[0])
+    bag_json = _run(["energy", "ur10e", bag, "--from", "10", "--to", "20", "--json"], capsys)[0]
+    window = ["--from", repr(start + 10.0), "--to", repr(start + 20.0)]
+    csv_json = _run(["energy", "ur10e", str(PTP), "--columns", ONLY, *window, "--json"], capsys)[0]
+    import json
+
+    bag_out, csv_out = json.loads(bag_json), json.loads(csv_json)
+    assert bag_out["samples"] == csv_out["samples"] and 900 < bag_out["samples"] < 1100
+    assert bag_out["total"]["e_elec"] == pytest.approx(csv_out["total"]["e_elec"], rel=1e-9)

@@ -288,8 +288,7 @@ def identify(
             say(f"reading {len(logs)} log(s) and identifying the payload")
             run = identify_payload_model(r, logs, out, reading)
         else:
-            say(f"reading and identifying {len(logs)} log(s) ({method} method)")
-            result = identify_logs(r, logs, out, reading=reading, options=options)
+            result = identify_logs(r, logs, out, reading=reading, options=options, progress=say)
     if payload_only:
         tell(run.notes, run.warnings)
         click.echo(

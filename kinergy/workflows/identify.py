@@ -37,7 +37,7 @@ from kinergy.jsonable import to_jsonable
 from kinergy.logs.checks import Check
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs, LogReading
-from kinergy.messages import coded
+from kinergy.messages import Say, coded, silent
 from kinergy.model import Robot, save_robot
 from kinergy.model.robot import Identified, InputRecord, Source
 from kinergy.predict import drive_state
@@ -189,9 +189,11 @@ def identify_logs(
     reading: LogReading | None = None,
     options: IdentifyOptions | None = None,
     rows: int = CHUNK_ROWS,
+    progress: Say = silent,
 ) -> IdentificationResult:
     """Read (through the checks), prepare and identify ``logs`` (files or logs in memory) and
-    write the model to ``out`` when given.
+    write the model to ``out`` when given; ``progress`` is told each log read (of all) and
+    when the identification starts.
 
     ``reading`` says how to read the logs (:class:`~kinergy.logs.reading.LogReading`),
     ``options`` what to identify. The logs are read in chunks of ``rows`` samples and never held
@@ -207,7 +209,11 @@ def identify_logs(
     """
     reading = reading or LogReading()
     options = options or IdentifyOptions()
-    with chunked_logs(logs, robot, reading, rows=max(rows, 2)) as (segments, inputs):
+    with chunked_logs(logs, robot, reading, rows=max(rows, 2), progress=progress) as (
+        segments,
+        inputs,
+    ):
+        progress(f"identifying ({options.method.value} method)")
         start = one_payload(reading.loaded(robot), segments, inputs.notes)
         chunks = LogChunks(segments, rows, check=_checks)
         try:

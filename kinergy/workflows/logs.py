@@ -28,6 +28,7 @@ from kinergy.logs.prepare import (
 )
 from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.logs.samples import used_bounds
+from kinergy.messages import Say, silent
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion, MotionSource
 from kinergy.trajectory.program_motion import program_motion
@@ -102,15 +103,19 @@ def chunked_logs(
     reading: LogReading,
     *,
     rows: int = CHUNK_ROWS,
+    progress: Say = silent,
 ) -> Iterator[tuple[list[PreparedSegment], InputLogs]]:
     """Every log read once, through the checks (:class:`~kinergy.logs.reading.CheckedLog`, in
     chunks of ``rows``), into a temporary spill removed on leaving the context, and its segments
     prepared (:func:`kinergy.logs.prepare.prepare_segment`): each yields its samples in chunks of
-    any size, equal to the whole segment's preparation."""
+    any size, equal to the whole segment's preparation. ``progress`` is told each log read, of
+    all."""
     inputs = InputLogs()
     with contextlib.ExitStack() as stack:
         segments: list[PreparedSegment] = []
-        for path in paths:
+        for k, path in enumerate(paths):
+            name = path.path if isinstance(path, Log) else os.fspath(path)
+            progress(f"reading and preparing {os.path.basename(name)}", done=k, total=len(paths))
             checked = CheckedLog(path, robot, reading, select=SPILLED, rows=rows)
             spill = spill_log(checked)
             stack.callback(spill.close)
