@@ -368,11 +368,15 @@ def merged_columns(ols: OlsFit, cols: Columns) -> Merging:
     entries, said, rotor = [], Messages(), {}
     for i, k in enumerate(dropped):
         text, entry = _merge_note(int(k), cols, kept, coef[:, i] if excited[i] else None)
-        said.note(text)
         entries.append(entry)
         if cols.group[k] == "rotor" and entry.into and all(e.index < n_link for e in entry.into):
             c_vec = np.zeros(n_link)
             for e in entry.into:
                 c_vec[e.index] = e.coefficient
             rotor[int(k - n_link)] = c_vec
+            # the physically constrained fit may move it: "kept" would not be true then
+            text = text.replace("kept the model's", "the regression keeps the model's") + (
+                " (a physically constrained fit may move it: the model file holds what is written)"
+            )
+        said.note(text)
     return Merging(tuple(entries), said, rotor)
