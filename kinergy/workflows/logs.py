@@ -96,6 +96,27 @@ def prepared_logs(
         return [s.whole() for s in segments], inputs
 
 
+def _resampled_notes(resampled: Sequence[tuple[str, int, int, float]]) -> list[str]:
+    """The note on a log's segments resampled onto a regular grid (name, rows, samples, step
+    in s each): one note for all of a log's segments."""
+    if len(resampled) == 1:
+        name, rows, samples, step = resampled[0]
+        return [
+            f"{name}: irregular time stamps: its {rows} rows resampled to {samples} samples "
+            f"{step * 1e3:.4g} ms apart (the counts identify and validate give)"
+        ]
+    if not resampled:
+        return []
+    each = ", ".join(
+        f"{name} {rows} to {samples} ({step * 1e3:.4g} ms)"
+        for name, rows, samples, step in resampled
+    )
+    return [
+        f"irregular time stamps: segments resampled onto a regular grid, rows to samples (the "
+        f"counts identify and validate give): {each}"
+    ]
+
+
 @contextlib.contextmanager
 def chunked_logs(
     paths: Sequence[str | os.PathLike[str] | Log],
@@ -121,16 +142,14 @@ def chunked_logs(
             stack.callback(spill.close)
             inputs.add(checked)
             cuts = [start for start, _ in spill.loads[1:]]
+            resampled: list[tuple[str, int, int, float]] = []
             for name, ab in _segments(checked.path, spill.state, inputs.notes, cuts):
                 prepared = prepare_segment(spill, ab, name, robot.n, reading.cutoff)
                 if prepared.grid is not None:
                     rows = prepared.rows.stop - prepared.rows.start
-                    inputs.notes.append(
-                        f"{name}: irregular time stamps: its {rows} rows resampled to "
-                        f"{prepared.grid[1]} samples {prepared.grid[0] * 1e3:.4g} ms apart (the "
-                        "counts identify and validate give)"
-                    )
+                    resampled.append((name, rows, prepared.grid[1], prepared.grid[0]))
                 segments.append(prepared)
+            inputs.notes += _resampled_notes(resampled)
         yield segments, inputs
 
 
