@@ -131,6 +131,10 @@ def convert_log(
         origin = first_stamp(source, bag)
         if origin < ABSOLUTE_STAMPS:
             chunks = (_shifted(c, origin) for c in chunks)
+            notes.append(
+                f"{target}: timestamp is the bag's header stamps in s, the first at "
+                f"{origin / 1e9:.9f} s (a controller's clock, kept as it is)"
+            )
         else:
             notes.append(
                 f"{target}: timestamp from the bag's first header stamp ({origin} ns): stamps "
