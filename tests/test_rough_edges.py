@@ -211,3 +211,27 @@ def test_every_output_spells_one_way_and_writes_units_one_way() -> None:
             if text != "optimized" and _OPTIMIZED.search(text):  # the JSON key is a name
                 found.append(f"{path.relative_to(package)}:{line}: 'optimized' (write 'optimised')")
     assert not found, "\n".join(found[:20])
+
+
+def _steps() -> None:
+    from kinergy.cli.common import progress
+
+    with progress() as say:
+        say("checking the reach")
+        for k in range(4):
+            say(f"placement {k + 1}", done=k, total=4)
+
+
+def test_long_work_shows_a_fraction_and_the_time_left_on_a_terminal_and_nothing_on_a_pipe(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.delenv("FORCE_COLOR", raising=False)
+    monkeypatch.delenv("TTY_COMPATIBLE", raising=False)
+    _steps()  # pytest's stderr is a pipe
+    assert capsys.readouterr().err == ""
+    monkeypatch.setenv("FORCE_COLOR", "1")  # rich takes stderr for a terminal
+    monkeypatch.setenv("COLUMNS", "120")
+    _steps()
+    err = re.sub(r"\x1b\[[0-9;?]*[a-zA-Z]", "", capsys.readouterr().err)
+    assert "placement 4" in err and "4/4" in err and "left" in err
+    assert "checking the reach" in err
