@@ -24,7 +24,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from kinergy.fleet.twin import twin_fleet
-from kinergy.workflows.fleet import fleet_energy
+from kinergy.workflows.fleet import FleetOptions, fleet_energy
 
 
 def build(folder: Path, robots: int, logs: int, seconds: float) -> Path:
@@ -58,7 +58,8 @@ def main() -> None:
     for n in args.workers:
         out = args.folder / f"out-{n}"
         start = time.perf_counter()
-        result = fleet_energy([], manifest, out / "fleet.parquet", report=out / "report", workers=n)
+        options = FleetOptions(workers=n)
+        result = fleet_energy([], manifest, out / "fleet.parquet", options, report=out / "report")
         walls[n] = time.perf_counter() - start
         drifting = [r.name for r in result.robots if r.drift]
         changes = sorted({(r.name, str(c.date)) for r in result.robots for c in r.changes})

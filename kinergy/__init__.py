@@ -1,12 +1,14 @@
 """kinergy: electro-mechanical models of robot arms from the logs their controllers write.
 
-The public API at the top level mirrors the commands (:mod:`kinergy.api`)::
+The public API at the top level mirrors the commands (:mod:`kinergy.api`, the one front door:
+every command parses its flags into the typed options these functions take and calls them)::
 
     robot = kinergy.load_robot("ur10e")             # a built-in model, or a path to a file
-    log = kinergy.read_log("run.csv", columns="timestamp,actual_q:6,...", robot=robot)
-    result = kinergy.identify(["run.csv"], robot, columns=..., out="my-ur10e.toml")
-    report = kinergy.validate(result.robot, ["held-out.csv"], columns=...)
-    kinergy.energy(result.robot, "held-out.csv", columns=...).supply.drawn   # J
+    reading = kinergy.LogReading.parse(columns="timestamp,actual_q:6,...")  # how logs are read
+    log = kinergy.read_log("run.csv", reading, robot=robot)
+    result = kinergy.identify(["run.csv"], robot, reading=reading, out="my-ur10e.toml")
+    report = kinergy.validate(result.robot, ["held-out.csv"], reading=reading)
+    kinergy.energy(result.robot, "held-out.csv", reading=reading).supply.drawn   # J
 
 and the dynamics underneath::
 
@@ -49,6 +51,11 @@ _API = {
     "read_log": "kinergy.api",
     "simulate": "kinergy.api",
     "validate": "kinergy.api",
+    "LogReading": "kinergy.api",
+    "IdentifyOptions": "kinergy.api",
+    "EnergyOptions": "kinergy.api",
+    "SimulateOptions": "kinergy.api",
+    "ProgramOptions": "kinergy.api",
     "IdentificationResult": "kinergy.identification.result",
     "ValidationReport": "kinergy.identification.validation",
     "LogEnergy": "kinergy.workflows.energy",
@@ -65,14 +72,19 @@ _API = {
 
 __all__ = [
     "BaseParameters",
+    "EnergyOptions",
     "EnergyReport",
     "IdentificationResult",
+    "IdentifyOptions",
     "KinergyError",
     "Log",
     "LogEnergy",
+    "LogReading",
     "Motion",
     "Payload",
+    "ProgramOptions",
     "Robot",
+    "SimulateOptions",
     "ValidationReport",
     "__version__",
     "base_parameters",
@@ -102,6 +114,11 @@ __all__ = [
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from kinergy.accounting.energy import EnergyReport
     from kinergy.api import (
+        EnergyOptions,
+        IdentifyOptions,
+        LogReading,
+        ProgramOptions,
+        SimulateOptions,
         energy,
         identify,
         identify_payload,

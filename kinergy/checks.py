@@ -34,9 +34,15 @@ import numpy as np
 from kinergy.arrays import Array
 from kinergy.errors import Code, KinergyError
 
-__all__ = ["choice", "known_keys", "number", "plain_text", "vector"]
+__all__ = ["choice", "flag", "integer", "known_keys", "number", "plain_text", "vector"]
 
 E = TypeVar("E", bound=enum.Enum)
+
+
+def flag(name: str) -> str:
+    """The command-line flag of an option called ``name`` in Python, as messages name it
+    (``tool_symmetry`` -> ``--tool-symmetry``)."""
+    return "--" + name.replace("_", "-")
 
 
 def _shown(value: Any) -> str:
@@ -122,6 +128,25 @@ def number(
         wanted = f"a finite number {rule}".rstrip()
         raise KinergyError(f"{what}: must be {wanted}, got {_shown(value)}", Code.NUMBER)
     return x
+
+
+def integer(value: Any, what: str, *, ge: int | None = None, le: int | None = None) -> int:
+    """``value`` as an int within ``[ge, le]`` (a float only when whole: ``2.0``; a count, a
+    seed).
+
+    Raises
+    ------
+    KinergyError
+        ``WHAT: must be a whole number >= 1 and <= 50, got 0`` (code ``NUMBER``).
+    """
+    ok = not isinstance(value, bool) and isinstance(value, int | float | np.integer | np.floating)
+    whole = ok and math.isfinite(float(value)) and float(value) == int(value)
+    n = int(value) if whole else None
+    if n is None or (ge is not None and n < ge) or (le is not None and n > le):
+        rule = " and ".join(f"{s} {b}" for s, b in ((">=", ge), ("<=", le)) if b is not None)
+        wanted = f"a whole number {rule}".rstrip()
+        raise KinergyError(f"{what}: must be {wanted}, got {_shown(value)}", Code.NUMBER)
+    return n
 
 
 def vector(

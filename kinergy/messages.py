@@ -17,12 +17,14 @@ and the time left (the command line's progress bar; nothing on a pipe).
 
 from __future__ import annotations
 
+import inspect
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Protocol, cast
 
 from kinergy.errors import Code
 
-__all__ = ["Message", "Messages", "Say", "coded", "silent"]
+__all__ = ["Message", "Messages", "Say", "as_say", "coded", "silent"]
 
 
 class Say(Protocol):
@@ -35,6 +37,26 @@ class Say(Protocol):
 
 def silent(message: str, *, done: int | None = None, total: int | None = None) -> None:
     """A :class:`Say` hook that says nothing."""
+
+
+def as_say(hook: Say | Callable[[str], None] | None) -> Say:
+    """``hook`` as a :class:`Say`: itself when it takes ``done`` and ``total``; a hook that
+    takes only the message (``print``) gets the parts done appended to it (``placement
+    (3/25)``); None: :func:`silent`."""
+    if hook is None:
+        return silent
+    try:
+        takes = {"done", "total"} <= set(inspect.signature(hook).parameters)
+    except (TypeError, ValueError):  # a builtin without a signature
+        takes = False
+    if takes:
+        return cast(Say, hook)
+    plain = cast(Callable[[str], None], hook)
+
+    def say(message: str, *, done: int | None = None, total: int | None = None) -> None:
+        plain(message if total is None else f"{message} ({done}/{total})")
+
+    return say
 
 
 class Message(str):

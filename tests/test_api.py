@@ -54,21 +54,22 @@ def _same(api: Any, cli: Any, where: str = "") -> None:
 @pytest.mark.skipif(not UR10E.exists(), reason="shared datasets not available")
 def test_identify_validate_energy_equal_the_commands(tmp_path, capsys) -> None:
     robot = kinergy.load_robot("ur10e")
-    result = kinergy.identify(FOURIER, robot, columns=SPEC, out=tmp_path / "api.toml")
+    reading = kinergy.LogReading.parse(columns=SPEC)
+    result = kinergy.identify(FOURIER, robot, reading=reading, out=tmp_path / "api.toml")
     argv = ["identify", *map(str, FOURIER), "--robot", "ur10e", "--columns", SPEC]
     cli = _cli([*argv, "--out", str(tmp_path / "cli.toml"), "--json"], capsys)
     _same(_plain(result.to_dict()), cli)
     model = kinergy.load_robot(tmp_path / "api.toml")
     assert model.identified is not None and len(model.identified.inputs) == 2
 
-    report = kinergy.validate(model, [HELD_OUT], columns=SPEC)
+    report = kinergy.validate(model, [HELD_OUT], reading=reading)
     cli = _cli(
         ["validate", str(tmp_path / "api.toml"), str(HELD_OUT), "--columns", SPEC, "--json"], capsys
     )
     cli["inputs"] = [i for i in cli["inputs"] if not i["path"].endswith(".toml")]  # the model file
-    _same(_plain(kinergy.jsonable.to_jsonable(report)), cli)
+    _same(_plain(report.to_dict()), cli)
 
-    energy = kinergy.energy(model, HELD_OUT, columns=SPEC)
+    energy = kinergy.energy(model, HELD_OUT, reading=reading)
     cli = _cli(
         ["energy", str(tmp_path / "api.toml"), str(HELD_OUT), "--columns", SPEC, "--json"], capsys
     )
@@ -80,9 +81,11 @@ def test_read_log_checks_with_a_robot_and_simulate_writes_the_twin() -> None:
     import kinergy.identification.sequential  # a sub-package never shadows the function
 
     assert callable(kinergy.identify) and callable(kinergy.simulate)
-    log = kinergy.simulate("ur5e", "test-b", mismatch="realistic", seed=2)
+    twin = kinergy.simulate("ur5e", "test-b", kinergy.SimulateOptions(mismatch="realistic", seed=2))
+    log = twin.log
     assert len(log) > 1000 and "actual_current" in log
-    with pytest.raises(kinergy.KinergyError, match="trajectory must be"):
+    assert twin.truth.name == "ur5e" and twin.truth != kinergy.load_robot("ur5e")
+    with pytest.raises(kinergy.KinergyError, match="test-c"):
         kinergy.simulate("ur5e", "test-c")
     motion_energy = kinergy.energy(
         "ur5e", kinergy.movej([[0] * 6, [1, -1, 1, 0, 1, 0]], speed=1.0, acceleration=2.0, dt=0.002)
@@ -92,12 +95,13 @@ def test_read_log_checks_with_a_robot_and_simulate_writes_the_twin() -> None:
 
 @pytest.mark.skipif(not UR10E.exists(), reason="shared datasets not available")
 def test_read_log_through_the_checks() -> None:
-    log = kinergy.read_log(HELD_OUT, columns=SPEC, robot="ur10e")
+    log = kinergy.read_log(HELD_OUT, kinergy.LogReading.parse(columns=SPEC), robot="ur10e")
     assert log["actual_q"].shape == (len(log), 6)
     swapped = SPEC.replace("actual_q:6,actual_qd:6", "actual_qd:6,actual_q:6")
+    reading = kinergy.LogReading.parse(columns=swapped)
     with pytest.raises(kinergy.KinergyError, match="speeds check failed"):
-        kinergy.read_log(HELD_OUT, columns=swapped, robot="ur10e")
-    assert len(kinergy.read_log(HELD_OUT, columns=swapped)) == len(log)  # unchecked without a robot
+        kinergy.read_log(HELD_OUT, reading, robot="ur10e")
+    assert len(kinergy.read_log(HELD_OUT, reading)) == len(log)  # unchecked without a robot
 
 
 def test_optimize_program_equals_the_command(
@@ -106,7 +110,8 @@ def test_optimize_program_equals_the_command(
     """``kinergy.optimize_program`` on a URScript program and on a task gives the command's JSON;
     a lever's name is parsed (and a wrong one refused) as the flag is."""
     small = Path(__file__).parent / "programs" / "small.script"
-    run = kinergy.optimize_program("ur5e", small, tool_symmetry="z", urscript=tmp_path / "a.script")
+    options = kinergy.ProgramOptions(tool_symmetry="z")  # type: ignore[arg-type]
+    run = kinergy.optimize_program("ur5e", small, options, urscript=tmp_path / "a.script")
     cli = _cli(
         ["optimize", "ur5e", str(small), "--tool-symmetry", "z", "--json",
          "--urscript", str(tmp_path / "c.script")],
@@ -117,23 +122,24 @@ def test_optimize_program_equals_the_command(
     api["written"], cli["written"] = [], []
     _same(api, cli)
     assert (tmp_path / "a.script").read_text() == (tmp_path / "c.script").read_text()
-    task = kinergy.optimize_program("ur5e", "test-a")
+    task = kinergy.optimize_program("ur5e", "test-a", points=0)
     cli = _cli(["optimize", "ur5e", "test-a", "--pareto-points", "0", "--json"], capsys)
     cli.pop("inputs")
     api = _plain(task.to_dict())
     api["solver"].pop("seconds"), cli["solver"].pop("seconds")  # wall time
     _same(api, cli)
-    with pytest.raises(kinergy.KinergyError, match="tool symmetry: expected one of none, z"):
-        kinergy.optimize_program("ur5e", small, tool_symmetry="z3")
+    with pytest.raises(kinergy.KinergyError, match="--tool-symmetry: must be one of none, z, z2"):
+        kinergy.ProgramOptions(tool_symmetry="z3")  # type: ignore[arg-type]
 
 
 def test_a_wrong_option_is_one_kinergy_error_naming_it() -> None:
-    with pytest.raises(kinergy.KinergyError, match=r"method='payload': not one of sequential"):
-        kinergy.identify(["x.csv"], "ur5e", method="payload")
-    with pytest.raises(kinergy.KinergyError, match=r"target='voltage': not one of"):
-        kinergy.identify(["x.csv"], "ur5e", method="full", target="voltage")
-    with pytest.raises(kinergy.KinergyError, match=r"via: only for a URScript program"):
-        kinergy.optimize_program("ur5e", "test-a", via="free")
+    with pytest.raises(kinergy.KinergyError, match=r"--method: must be one of sequential, full"):
+        kinergy.IdentifyOptions(method="payload")  # type: ignore[arg-type]
+    with pytest.raises(kinergy.KinergyError, match=r"--target: must be one of auto, moment"):
+        kinergy.IdentifyOptions(method="full", target="voltage")  # type: ignore[arg-type]
+    free = kinergy.ProgramOptions(via="free")  # type: ignore[arg-type]
+    with pytest.raises(kinergy.KinergyError, match=r"--via: only for a URScript program"):
+        kinergy.optimize_program("ur5e", "test-a", free)
 
 
 def test_an_option_the_kind_of_task_does_not_take_is_refused(
@@ -165,7 +171,7 @@ def test_energy_repairs_a_log_cut_short_when_asked(
     assert "--repair" in capsys.readouterr().err
     assert main(["energy", "ur5e", str(log), "--repair", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    api = kinergy.energy("ur5e", log, repair=True)
+    api = kinergy.energy("ur5e", log, reading=kinergy.LogReading(repair=True))
     assert out["samples"] == api.samples == text.count("\n") - 2
 
 
@@ -199,3 +205,177 @@ def test_identify_payload_equals_the_command(
     assert api == cmd
     with pytest.raises(kinergy.KinergyError, match="exists: kinergy never replaces a log"):
         kinergy.identify_payload([log], "ur5e", out=log)
+
+
+# ---------------------------------------------------------------------------------------------
+# one front door: the commands parse their flags into the API's options and call it
+
+
+CLI = Path(kinergy.__file__).parent / "cli"
+CALIBRATION = (
+    Path(__file__).resolve().parents[2]
+    / "shared"
+    / "datasets"
+    / "ur5e-calibration"
+    / "robot_calibration_summary.txt"
+)
+
+
+def test_every_command_calls_the_api() -> None:
+    """Each command's module imports the API (``from kinergy import api``) and never a workflow
+    (the import-linter contract says the same for every module of the CLI)."""
+    import ast
+
+    for path in sorted(CLI.glob("*.py")):
+        if path.name in ("__init__.py", "app.py", "common.py"):
+            continue
+        tree = ast.parse(path.read_text())
+        imports = [
+            (node.module, [a.name for a in node.names])
+            for node in ast.walk(tree)
+            if isinstance(node, ast.ImportFrom)
+        ]
+        assert ("kinergy", ["api"]) in imports, path.name
+        assert not [m for m, _ in imports if m and m.startswith("kinergy.workflows")], path.name
+
+
+def test_the_reading_flags_are_log_reading_parse() -> None:
+    """The log-reading flags are built from :meth:`LogReading.parse` (one flag per parameter):
+    a command reading logs gets the same :class:`LogReading` as the API is given."""
+    import inspect
+
+    from kinergy.cli.common import _READING_FLAGS
+    from kinergy.cli.identify import identify
+
+    parameters = set(inspect.signature(kinergy.LogReading.parse).parameters)
+    assert set(_READING_FLAGS) == parameters
+    flags = {p.name for p in identify.params}
+    assert parameters <= flags and "reading" not in flags
+    parsed = kinergy.LogReading.parse(
+        columns=SPEC, repair=True, cutoff=5.0, accept=["fit,robot"], topic="js", effort="torque"
+    )
+    assert parsed.columns is not None and parsed.columns[:2] == ("timestamp", "actual_q_0")
+    assert {c.value for c in parsed.accept} == {"fit", "robot"}
+    assert parsed.bag is not None and parsed.bag.topic == "/js"
+
+
+@pytest.mark.parametrize(
+    ("argv", "build"),
+    [
+        (
+            ["identify", "x.csv", "--robot", "ur5e", "--out", "m.toml", "--ridge", "-1"],
+            lambda: kinergy.IdentifyOptions(ridge=-1.0),
+        ),
+        (
+            ["identify", "x.csv", "--robot", "ur5e", "--out", "m.toml", "--cutoff", "0"],
+            lambda: kinergy.LogReading(cutoff=0.0),
+        ),
+        (
+            ["validate", "ur5e", "x.csv", "--accept", "nope"],
+            lambda: kinergy.LogReading.parse(accept=["nope"]),
+        ),
+        (
+            ["simulate", "ur5e", "--trajectory", "test-a", "--out", "a.csv", "--lag", "7"],
+            lambda: kinergy.SimulateOptions(lag=7.0),
+        ),
+        (
+            ["simulate", "ur5e", "--trajectory", "test-a", "--out", "a.csv", "--seed", "-1"],
+            lambda: kinergy.SimulateOptions(seed=-1),
+        ),
+        (
+            ["excite", "ur5e", "--out", "m.csv", "--harmonics", "1"],
+            lambda: kinergy.api.ExciteOptions(out="m.csv", harmonics=1),
+        ),
+        (
+            ["record", "127.0.0.1", "--out", "r.csv", "--frequency", "1000"],
+            lambda: kinergy.api.RecordOptions(frequency=1000.0),
+        ),
+        (
+            ["fleet", "energy", "--manifest", "f.toml", "--out", "f.parquet", "--workers", "0"],
+            lambda: kinergy.api.FleetOptions(workers=0),
+        ),
+        (
+            ["nursing", "--seed", "-3"],
+            lambda: kinergy.api.NursingStudyOptions(seed=-3),
+        ),
+        (  # the longest cycle time, once: for a task and a program alike
+            ["optimize", "ur5e", "test-a", "--cycle-time", "700"],
+            lambda: kinergy.ProgramOptions(cycle_time=700.0),
+        ),
+        (
+            ["place", "ur5e", "p.script", "--x", "0:0", "--y", "0:0", "--v-max", "1e-4"],
+            lambda: kinergy.ProgramOptions(v_max=1e-4),
+        ),
+        (
+            ["place", "ur5e", "p.script", "--x", "0:0", "--y", "0:0", "--step", "0"],
+            lambda: kinergy.api.PlacementGrid(
+                x=kinergy.api.Range(0, 0), y=kinergy.api.Range(0, 0), step=0.0
+            ),
+        ),
+    ],
+)
+def test_an_option_is_bounded_once(
+    argv: list[str], build: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A value out of bounds is refused by its option type: the command (a usage error, exit 2,
+    before anything is read or written) and the API say the same line."""
+    with pytest.raises(kinergy.KinergyError) as refused:
+        build()
+    capsys.readouterr()
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == f"kinergy: error: {refused.value}\n"
+
+
+def test_excite_equals_the_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    small = {"harmonics": 2, "samples": 40, "starts": 1, "maxiter": 5, "compare": 2}
+    options = kinergy.api.ExciteOptions(out=tmp_path / "api.csv", **small)
+    run = kinergy.api.excite("ur5e", options)
+    argv = ["excite", "ur5e", "--quiet", "--json", "--out", str(tmp_path / "cli.csv")]
+    cli = _cli([*argv, *(f"--{k}={v}" for k, v in small.items())], capsys)
+    assert cli.pop("inputs") == []
+    api = _plain(run.to_dict())
+    for out in (api, cli):  # the files written and the optimiser's wall time differ
+        out.pop("out"), out.pop("seconds")
+    _same(api, cli)
+    assert (tmp_path / "api.csv").read_text() == (tmp_path / "cli.csv").read_text()
+
+
+def test_robot_commands_equal_the_api(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    listed = _cli_list(["robot", "list", "--json"], capsys)
+    assert listed == _plain([r.to_dict() for r in kinergy.api.robot_list()])
+    shown = _cli(["robot", "show", "ur5e", "--payload", "2", "--json"], capsys)
+    shown.pop("inputs")
+    loaded = kinergy.load_robot("ur5e", payload=kinergy.Payload(mass=2.0))
+    _same(_plain(kinergy.api.robot_show(loaded).to_dict()), shown)
+    export = kinergy.api.export_robot("ur5e", "mjcf", tmp_path / "api.xml", source="ur5e")
+    assert (
+        main(["robot", "export", "ur5e", "--format", "mjcf", "--out", str(tmp_path / "c.xml")]) == 0
+    )
+    assert (tmp_path / "c.xml").read_text() == (tmp_path / "api.xml").read_text() == export.text
+
+
+@pytest.mark.skipif(not CALIBRATION.exists(), reason="shared datasets not available")
+def test_import_calibration_equals_the_command(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    run = kinergy.api.import_calibration("ur5e", CALIBRATION, out=tmp_path / "api.toml")
+    argv = ["robot", "import-calibration", "ur5e", str(CALIBRATION), "--json"]
+    cli = _cli([*argv, "--out", str(tmp_path / "cli.toml")], capsys)
+    cli.pop("inputs", None)
+    _same(_plain(run.to_dict()), cli)
+
+
+def test_simulate_writes_what_the_command_writes(tmp_path: Path) -> None:
+    options = kinergy.SimulateOptions(mismatch="realistic", seed=5, lag=0.002)
+    twin = kinergy.simulate("ur5e", "test-b", options, out=tmp_path / "api.csv")
+    argv = ["simulate", "ur5e", "--trajectory", "test-b", "--mismatch", "realistic"]
+    assert main([*argv, "--seed", "5", "--lag", "0.002", "--out", str(tmp_path / "c.csv")]) == 0
+    assert (tmp_path / "api.csv").read_text() == (tmp_path / "c.csv").read_text()
+    assert twin.settings.lag == 0.002 and twin.settings.current_step > 0  # realistic's steps
+
+
+def _cli_list(argv: list[str], capsys: pytest.CaptureFixture[str]) -> Any:
+    capsys.readouterr()
+    assert main(argv) == 0
+    return json.loads(capsys.readouterr().out)

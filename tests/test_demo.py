@@ -34,7 +34,8 @@ def demo_run(tmp_path_factory: pytest.TempPathFactory):
 
 
 def test_demo_writes_a_report_whose_images_all_exist(demo_run) -> None:
-    out, (_tables, report, _seconds) = demo_run
+    out, run = demo_run
+    report = run.report
     assert report == out / "report.html" and report.exists()
     parser = _Images()
     parser.feed(report.read_text())
@@ -47,7 +48,8 @@ def test_demo_writes_a_report_whose_images_all_exist(demo_run) -> None:
 
 
 def test_demo_prints_the_five_tables_with_comparisons(demo_run) -> None:
-    _out, (tables, _report, _seconds) = demo_run
+    _out, run = demo_run
+    tables = run.tables
     assert {"IV", "V", "VI", "VII", "VIII", "timing"} <= set(tables)
     program, _uniform, optimised = tables["timing"][0].rows
     assert float(optimised[2]) < float(program[2]) and optimised[-1] == "yes"
@@ -59,7 +61,8 @@ def test_demo_prints_the_five_tables_with_comparisons(demo_run) -> None:
 
 def test_demo_identifies_within_the_issue_tolerances(demo_run) -> None:
     # identification issue: rotor inertia 3 %, k_t 2 %, friction 10 % (or 0.005 N m)
-    _out, (tables, _report, _seconds) = demo_run
+    _out, run = demo_run
+    tables = run.tables
     truth = kinergy.load_robot("ur5e")
     for j, row in enumerate(tables["IV"][0].rows):
         assert abs(float(row[-1])) < 3.0  # J_m + J_r error in %
@@ -93,7 +96,8 @@ def test_demo_identifies_within_the_issue_tolerances(demo_run) -> None:
 def test_demo_text_fits_120_characters(demo_run, capsys: pytest.CaptureFixture[str]) -> None:
     """``kinergy demo --mismatch none`` prints its tables in lines of at most 120 characters
     (what the command prints: :func:`print_tables` of these tables)."""
-    _out, (tables, _report, _seconds) = demo_run
+    _out, run = demo_run
+    tables = run.tables
     print_tables(tables, TABLES)
     text = capsys.readouterr().out
     assert "UR5e Table VI" in text and "UR5e Table VIII" in text
@@ -102,7 +106,8 @@ def test_demo_text_fits_120_characters(demo_run, capsys: pytest.CaptureFixture[s
 
 def test_demo_report_fits_1280_px(demo_run, tmp_path: Path) -> None:
     """In a 1280 px browser window every table of the demo's report fits its card."""
-    _out, (_tables, report, _seconds) = demo_run
+    _out, run = demo_run
+    report = run.report
     assert table_overflow(find_chromium(), report, tmp_path) == []
 
 

@@ -270,7 +270,7 @@ def _twin_logs(folder: Path) -> dict[str, Path]:
     m = paper_trajectory(robot, "test-a")
     q, qd, qdd = m.q.copy(), m.qd.copy(), m.qdd.copy()
     q[:, 5], qd[:, 5], qdd[:, 5] = q[0, 5], 0.0, 0.0
-    still = api_simulate(robot, Motion(m.t, q, qd, qdd))
+    still = api_simulate(robot, Motion(m.t, q, qd, qdd)).log
     write_log(logs["still"], still.t, still.signals)
     return logs
 
@@ -291,15 +291,17 @@ def _robot_file(folder: Path) -> list[str]:
 
 def _nursing_result() -> Any:
     """The nursing method on the coupled twin: its Table 6 excitation and one friction run."""
+    from kinergy.api import IdentifyOptions, SimulateOptions
     from kinergy.experiments.friction_runs import back_and_forth_motion
     from kinergy.experiments.nursing_excitation import table6_motion
-    from kinergy.twin import TwinSettings
 
     arm = load_robot("nursing-arm")
     motion, _, _ = table6_motion(arm, periods=2, dt=0.004)
-    excitation = api_simulate(arm, motion, settings=TwinSettings.exact())
-    run = api_simulate(arm, back_and_forth_motion(arm, 0).motion, settings=TwinSettings.exact())
-    return json.loads(json.dumps(api_identify([excitation, run], arm, method="nursing").to_dict()))
+    exact = SimulateOptions(exact=True)
+    excitation = api_simulate(arm, motion, exact).log
+    run = api_simulate(arm, back_and_forth_motion(arm, 0).motion, exact).log
+    nursing = IdentifyOptions(method="nursing")  # type: ignore[arg-type]
+    return json.loads(json.dumps(api_identify([excitation, run], arm, nursing).to_dict()))
 
 
 @pytest.fixture(scope="module")

@@ -16,8 +16,11 @@ from kinergy.cli import main
 from kinergy.io.rtde import read_log, write_log
 from kinergy.trajectory.programs import paper_trajectory
 from kinergy.twin import simulate
-from kinergy.workflows.energy import energy_of_log
+from kinergy.workflows.energy import EnergyOptions, energy_of_log
 from kinergy.workflows.logs import read_motion
+
+#: the measured motion of a log
+ACTUAL = EnergyOptions(source="actual")
 
 RTOL = 1e-9
 
@@ -56,8 +59,8 @@ def test_chunks_of_any_size_give_the_whole_logs_figures(
     ur5e: kinergy.Robot, long_log: Path, source: str, recovery: bool
 ) -> None:
     # actual: accelerations from a spline of the noisy speed, carried across chunk boundaries
-    whole = energy_of_log(ur5e, long_log, source=source, recovery=recovery, rows=10**7)
-    got = energy_of_log(ur5e, long_log, source=source, recovery=recovery, rows=1000)
+    whole = energy_of_log(ur5e, long_log, None, EnergyOptions(source, recovery), rows=10**7)
+    got = energy_of_log(ur5e, long_log, None, EnergyOptions(source, recovery), rows=1000)
     want = whole.to_dict()
     assert got.samples == want["samples"] >= 10_000 and got.segments == 1
     assert "measured" in want
@@ -81,7 +84,7 @@ def test_a_gap_is_never_integrated_across(
     write_log(parts["b"], t_b, b.signals)
     joined = {k: np.concatenate([a[k], b[k]]) for k in a.signals}
     write_log(parts["ab"], np.concatenate([a.t, t_b]), joined)
-    one = {k: energy_of_log(ur5e, p, source="actual", rows=1000) for k, p in parts.items()}
+    one = {k: energy_of_log(ur5e, p, None, ACTUAL, rows=1000) for k, p in parts.items()}
     ab, sa, sb = one["ab"], one["a"], one["b"]
     assert ab.segments == 2 and sa.segments == sb.segments == 1
     assert ab.duration == pytest.approx(sa.duration + sb.duration, rel=1e-12)
@@ -93,7 +96,7 @@ def test_a_gap_is_never_integrated_across(
     assert ab.measured is not None and sa.measured is not None and sb.measured is not None
     assert ab.measured.drawn == pytest.approx(sa.measured.drawn + sb.measured.drawn, rel=RTOL)
     # read whole, the log splits the same way
-    whole = energy_of_log(ur5e, parts["ab"], source="actual", rows=10**7)
+    whole = energy_of_log(ur5e, parts["ab"], None, ACTUAL, rows=10**7)
     _assert_same(ab.to_dict(), whole.to_dict())
     assert main(["energy", "ur5e", str(parts["ab"])]) == 0
     text = capsys.readouterr().out
@@ -118,8 +121,8 @@ def test_a_motion_derived_from_positions_is_said_and_close(
     log = read_log(long_log)
     path = tmp_path / "fewer.csv"
     write_log(path, log.t, {k: v for k, v in log.signals.items() if k not in dropped})
-    full = energy_of_log(ur5e, long_log, source="target")
-    fewer = energy_of_log(ur5e, path, source="target")
+    full = energy_of_log(ur5e, long_log, None, EnergyOptions("target"))
+    fewer = energy_of_log(ur5e, path, None, EnergyOptions("target"))
     assert f"{path}: {note}" in fewer.notes
     assert not any("spline" in n for n in full.notes)
     # the spline of the commanded positions gives the commanded motion's energy closely

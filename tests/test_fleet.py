@@ -257,3 +257,19 @@ def test_step_then_ramp():
     levels = [100.0] * 4 + list(120.0 * (1 + 0.25 * np.arange(6) / 5))
     tr = trend(*series(levels, seed=3))
     assert tr.drift and [c.date.day for c in tr.changes] == [5]
+
+
+def test_the_api_gives_the_command_s_json(result, fleet_dir, tmp_path):
+    """``kinergy.api.fleet_energy``'s ``to_dict()`` is the command's ``--json`` but for the run's
+    own wall time and memory."""
+    import kinergy.api as api
+
+    data, _ = result
+    run = api.fleet_energy(
+        [], fleet_dir / "fleet.toml", tmp_path / "fleet.parquet", api.FleetOptions(workers=2)
+    )
+    got = json.loads(json.dumps(run.to_dict()))
+    cli = {k: v for k, v in data.items() if k not in ("kinergy", "inputs")}
+    for out in (got, cli):
+        out.pop("seconds"), out.pop("peak_rss_MB")
+    assert got == cli

@@ -168,7 +168,7 @@ def test_the_fit_record_does_not_depend_on_the_chunks(twin_log: Path, ur5e: Robo
     datas, read = prepared_logs([twin_log], ur5e, LogReading())
     whole = identify_model(ur5e, datas)
     chunked = identify_logs(ur5e, [twin_log], None, rows=997)
-    assert chunked.inputs.notes == read.notes and "2 segments" in read.notes[0]
+    assert chunked.inputs.notes == read.notes and any("2 segments" in n for n in read.notes)
     assert chunked.fit.logs == whole.fit.logs and chunked.fit.samples == whole.fit.samples
     np.testing.assert_allclose(chunked.fit.lag, whole.fit.lag, rtol=1e-9)
     for key in ("torque", "current"):

@@ -42,7 +42,7 @@ def test_the_energy_of_a_window_is_the_energy_of_the_cut_log(tmp_path: Path) -> 
     write_log(tmp_path / "whole.csv", log.t, log.signals)
     keep = (log.t >= 2.0) & (log.t <= 6.0)
     write_log(tmp_path / "cut.csv", log.t[keep], {k: v[keep] for k, v in log.signals.items()})
-    window = energy("ur5e", tmp_path / "whole.csv", start=2.0, stop=6.0).to_dict()
+    window = energy("ur5e", tmp_path / "whole.csv", reading=LogReading(window=(2.0, 6.0))).to_dict()
     cut = energy("ur5e", tmp_path / "cut.csv").to_dict()
     assert window["total"]["e_elec"] == pytest.approx(cut["total"]["e_elec"], rel=1e-12)
     assert window["samples"] == cut["samples"] == int(keep.sum())

@@ -107,11 +107,11 @@ def test_the_logged_payload_is_the_energy_s_and_the_given_one_replaces_it(tmp_pa
     bare = tmp_path / "bare.csv"
     write_log(bare, twin.t, twin.signals)
     from_log = energy("ur5e", logged).to_dict()["total"]["e_elec"]
-    given = energy("ur5e", bare, payload=payload).to_dict()["total"]["e_elec"]
+    given = energy("ur5e", bare, reading=LogReading(payload=payload)).to_dict()["total"]["e_elec"]
     without = energy("ur5e", bare).to_dict()["total"]["e_elec"]
     assert from_log == pytest.approx(given, rel=1e-9)
     assert abs(from_log - without) > 0.02 * without
-    replaced = energy("ur5e", logged, payload="0")
+    replaced = energy("ur5e", logged, reading=LogReading(payload="0"))
     assert replaced.to_dict()["total"]["e_elec"] == pytest.approx(without, rel=1e-9)
     assert any("logged payload" in n and "not used" in n for n in replaced.notes)
 
@@ -135,14 +135,14 @@ def test_a_payload_that_changes_in_a_log_is_honoured(tmp_path: Path) -> None:
     both = energy("ur5e", path).to_dict()["total"]["e_elec"]
     log = read_log(path)
     cut = float(log.t[np.flatnonzero(log["payload"] == b.mass)[0]])
-    first = energy("ur5e", path, payload=a, stop=cut - 1.0)
-    second = energy("ur5e", path, payload=b, start=cut)
+    first = energy("ur5e", path, reading=LogReading(payload=a, window=(None, cut - 1.0)))
+    second = energy("ur5e", path, reading=LogReading(payload=b, window=(cut, None)))
     parts = first.to_dict()["total"]["e_elec"] + second.to_dict()["total"]["e_elec"]
     assert both == pytest.approx(parts, rel=1e-6)
     # validate: each segment with its own payload explains the torques
     report = validate("ur5e", [path])
     assert min(m.r2 for m in report.torque) > 0.99
-    wrong = validate("ur5e", [path], payload="0")
+    wrong = validate("ur5e", [path], reading=LogReading(payload="0"))
     assert min(m.r2 for m in wrong.torque) < min(m.r2 for m in report.torque)
     # identify fits one model with one payload: refused, saying what to do
     with pytest.raises(KinergyError, match=r"different payloads \(1 kg .*4 kg.*--from/--to"):
@@ -203,7 +203,7 @@ def test_the_ur3e_rad_fit_uses_the_logged_payload() -> None:
     assert result.robot.payload is None  # the run's payload is not the arm's: not written
     with pytest.raises(KinergyError, match="fit check failed"):
         identify([_rad_in_memory(payload=False)], "ur3e")
-    cut = identify([_rad_in_memory(payload=False)], "ur3e", accept="fit")
+    cut = identify([_rad_in_memory(payload=False)], "ur3e", reading=LogReading(accept="fit"))
     assert min(m.r2 for m in cut.fit.torque[:5]) < 0.5
 
 
@@ -216,7 +216,9 @@ def test_the_report_and_the_fleet_carry_the_logged_payload(tmp_path: Path) -> No
     logged = Log("logged.csv", twin.t, {**twin.signals, **_columns(len(twin.t))})
     write_log(tmp_path / "logged.csv", logged.t, logged.signals)
     robot = load_robot("ur5e")
-    expected = energy(robot.with_payload(payload), tmp_path / "logged.csv", payload=payload)
+    expected = energy(
+        robot.with_payload(payload), tmp_path / "logged.csv", reading=LogReading(payload=payload)
+    )
     e_elec = expected.to_dict()["total"]["e_elec"]
     report, _ = log_energy_report(robot, tmp_path / "logged.csv")
     assert report.figures().total_e_elec == pytest.approx(e_elec, rel=1e-6)

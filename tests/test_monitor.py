@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 import kinergy
+import kinergy.api
 from kinergy.cli.app import main
 from kinergy.live.monitor import MONITOR_FIELDS, CycleTracker
 from kinergy.trajectory.motion import Motion
@@ -152,17 +153,41 @@ def test_monitor_text(ur5e_twin, capsys):
 
 
 @pytest.mark.parametrize(
-    ("argv", "message"),
+    ("argv", "message", "status"),
     [
-        (["monitor", "127.0.0.1:1", "--model", "ur5e"], "cannot connect to 127.0.0.1:1"),
-        (["monitor", "127.0.0.1:1", "--model", "no-such-robot"], "no-such-robot"),
+        (["monitor", "127.0.0.1:1", "--model", "ur5e"], "cannot connect to 127.0.0.1:1", 1),
+        (["monitor", "127.0.0.1:1", "--model", "no-such-robot"], "no-such-robot", 1),
         (
             ["monitor", "127.0.0.1", "--model", "ur5e", "--duration", "-1"],
-            "--duration: must be a finite number > 0",
+            "--duration: must be a finite number > 0, got -1",
+            2,
         ),
     ],
 )
-def test_monitor_errors(argv, message, capsys):
-    assert main(argv) == 1
+def test_monitor_errors(argv, message, status, capsys):
+    assert main(argv) == status
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err
+
+
+def test_the_api_monitors_as_the_command(ur5e_twin, capsys, monkeypatch):
+    """The command calls ``kinergy.api.monitor`` and prints its result's ``to_dict()`` as
+    ``--json`` (two live runs differ in where the first cycle is found, so the command's own
+    run is compared with its JSON)."""
+    robot, cycle = ur5e_twin
+    log, _ = repeated(robot, cycle, len(cycle.t) - 1, offset=0)
+    runs = []
+    monitor = kinergy.api.monitor
+
+    def recorded(*args, **kwargs):
+        runs.append(monitor(*args, **kwargs))
+        return runs[-1]
+
+    monkeypatch.setattr(kinergy.api, "monitor", recorded)
+    with RtdeServer(log) as server:
+        argv = ["monitor", server.address, "--model", "ur5e", "--duration", "7", "--json"]
+        assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out.pop("kinergy")["options"]["duration"] == 7.0 and out.pop("inputs") == []
+    assert len(runs) == 1 and len(runs[0].cycles) >= 2
+    assert out == json.loads(json.dumps(runs[0].to_dict()))

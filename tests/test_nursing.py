@@ -13,6 +13,7 @@ import pytest
 from click.testing import CliRunner
 
 import kinergy
+import kinergy.api
 from kinergy.cli import nursing as nursing_cmd
 from kinergy.drives.coupled import (
     coupled_torques,
@@ -375,7 +376,7 @@ def test_nursing_command_json(monkeypatch) -> None:
 
     canned = {"robot": "nursing-arm", "friction": [], "ridge": {"rmse_test": [0.1] * 6}}
     study = SimpleNamespace(excitation_notes=(), warnings=(), **canned)
-    monkeypatch.setattr(nursing_cmd, "nursing_study", lambda robot, **kw: study)
+    monkeypatch.setattr(kinergy.api, "nursing_study", lambda robot, options, **kw: study)
     monkeypatch.setattr(nursing_cmd, "json_result", lambda s, *a: json.dumps(vars(s)))
     result = CliRunner().invoke(nursing_cmd.nursing, ["--json", "--seed", "3"])
     assert result.exit_code == 0, result.output
@@ -412,3 +413,22 @@ def test_the_nursing_method_does_not_depend_on_the_chunks(arm) -> None:
     want = np.array([b.value for b in whole.fit.base_parameters])
     np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12 * np.abs(want).max())
     np.testing.assert_allclose(chunked.fit.ridge.rmse_test, whole.fit.ridge.rmse_test, rtol=1e-9)
+
+
+def test_the_api_runs_the_study_as_the_command(tmp_path) -> None:
+    """``kinergy.api.nursing_study``'s ``to_dict()`` is ``kinergy nursing --json`` (but the
+    timings), and what it writes to ``out``."""
+    from kinergy.cli import main
+
+    options = kinergy.api.NursingStudyOptions(noise=False)
+    study = kinergy.api.nursing_study("nursing-arm", options, out=tmp_path / "api.json")
+    result = CliRunner().invoke(nursing_cmd.nursing, ["--exact", "--json"])
+    assert result.exit_code == 0, result.output
+    cli = json.loads(result.stdout)
+    cli.pop("kinergy"), cli.pop("inputs")
+    got = json.loads(json.dumps(study.to_dict()))
+    assert json.loads((tmp_path / "api.json").read_text()) == got
+    for out in (got, cli):
+        out.pop("timings")
+    assert got == cli
+    assert main(["nursing", "--exact", "--seed", "-1"]) == 2

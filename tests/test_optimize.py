@@ -13,6 +13,7 @@ import pytest
 from click.testing import CliRunner
 
 import kinergy
+from kinergy.cli import main
 from kinergy.cli.optimize import optimize
 from kinergy.drives.transmission import joint_torque
 from kinergy.errors import KinergyError
@@ -522,23 +523,22 @@ def test_command_text_report(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(
-    ("args", "match"),
-    [
-        (["--cycle-time", "fast"], "--cycle-time"),
-        (["--cycle-time", "0.5"], "shorter than the fastest feasible"),
-        (["--a-max", "-1"], "--a-max"),
-        (["--pareto-points", "0", "--plot", "x.png"], "--plot"),
+    ("args", "match", "status"),
+    [  # 2: the options refuse the value (a usage error); 1: the run refuses it
+        (["--cycle-time", "fast"], "--cycle-time", 2),
+        (["--cycle-time", "0.5"], "shorter than the fastest feasible", 1),
+        (["--a-max", "-1"], "--a-max: must be a finite number >= 0.001", 2),
+        (["--pareto-points", "0", "--plot", "x.png"], "--plot", 1),
     ],
 )
 def test_command_errors_are_one_line_and_leave_no_file(
-    tmp_path: Path, args: list[str], match: str
+    tmp_path: Path, args: list[str], match: str, status: int, capsys: pytest.CaptureFixture[str]
 ) -> None:
     task = _write(tmp_path, SMALL)
     script = tmp_path / "prog.script"
-    result = CliRunner().invoke(optimize, ["ur5e", str(task), "--urscript", str(script), *args])
-    assert result.exit_code != 0
-    assert isinstance(result.exception, KinergyError)
-    assert re.search(match, str(result.exception)) and "\n" not in str(result.exception)
+    assert main(["optimize", "ur5e", str(task), "--urscript", str(script), *args]) == status
+    err = capsys.readouterr().err
+    assert re.search(match, err) and err.count("\n") == 1 and err.startswith("kinergy: error: ")
     assert not script.exists()
 
 

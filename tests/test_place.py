@@ -240,3 +240,38 @@ def test_any_range_text_and_step_is_parsed_or_refused_in_one_line(text: str, ste
     assert math.isfinite(r.low) and math.isfinite(r.high) and r.low <= r.high
     assert 1 <= grid.count <= MAX_CANDIDATES == 400
     assert all(math.isfinite(p.x) for p in grid.placements())
+
+
+def test_the_api_places_as_the_command(
+    placed: tuple[Path, dict], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``kinergy.api.place`` with the grid and options the command parsed: its ``to_dict()`` is
+    the command's ``--json`` (the files it writes are its own)."""
+    import kinergy.api as api
+
+    _folder, data = placed
+    monkeypatch.chdir(tmp_path)  # the program named as the command named it
+    program = Path("small.script")
+    program.write_text(SMALL)
+    grid = PlacementGrid(x=Range(-0.1, 0.1), y=Range(0.0, 0.9), step=0.45)
+    options = api.ProgramOptions(tool_symmetry=api.ToolSymmetry.Z)
+    run = api.place("ur5e", program, grid, options, urscript="placed.script")
+    got = json.loads(json.dumps(run.to_dict(), default=str).replace("NaN", "null"))
+    cli = {k: v for k, v in data.items() if k not in ("kinergy", "inputs")}
+    got.pop("written"), cli.pop("written")
+    assert _close(got, cli)
+
+
+def _close(a: object, b: object) -> bool:
+    """``a == b`` with floats equal to 1e-12 relative."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        assert set(a) == set(b), set(a) ^ set(b)
+        return all(_close(a[k], b[k]) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        assert len(a) == len(b)
+        return all(_close(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float) and isinstance(b, float):
+        assert a == pytest.approx(b, rel=1e-12, abs=1e-15)
+        return True
+    assert a == b
+    return True

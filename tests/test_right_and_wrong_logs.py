@@ -168,13 +168,14 @@ FRICTION_WINDOWS = [
 
 
 def test_windows_where_friction_makes_the_current_are_accepted() -> None:
+    from kinergy.api import SimulateOptions
     from kinergy.api import simulate as twin
     from kinergy.logs.reading import CheckedLog, LogReading
     from kinergy.logs.window import TimeWindow
 
     notes = []
     for robot, trajectory, start, stop in FRICTION_WINDOWS:
-        log = twin(robot, trajectory, mismatch="realistic", seed=2)
+        log = twin(robot, trajectory, SimulateOptions(mismatch="realistic", seed=2)).log
         reading = LogReading(window=TimeWindow(start, stop))
         checked = CheckedLog(log, load_robot(robot), reading)
         checked.read()  # accepted
@@ -212,11 +213,12 @@ def test_a_noisy_loggers_window_is_judged_where_the_signal_stands_out() -> None:
 
 def test_a_window_where_every_joint_cruises_is_accepted() -> None:
     # the nursing arm's test B: one second where every commanded speed holds one value
+    from kinergy.api import SimulateOptions
     from kinergy.api import simulate as twin
     from kinergy.logs.reading import CheckedLog, LogReading
     from kinergy.logs.window import TimeWindow
 
-    log = twin("nursing-arm", "test-b", seed=2)
+    log = twin("nursing-arm", "test-b", SimulateOptions(seed=2)).log
     window = TimeWindow(23.61, 24.61)
     keep = window.keep(log.t)
     assert np.ptp(log["target_qd"][keep], axis=0).max() == 0.0  # cruising, every joint

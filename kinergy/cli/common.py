@@ -7,7 +7,6 @@ import contextlib
 import enum
 import functools
 import hashlib
-import math
 import textwrap
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
@@ -29,49 +28,41 @@ from rich.progress import (
 from rich.text import Text
 
 from kinergy._version import __version__
+from kinergy.checks import choice
 from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
 from kinergy.files import check_folder, check_outputs, check_parent, check_replaceable
-from kinergy.io.columns import parse_column_spec
 from kinergy.io.formats import NOT_LOGS
-from kinergy.io.rosbag import bag_options
+from kinergy.io.rosbag import Effort
 from kinergy.jsonable import dumps, to_jsonable
-from kinergy.logs.checks import Check, parse_accept
-from kinergy.logs.reading import InputLogs, LogReading
-from kinergy.logs.window import TimeWindow
+from kinergy.logs.checks import Check
+from kinergy.logs.reading import MAX_CUTOFF, InputLogs, LogReading
 from kinergy.messages import Say, silent
 from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
     "TABLE_WIDTH",
-    "Finite",
-    "accept_option",
-    "bag_options",
-    "columns_option",
-    "cutoff_option",
-    "effort_option",
+    "as_usage",
+    "choice_of",
     "flag_of",
     "fmt",
     "fmt_vector",
     "json_result",
     "load",
     "log_output",
-    "log_reading",
     "note",
     "output_file_option",
     "payload_option",
     "print_tables",
     "progress",
+    "reading_options",
     "refuse_together",
-    "repair_option",
     "report_folder_option",
     "seed_option",
     "swapped",
     "table",
     "tell",
-    "topic_option",
     "warn",
-    "window_options",
     "writes",
 ]
 
@@ -80,24 +71,6 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 #: the widest line :func:`table` prints, characters
 TABLE_WIDTH = 120
-
-
-class Finite(click.FloatRange):
-    """A number option that must be finite (NaN and infinities refused, naming the flag), within
-    the range when one is given: ``Finite()``, ``Finite(0.0, 1.0)``, ``Finite(min=0.0)``."""
-
-    name = "number"
-
-    def _describe_range(self) -> str:
-        if self.min is None and self.max is None:
-            return "finite"
-        return super()._describe_range()
-
-    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
-        x = super().convert(value, param, ctx)
-        if not math.isfinite(x):
-            self.fail(f"{value!r} is not a finite number", param, ctx)
-        return x
 
 
 def prose(text: str, width: int = TABLE_WIDTH) -> str:
@@ -168,34 +141,6 @@ def fmt_vector(v: Any) -> str:
     return "[" + ", ".join(fmt(float(x)) for x in np.asarray(v)) + "]"
 
 
-def log_reading(
-    robot: Robot,
-    *,
-    columns: str | None = None,
-    repair: bool = False,
-    cutoff: float | None = None,
-    accept: Sequence[str] = (),
-    topic: str | None = None,
-    effort: str | None = None,
-    payload: str | None = None,
-    start: float | None = None,
-    stop: float | None = None,
-) -> LogReading:
-    """The log-reading options of a command, parsed for ``robot`` (its joint count checks the
-    ``--columns`` spec); ``payload`` is ``--payload`` (it replaces the log's and the robot
-    file's: :meth:`LogReading.loaded`), ``start`` and ``stop`` are ``--from`` and ``--to``."""
-    names = None if columns is None else parse_column_spec(columns, robot.n)
-    return LogReading(
-        columns=names,
-        repair=repair,
-        cutoff=cutoff,
-        accept=parse_accept(accept),
-        bag=bag_options(topic, effort),
-        payload=None if payload is None else parse_payload(payload),
-        window=None if start is None and stop is None else TimeWindow(start, stop),
-    )
-
-
 #: suffixes of logs (a model file is never one of them)
 _LOG_SUFFIXES = (".csv", ".txt", ".mcap", ".db3", ".log")
 #: suffixes of robot files (a log is never one of them)
@@ -221,12 +166,14 @@ def load(robot_name: str, payload: str | None) -> Robot:
     return load_robot(robot_name, payload=None if payload is None else parse_payload(payload))
 
 
+#: ``--payload``'s value, as :func:`kinergy.model.toml.parse_payload` reads it
+PAYLOAD_METAVAR = "MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]"
+
 payload_option = click.option(
     "--payload",
-    metavar="MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]",
-    help="Payload at the flange: kg, m (flange frame), kg m² about its centre of mass. It "
-    "replaces the model's and the one a log's controller logged (payload, payload_cog, "
-    "payload_inertia), which is used otherwise.",
+    metavar=PAYLOAD_METAVAR,
+    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2 about its "
+    "centre of mass.",
 )
 
 
@@ -260,75 +207,132 @@ def report_folder_option(contents: str = "the figures") -> Callable[[F], F]:
     )
 
 
-columns_option = click.option(
-    "--columns",
-    metavar="SPEC",
-    help="Layout of a headerless log: UR's RTDE field names, NAME:N for an N-vector, _ (or _:N) "
-    'for columns to skip, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6"; or a header '
-    "log's own names mapped to RTDE fields, FIELD=COLUMN with * for a vector's index, e.g. "
-    '"timestamp=time,actual_q=positions_*" (_=COLUMN leaves a column unread). A header\'s '
-    "columns that are no RTDE field are ignored (a note names them).",
-)
-topic_option = click.option(
-    "--topic",
-    metavar="TOPIC",
-    default=None,
-    help="ROS 2 bags: the sensor_msgs/JointState topic [/joint_states].",
-)
-effort_option = click.option(
-    "--effort",
-    type=click.Choice(["current", "torque"]),
-    default=None,
-    help="ROS 2 bags: what JointState effort holds, motor currents (A) or joint torques (N m) "
-    "[current for UR arms, as UR's driver publishes by default; torque for others].",
-)
-accept_option = click.option(
-    "--accept",
-    "accept",
-    multiple=True,
-    metavar="CHECK",
-    help="Go on although this check fails (repeatable; recorded in the result): "
-    + ", ".join(c.value for c in Check)
-    + ", or all.",
-)
-cutoff_option = click.option(
-    "--cutoff",
-    type=Finite(0.0, 1e6, min_open=True),
-    default=None,
-    help="Low-pass cutoff for measured speeds, Hz [min(10, fs/5)].",
-)
-repair_option = click.option(
-    "--repair",
-    is_flag=True,
-    help="Drop malformed rows (cut short, non-numeric, time out of order) instead of rejecting.",
-)
+class EnumChoice(click.Choice):
+    """A click choice of the members of an enum, by their values (``--method full``), given to
+    the command as the member (``Method.FULL``)."""
+
+    def __init__(self, kind: type[enum.Enum]) -> None:
+        super().__init__([str(member.value) for member in kind])
+        self.kind = kind
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if isinstance(value, self.kind):
+            return value
+        name = super().convert(value, param, ctx)  # a name not of the enum: a usage error
+        return choice(name, self.kind, param.get_error_hint(ctx) if param and ctx else "value")
 
 
-def window_options(command: F) -> F:
-    """``--from`` and ``--to`` (as ``start`` and ``stop``): the time window of every log a
-    command reads."""
-    command = click.option(
+def choice_of(kind: type[enum.Enum]) -> EnumChoice:
+    """The click type of an option whose values are those of enum ``kind``."""
+    return EnumChoice(kind)
+
+
+@contextlib.contextmanager
+def as_usage() -> Iterator[None]:
+    """Options built from a command's flags: a value the option's type refuses on construction
+    (one line naming the flag, as the Python API gives it) is a usage error, exit status 2."""
+    try:
+        yield
+    except KinergyError as exc:
+        raise click.UsageError(str(exc)) from None
+
+
+#: the flag of each parameter of :meth:`LogReading.parse`: how every command reads its logs
+_READING_FLAGS: dict[str, Callable[[Any], Any]] = {
+    "columns": click.option(
+        "--columns",
+        metavar="SPEC",
+        help="Layout of a headerless log: UR's RTDE field names, NAME:N for an N-vector, _ (or "
+        '_:N) for columns to skip, e.g. "timestamp,actual_q:6,actual_qd:6,actual_current:6"; or '
+        "a header log's own names mapped to RTDE fields, FIELD=COLUMN with * for a vector's "
+        'index, e.g. "timestamp=time,actual_q=positions_*" (_=COLUMN leaves a column unread). A '
+        "header's columns that are no RTDE field are ignored (a note names them).",
+    ),
+    "repair": click.option(
+        "--repair",
+        is_flag=True,
+        help="Drop malformed rows (cut short, non-numeric, time out of order) instead of "
+        "rejecting.",
+    ),
+    "cutoff": click.option(
+        "--cutoff",
+        type=float,
+        default=None,
+        help=f"Low-pass cutoff for measured speeds, Hz (> 0, <= {MAX_CUTOFF:g}) [min(10, fs/5)].",
+    ),
+    "accept": click.option(
+        "--accept",
+        "accept",
+        multiple=True,
+        metavar="CHECK",
+        help="Go on although this check fails (repeatable; recorded in the result): "
+        + ", ".join(c.value for c in Check)
+        + ", or all.",
+    ),
+    "topic": click.option(
+        "--topic",
+        metavar="TOPIC",
+        default=None,
+        help="ROS 2 bags: the sensor_msgs/JointState topic [/joint_states].",
+    ),
+    "effort": click.option(
+        "--effort",
+        type=choice_of(Effort),
+        default=None,
+        help="ROS 2 bags: what JointState effort holds, motor currents (A) or joint torques "
+        "(N m) [current for UR arms, as UR's driver publishes by default; torque for others].",
+    ),
+    "payload": click.option(
+        "--payload",
+        metavar=PAYLOAD_METAVAR,
+        help="Payload at the flange: kg, m (flange frame), kg m^2 about its centre of mass. It "
+        "replaces the model's and the one a log's controller logged (payload, payload_cog, "
+        "payload_inertia), which is used otherwise.",
+    ),
+    "start": click.option(
+        "--from",
+        "start",
+        type=float,
+        default=None,
+        metavar="S",
+        help="Read each log from this time (s, on the log's own time axis) [its start].",
+    ),
+    "stop": click.option(
         "--to",
         "stop",
-        type=Finite(),
+        type=float,
         default=None,
         metavar="S",
         help="Read each log up to this time (s, on the log's own time axis: its timestamp "
         "column; a ROS 2 bag's from its first message) [its end].",
-    )(command)
-    return click.option(
-        "--from",
-        "start",
-        type=Finite(),
-        default=None,
-        metavar="S",
-        help="Read each log from this time (s, on the log's own time axis) [its start].",
-    )(command)
+    ),
+}
+
+
+def reading_options(*names: str) -> Callable[[F], F]:
+    """The log-reading flags, one per parameter of :meth:`LogReading.parse` (``names``: those
+    the command takes; default all), parsed there into one :class:`LogReading` that the command
+    receives as ``reading``."""
+    wanted = names or tuple(_READING_FLAGS)
+
+    def decorate(command: F) -> F:
+        @functools.wraps(command)
+        def parsed(**kwargs: Any) -> Any:
+            flags = {name: kwargs.pop(name) for name in wanted}
+            with as_usage():
+                reading = LogReading.parse(**flags)
+            return command(reading=reading, **kwargs)
+
+        for name in reversed(wanted):
+            parsed = _READING_FLAGS[name](parsed)
+        return parsed  # type: ignore[return-value]
+
+    return decorate
 
 
 seed_option = click.option(
     "--seed",
-    type=click.IntRange(0, 2**32 - 1),
+    type=int,
     default=0,
     show_default=True,
     help="Seed of the random generator (0 to 2^32-1).",
@@ -363,7 +367,7 @@ def log_output(flag: str, path: str) -> None:
 
 def refuse_together(*pairs: tuple[str, str, str]) -> None:
     """Refuse, in one line naming both flags, two options given together on the command line
-    that contradict each other: each pair is (parameter, parameter, why)."""
+    that contradict each other (a usage error): each pair is (parameter, parameter, why)."""
     ctx = click.get_current_context()
 
     def given(name: str) -> bool:
@@ -371,7 +375,7 @@ def refuse_together(*pairs: tuple[str, str, str]) -> None:
 
     for a, b, why in pairs:
         if given(a) and given(b):
-            raise KinergyError(
+            raise click.UsageError(
                 f"{flag_of(ctx.command, a)} and {flag_of(ctx.command, b)} together: {why}"
             )
 
@@ -544,11 +548,15 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def json_result(result: Any, inputs: InputLogs | None = None) -> str:
-    """``--json`` of a command: ``result`` (a typed result or a dict) with where it came from:
-    ``kinergy`` (``version``, ``command``, the command's ``options`` as given) and ``inputs``
-    (every input file by content: ``path``, ``sha256``, ``size``; a log also ``rows`` and its
-    ``checks``, from ``inputs``). A result that is a list is printed as it is."""
+def json_result(result: Any) -> str:
+    """``--json`` of a command: ``result.to_dict()`` (a result of :mod:`kinergy.api`; plain data
+    as it is) with where it came from: ``kinergy`` (``version``, ``command``, the command's
+    ``options`` as given) and ``inputs`` (every input file by content: ``path``, ``sha256``,
+    ``size``; a log also ``rows`` and its ``checks``, from the result's ``inputs``). A result
+    that is a list is printed as it is."""
+    inputs = getattr(result, "inputs", None)
+    inputs = inputs if isinstance(inputs, InputLogs) else None
+    result = result.to_dict() if hasattr(result, "to_dict") else result
     out = to_jsonable(result)
     if not isinstance(out, dict):  # a list (robot list): nothing to record beside it
         return dumps(out)
@@ -563,7 +571,12 @@ def json_result(result: Any, inputs: InputLogs | None = None) -> str:
             elif Path(path).is_file():
                 files.append(_file_record(path))
     files += logs.values()
-    options = {k: _plain(v) for k, v in ctx.params.items() if k != "as_json"}
+    types = {p.name: p.type for p in ctx.command.params}
+    options = {
+        k: _plain(getattr(types.get(k), "shown", lambda v: v)(v))  # a type's word for a value
+        for k, v in ctx.params.items()
+        if k != "as_json"
+    }
     out["kinergy"] = {"version": __version__, "command": ctx.command_path, "options": options}
     out["inputs"] = files
     return dumps(out)

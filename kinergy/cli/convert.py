@@ -6,21 +6,10 @@ from pathlib import Path
 
 import click
 
-from kinergy.cli.common import (
-    bag_options,
-    columns_option,
-    effort_option,
-    log_output,
-    note,
-    repair_option,
-    tell,
-    topic_option,
-)
+from kinergy import api
+from kinergy.cli.common import log_output, note, reading_options, tell
 from kinergy.errors import KinergyError
 from kinergy.files import check_output, check_parent
-from kinergy.io.columns import parse_column_spec
-from kinergy.model import load_robot
-from kinergy.workflows.convert import LogKind, convert_log
 
 __all__ = ["convert"]
 
@@ -30,7 +19,7 @@ __all__ = ["convert"]
 @click.option(
     "--to",
     "to",
-    type=click.Choice([k.value for k in LogKind]),
+    type=click.Choice(["bag", "csv"]),
     required=True,
     help="bag: a rosbag2 folder (MCAP storage) as UR's ROS 2 driver records one; csv: UR's "
     "record.py layout.",
@@ -45,20 +34,8 @@ __all__ = ["convert"]
     help="The robot the log is of (built-in or file): its joint names and count (every UR arm "
     "gives UR's driver's names, shoulder_pan_joint ... wrist_3_joint).",
 )
-@columns_option
-@topic_option
-@effort_option
-@repair_option
-def convert(
-    log: str,
-    to: str,
-    out: str,
-    robot_name: str,
-    columns: str | None,
-    topic: str | None,
-    effort: str | None,
-    repair: bool,
-) -> None:
+@reading_options("columns", "topic", "effort", "repair")
+def convert(log: str, to: str, out: str, robot_name: str, reading: api.LogReading) -> None:
     """Convert LOG to a ROS 2 bag or a CSV log at OUT (never replaced: a new name).
 
     --to bag: one sensor_msgs/JointState per sample on /joint_states, its header stamp the
@@ -72,25 +49,15 @@ def convert(
     if target.exists() or target.is_symlink():
         raise KinergyError(f"OUT {out}: exists; kinergy never replaces it: give a new name")
     check_parent(check_output(target))
-    kind = LogKind(to)
-    if kind is LogKind.CSV:
+    kind = api.LogKind(to)
+    if kind is api.LogKind.CSV:
         log_output("OUT", out)
     elif target.suffix.lower() in (".mcap", ".db3", ".csv", ".txt"):
         raise KinergyError(
             f"OUT {out}: a bag is a folder (its {target.name}.mcap inside): give a name "
             f"without {target.suffix}"
         )
-    robot = load_robot(robot_name)
-    spec = None if columns is None else parse_column_spec(columns, robot.n)
-    result = convert_log(
-        log,
-        target,
-        kind,
-        tuple(robot.joint_names),
-        columns=spec,
-        repair=repair,
-        bag=bag_options(topic, effort),
-    )
+    result = api.convert(log, target, kind, robot_name, reading=reading)
     tell(result.notes, [])
     if result.left_out:
         note(

@@ -3,90 +3,112 @@ mechanical and electrical energy, and the log's measured supply energy beside th
 
 from __future__ import annotations
 
-from typing import Any
+import math
 
 import click
 
-from kinergy.accounting.supply import MEASURED_INCLUDES, PREDICTED_INCLUDES
+from kinergy import api
 from kinergy.cli.common import (
-    accept_option,
-    columns_option,
-    effort_option,
+    as_usage,
+    choice_of,
     json_result,
-    load,
-    log_reading,
-    payload_option,
     prose,
-    repair_option,
+    reading_options,
     swapped,
     table,
     tell,
-    topic_option,
-    window_options,
     writes,
 )
-from kinergy.workflows.energy import energy_with_outputs
+from kinergy.logs.reading import LogReading
 
 __all__ = ["energy", "energy_text"]
 
 _PARTS = ("inertial", "gravity", "friction", "copper")
 
 
-def _row(name: str, e: dict[str, Any], efficiency: float | None, mean_power: float) -> list[str]:
-    eff = "-" if efficiency is None else f"{100 * efficiency:.1f}"
+def _row(
+    name: str,
+    e_mech: float,
+    e_elec: float,
+    efficiency: float,
+    mean_power: float,
+    peak_power: float,
+    parts: dict[str, float],
+) -> list[str]:
+    eff = "-" if not math.isfinite(efficiency) else f"{100 * efficiency:.1f}"
     return [
         name,
-        f"{e['e_mech']:.1f}",
-        f"{e['e_elec']:.1f}",
+        f"{e_mech:.1f}",
+        f"{e_elec:.1f}",
         eff,
         f"{mean_power:.1f}",
-        f"{e['peak_power']:.1f}",
-        *(f"{e['breakdown'][k]:.1f}" for k in _PARTS),
+        f"{peak_power:.1f}",
+        *(f"{parts[k]:.1f}" for k in _PARTS),
     ]
 
 
-def _supply_lines(report: dict[str, Any]) -> list[str]:
+def _supply_lines(result: api.LogEnergy) -> list[str]:
     """What the arm draws from its supply, predicted and (where logged) measured."""
-    sup = report["supply"]
-    share = f", {100 * sup['standby'] / sup['drawn']:.0f} % of it" if sup["drawn"] > 0 else ""
+    sup, measured = result.supply, result.measured
+    share = f", {100 * sup.standby / sup.drawn:.0f} % of it" if sup.drawn > 0 else ""
     lines = [
-        f"Drawn from the arm's supply: {sup['drawn']:.1f} J predicted = motors {sup['motors']:.1f} J"
-        f" + standing draw {sup['standby']:.1f} J ({sup['standby_power']:.3g} W for "
-        f"{report['duration']:.1f} s{share}); {sup['shunt']:.1f} J of braking burnt in the shunt, "
-        f"not drawn. Mean {sup['mean_power']:.1f} W, peak {sup['peak_power']:.1f} W.",
+        f"Drawn from the arm's supply: {sup.drawn:.1f} J predicted = motors {sup.motors:.1f} J"
+        f" + standing draw {sup.standby:.1f} J ({sup.standby_power:.3g} W for "
+        f"{result.duration:.1f} s{share}); {sup.shunt:.1f} J of braking burnt in the shunt, "
+        f"not drawn. Mean {sup.mean_power:.1f} W, peak {sup.peak_power:.1f} W.",
     ]
-    measured = report.get("measured")
     if measured is not None:
-        error = measured.get("error")
+        error = result.measured_dict().get("error")
         lines.append(
-            f"Measured by the log: {measured['drawn']:.1f} J (mean {measured['mean_power']:.1f} W)"
+            f"Measured by the log: {measured.drawn:.1f} J (mean {measured.mean_power:.1f} W)"
             + ("" if error is None else f"; predicted {error:+.1f} %")
             + "."
         )
-    lines += [f"  predicted: {PREDICTED_INCLUDES}."]
+    lines += [f"  predicted: {sup.includes}."]
     if measured is not None:
-        lines.append(f"  measured: {MEASURED_INCLUDES}.")
+        lines.append(f"  measured: {measured.includes}.")
     return lines
 
 
-def energy_text(report: dict[str, Any]) -> str:
+def energy_text(result: api.LogEnergy) -> str:
     """The ``energy`` answer: what the arm draws from its supply (predicted, and measured where
     logged), then one row per joint and the total, with what each figure includes."""
-    rows = [_row(j["name"], j, j["efficiency"], j["mean_power"]) for j in report["joints"]]
-    tot = report["total"]
-    rows.append(_row("total", tot, tot["efficiency"], tot["e_elec"] / report["duration"]))
-    head = f"{report['robot']}: {report['duration']:.3f} s, {report['samples']} samples; " + (
+    r, duration = result, result.duration
+    rows = [
+        _row(
+            name,
+            r.e_mech[i],
+            r.e_elec[i],
+            r.efficiency[i],
+            r.e_elec[i] / duration,
+            r.peak_power[i],
+            {k: v[i] for k, v in r.breakdown.items()},
+        )
+        for i, name in enumerate(r.joints)
+    ]
+    rows.append(
+        _row(
+            "total",
+            r.total_e_mech,
+            r.total_e_elec,
+            r.total_efficiency,
+            r.total_e_elec / duration,
+            r.bus_peak,
+            {k: v.sum() for k, v in r.breakdown.items()},
+        )
+    )
+    head = f"{r.robot}: {duration:.3f} s, {r.samples} samples; " + (
         "signed integrals (braking energy returns to the bus)"
-        if report["recovery"]
+        if r.recovery
         else "no recovery (negative power clipped)"
     )
     headers = ["joint", "E_mech [J]", "E_elec [J]", "eta [%]", "mean P [W]", "peak P [W]"]
     headers += [f"{k} [J]" for k in _PARTS]
-    if "segments" in report:
-        head += f"\n{report['segments']} segments; gaps of {report['gaps']:.3f} s not integrated."
+    if r.segments > 1:
+        head += f"\n{r.segments} segments; gaps of {r.span - duration:.3f} s not integrated."
     lines = [
         prose(head),
-        *(prose(line) for line in _supply_lines(report)),
+        *(prose(line) for line in _supply_lines(result)),
         "",
         table(headers, rows),
         "",
@@ -99,19 +121,14 @@ def energy_text(report: dict[str, Any]) -> str:
 @click.command()
 @click.argument("model", metavar="MODEL")
 @click.argument("motion_path", metavar="LOG_OR_MOTION", type=click.Path())
-@columns_option
-@repair_option
-@accept_option
-@topic_option
-@effort_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option(
     "--no-recovery", is_flag=True, help="Clip negative power: the supply takes no energy back."
 )
 @click.option(
     "--source",
-    type=click.Choice(["auto", "target", "actual"]),
-    default="auto",
+    type=choice_of(api.MotionSource),
+    default=api.MotionSource.AUTO.value,
     show_default=True,
     help="Which motion of a log: commanded (target_*) or measured (actual_*).",
 )
@@ -129,25 +146,17 @@ def energy_text(report: dict[str, Any]) -> str:
     help="Draw the supply's power over time, predicted against measured, with the energy of "
     "each (PNG).",
 )
-@payload_option
-@window_options
+@reading_options("columns", "repair", "accept", "topic", "effort", "payload", "start", "stop")
 @writes(files=("trace", "plot"), inputs=("model", "motion_path"))
 def energy(
     model: str,
     motion_path: str,
-    columns: str | None,
-    repair: bool,
     as_json: bool,
     no_recovery: bool,
-    source: str,
-    payload: str | None,
-    accept: tuple[str, ...],
-    topic: str | None,
-    effort: str | None,
-    start: float | None,
-    stop: float | None,
+    source: api.MotionSource,
     trace: str | None,
     plot: str | None,
+    reading: LogReading,
 ) -> None:
     """What a logged or planned motion draws from the arm's supply, and per-joint mechanical and
     electrical energy; a log's measured supply energy beside the prediction.
@@ -157,21 +166,9 @@ def energy(
     test-b: the UR5e doc's tests A and B planned for MODEL).
     """
     swapped(model, [motion_path])
-    r = load(model, None)
-    reading = log_reading(
-        r,
-        columns=columns,
-        repair=repair,
-        accept=accept,
-        topic=topic,
-        effort=effort,
-        payload=payload,
-        start=start,
-        stop=stop,
-    )
-    result = energy_with_outputs(
-        r, motion_path, reading, source=source, recovery=not no_recovery, trace=trace, plot=plot
-    )
+    with as_usage():
+        options = api.EnergyOptions(source=source, recovery=not no_recovery)
+    result = api.energy(model, motion_path, options, reading=reading, trace=trace, plot=plot)
+    assert isinstance(result, api.LogEnergy)  # a file or a built-in motion, not a Motion
     tell(result.notes, result.warnings)
-    report = result.to_dict()
-    click.echo(json_result(report, result.inputs) if as_json else energy_text(report))
+    click.echo(json_result(result) if as_json else energy_text(result))

@@ -6,25 +6,18 @@ from pathlib import Path
 
 import click
 
+from kinergy import api
 from kinergy.cli.common import (
-    Finite,
-    accept_option,
-    bag_options,
-    effort_option,
+    as_usage,
     json_result,
     output_file_option,
-    payload_option,
     progress,
+    reading_options,
     table,
-    topic_option,
     warn,
-    window_options,
 )
 from kinergy.fleet.analysis import LogResult
-from kinergy.logs.checks import parse_accept
-from kinergy.logs.window import TimeWindow
-from kinergy.model import parse_payload
-from kinergy.workflows.fleet import fleet_energy
+from kinergy.logs.reading import LogReading
 
 __all__ = ["fleet"]
 
@@ -40,20 +33,16 @@ def fleet() -> None:
 @output_file_option("--out", "FLEET.parquet.", required=True)
 @click.option("--report", type=click.Path(file_okay=False), help="Write the HTML report here.")
 @click.option("--scheduler", metavar="ADDRESS", help="A Dask scheduler (default: a local cluster).")
-@click.option("--workers", type=int, help="Local cluster worker processes [one per core].")
+@click.option("--workers", type=int, help="Local cluster worker processes, >= 1 [one per core].")
 @click.option(
     "--min-rise",
-    type=Finite(min=0.0),
+    type=float,
     default=0.05,
     show_default=True,
-    help="Smallest rise called drift.",
+    help="Smallest rise called drift (a fraction, >= 0).",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the robots as JSON.")
-@topic_option
-@effort_option
-@accept_option
-@payload_option
-@window_options
+@reading_options("topic", "effort", "accept", "payload", "start", "stop")
 def energy(
     logs: tuple[str, ...],
     manifest: str,
@@ -63,12 +52,7 @@ def energy(
     workers: int | None,
     min_rise: float,
     as_json: bool,
-    topic: str | None,
-    effort: str | None,
-    accept: tuple[str, ...],
-    payload: str | None,
-    start: float | None,
-    stop: float | None,
+    reading: LogReading,
 ) -> None:
     """Energy per cycle of every log (LOGS and the manifest's globs), by robot and by day.
 
@@ -83,14 +67,12 @@ def energy(
             warn(f"{result.error} (left out of {result.robot}'s figures)")
         say("energy of the fleet's logs", done=done, total=total)
 
+    with as_usage():
+        options = api.FleetOptions(scheduler=scheduler, workers=workers, min_rise=min_rise)
     with progress() as say:
-        result = fleet_energy(
-            logs, manifest, out, report=report, scheduler=scheduler, workers=workers,
-            min_rise=min_rise, progress=tick, bag=bag_options(topic, effort),
-            accept=parse_accept(accept),
-            payload=None if payload is None else parse_payload(payload),
-            window=None if start is None and stop is None else TimeWindow(start, stop),
-        )  # fmt: skip
+        result = api.fleet_energy(
+            logs, manifest, out, options, reading=reading, report=report, progress=tick
+        )
     if as_json:
         click.echo(json_result(result))
         return

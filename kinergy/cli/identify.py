@@ -4,32 +4,34 @@ from __future__ import annotations
 
 import click
 
+from kinergy import api
 from kinergy.cli.common import (
-    Finite,
-    accept_option,
-    columns_option,
-    cutoff_option,
-    effort_option,
+    as_usage,
+    choice_of,
     json_result,
-    log_reading,
     output_file_option,
-    payload_option,
     progress,
-    repair_option,
+    reading_options,
     table,
     tell,
-    topic_option,
-    window_options,
     writes,
 )
 from kinergy.cli.validate import validation_text
 from kinergy.friction.registry import MODELS
 from kinergy.identification.full import FullFit
-from kinergy.identification.options import IdentifyOptions, Method, Solver, Target, friction_option
+from kinergy.identification.options import (
+    AUTO,
+    MAX_RIDGE,
+    IdentifyOptions,
+    Method,
+    Solver,
+    Target,
+    friction_option,
+)
 from kinergy.identification.payload import PayloadEstimate
 from kinergy.identification.result import FLAGS, IDENTIFIED, DriveEstimate, IdentificationResult
+from kinergy.logs.reading import LogReading
 from kinergy.model import load_robot
-from kinergy.workflows.identify import METHODS, identify_logs, identify_payload_model
 
 __all__ = ["identify"]
 
@@ -177,8 +179,8 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 )
 @click.option(
     "--method",
-    type=click.Choice(METHODS),
-    default="sequential",
+    type=choice_of(Method),
+    default=Method.SEQUENTIAL.value,
     show_default=True,
     help="sequential: the UR5e doc's procedure (drives from the currents); full: base-parameter "
     "regression (links and drives); nursing: the nursing doc's method (friction from constant-"
@@ -186,15 +188,11 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
     "logs).",
 )
 @output_file_option("--out", "Model file to write (TOML).", required=True)
-@columns_option
-@accept_option
-@topic_option
-@effort_option
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @click.option(
     "--friction",
     "friction",
-    type=click.Choice([*sorted(MODELS), "auto"]),
+    type=click.Choice([*sorted(MODELS), AUTO.value]),
     default=None,
     help="Friction model for every joint (default: the model's own), e.g. power_law, "
     "load_coulomb, thermal_viscous; auto: per joint, the model with the lowest "
@@ -203,56 +201,45 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
 )
 @click.option(
     "--target",
-    type=click.Choice(["auto", "moment", "current", "torque"]),
-    default="auto",
+    type=choice_of(Target),
+    default=Target.AUTO.value,
     show_default=True,
     help="Full method: regress against target_moment, currents or measured torques.",
 )
 @click.option(
     "--solver",
-    type=click.Choice(["ols", "wls", "ridge"]),
-    default="ols",
+    type=choice_of(Solver),
+    default=Solver.OLS.value,
     show_default=True,
     help="Full method: ordinary, weighted or ridge least squares.",
 )
 @click.option(
     "--ridge",
     "ridge",
-    type=Finite(0.0, 1e12),
+    type=float,
     default=0.0,
     show_default=True,
-    help="Full method: ridge weight.",
+    help=f"Full method: ridge weight (0 to {MAX_RIDGE:g}).",
 )
 @click.option(
     "--payload-only",
     is_flag=True,
     help="Identify only the payload from logs taken with it; ROBOT is the model identified without it.",
 )
-@cutoff_option
-@repair_option
-@payload_option
-@window_options
+@reading_options()
 @writes(files=("out",), inputs=("logs", "robot_name"))
 def identify(
     logs: tuple[str, ...],
     robot_name: str,
-    method: str,
+    method: Method,
     out: str,
-    columns: str | None,
     as_json: bool,
     friction: str | None,
-    target: str,
-    solver: str,
+    target: Target,
+    solver: Solver,
     ridge: float,
     payload_only: bool,
-    cutoff: float | None,
-    repair: bool,
-    accept: tuple[str, ...],
-    topic: str | None,
-    effort: str | None,
-    payload: str | None,
-    start: float | None,
-    stop: float | None,
+    reading: LogReading,
 ) -> None:
     """Identify a model from controller logs and write it as a robot file.
 
@@ -263,41 +250,24 @@ def identify(
     (electronics with the brakes released) is identified with its standard error; the motors' R
     and k_b stay the model's (actual_joint_voltage is each joint's bus voltage).
     """
+    with as_usage():
+        options = IdentifyOptions(
+            method=method,
+            friction=friction_option(friction),
+            target=target,
+            solver=solver,
+            ridge=ridge,
+        )
     r = load_robot(robot_name)
-    reading = log_reading(
-        r,
-        columns=columns,
-        repair=repair,
-        cutoff=cutoff,
-        accept=accept,
-        topic=topic,
-        effort=effort,
-        payload=payload,
-        start=start,
-        stop=stop,
-    )
-    options = IdentifyOptions(
-        method=Method(method),
-        friction=friction_option(friction),
-        target=Target(target),
-        solver=Solver(solver),
-        ridge=ridge,
-    )
     with progress() as say:
         if payload_only:
             say(f"reading {len(logs)} log(s) and identifying the payload")
-            run = identify_payload_model(r, logs, out, reading)
+            run = api.identify_payload(logs, r, out=out, reading=reading)
         else:
-            result = identify_logs(r, logs, out, reading=reading, options=options, progress=say)
+            result = api.identify(logs, r, options, reading=reading, out=out, progress=say)
     if payload_only:
         tell(run.notes, run.warnings)
-        click.echo(
-            json_result(run.to_dict(), run.inputs) if as_json else _payload_text(run.payload, out)
-        )
+        click.echo(json_result(run) if as_json else _payload_text(run.payload, out))
         return
     tell(result.notes, result.warnings)
-    click.echo(
-        json_result(result.to_dict(), result.inputs)
-        if as_json
-        else _result_text(result, len(logs), out)
-    )
+    click.echo(json_result(result) if as_json else _result_text(result, len(logs), out))

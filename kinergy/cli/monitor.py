@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import Finite, accept_option, fmt, json_result, load, progress
+from kinergy import api
+from kinergy.cli.common import as_usage, fmt, json_result, load, progress, reading_options
 from kinergy.live.monitor import CycleEnergy
-from kinergy.logs.checks import parse_accept
-from kinergy.workflows.monitor import monitor_cycles
+from kinergy.logs.reading import LogReading
 
 __all__ = ["monitor"]
 
@@ -28,17 +28,17 @@ def _line(c: CycleEnergy) -> str:
 @click.option(
     "--model", "model", required=True, metavar="ROBOT", help="Robot model (name or file)."
 )
-@click.option("--frequency", type=Finite(), default=500.0, show_default=True, help="Hz.")
-@click.option("--duration", type=Finite(), help="Stop after this many seconds of controller time.")
+@click.option("--frequency", type=float, default=500.0, show_default=True, help="Hz (> 0, <= 500).")
+@click.option("--duration", type=float, help="Stop after this many seconds of controller time.")
 @click.option("--json", "as_json", is_flag=True, help="At the end, print the cycles as JSON.")
-@accept_option
+@reading_options("accept")
 def monitor(
     address: str,
     model: str,
     frequency: float,
     duration: float | None,
     as_json: bool,
-    accept: tuple[str, ...],
+    reading: LogReading,
 ) -> None:
     """Energy of every program cycle, live: the supply's (voltage x current) against the model's.
 
@@ -46,6 +46,8 @@ def monitor(
     motion has repeated); until the first one, a line a second on stderr says how much has come.
     Ctrl-C stops.
     """
+    with as_usage():
+        options = api.StreamOptions(frequency=frequency, duration=duration)
     robot = load(model, None)
     shown: list[CycleEnergy] = []
 
@@ -65,26 +67,10 @@ def monitor(
         )
 
     with progress() as say:
-        tracker = monitor_cycles(
-            address,
-            robot,
-            frequency=frequency,
-            duration=duration,
-            on_cycle=show,
-            status=say,
-            accept=parse_accept(accept),
-            waiting=waiting,
+        run = api.monitor(
+            address, robot, options, reading=reading, on_cycle=show, status=say, waiting=waiting
         )
-    period = "not found" if tracker.period is None else f"{fmt(tracker.period)} s"
+    period = "not found" if run.period is None else f"{fmt(run.period)} s"
     if as_json:
-        click.echo(
-            json_result(
-                {
-                    "robot": robot.name,
-                    "period": tracker.period,
-                    "supply_logged": tracker.supply,
-                    "cycles": [{**vars(c), "error": c.error} for c in shown],
-                }
-            )
-        )
-    click.echo(f"{len(shown)} cycle(s), period {period}", err=True)
+        click.echo(json_result(run))
+    click.echo(f"{len(run.cycles)} cycle(s), period {period}", err=True)

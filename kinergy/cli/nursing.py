@@ -10,7 +10,9 @@ from __future__ import annotations
 import click
 import numpy as np
 
+from kinergy import api
 from kinergy.cli.common import (
+    as_usage,
     json_result,
     output_file_option,
     progress,
@@ -19,10 +21,6 @@ from kinergy.cli.common import (
     tell,
     writes,
 )
-from kinergy.files import atomic_write
-from kinergy.jsonable import dumps
-from kinergy.model import load_robot
-from kinergy.workflows.nursing import NursingStudy, nursing_study
 
 __all__ = ["nursing", "study_text"]
 
@@ -46,7 +44,7 @@ def _gamma(g: tuple[float, ...] | None) -> list[str]:
     return ["-"] * 6 if g is None else [f"{x:.4g}" if abs(x) > 1e-9 else "0" for x in g]
 
 
-def _friction_rows(study: NursingStudy) -> list[list[str]]:
+def _friction_rows(study: api.NursingStudy) -> list[list[str]]:
     """Per joint its PSO and LSQ fits and the twin's curve; then the doc's Table 4 curves."""
     rows = []
     for e in study.friction:
@@ -63,7 +61,7 @@ def _friction_rows(study: NursingStudy) -> list[list[str]]:
     return rows
 
 
-def _friction_text(study: NursingStudy) -> list[str]:
+def _friction_text(study: api.NursingStudy) -> list[str]:
     """The friction table with its caption and notes."""
     first = study.friction[0]
     return [
@@ -86,7 +84,7 @@ def _friction_text(study: NursingStudy) -> list[str]:
     ]
 
 
-def _ridge_text(study: NursingStudy) -> list[str]:
+def _ridge_text(study: api.NursingStudy) -> list[str]:
     """The RMSE table against Table 8 with its caption and note."""
     r = study.ridge
     rows = [
@@ -105,7 +103,7 @@ def _ridge_text(study: NursingStudy) -> list[str]:
     ]
 
 
-def study_text(study: NursingStudy) -> str:
+def study_text(study: api.NursingStudy) -> str:
     """The study as the two tables the command prints."""
     noise = "the twin's default noise" if study.noise else "no noise"
     t = study.timings
@@ -142,11 +140,10 @@ def nursing(robot_name: str, as_json: bool, noise: bool, seed: int, out: str | N
     (PSO and least squares) with R^2 next to the doc's Table 4 and 0.927 / 0.931, and the
     per-joint torque RMSE next to Table 8.
     """
-    robot = load_robot(robot_name)
+    with as_usage():
+        options = api.NursingStudyOptions(noise=noise, seed=seed)
     with progress() as say:
-        study = nursing_study(robot, noise=noise, seed=seed, progress=say)
-    if out is not None:
-        atomic_write(out, lambda fh: fh.write(dumps(study) + "\n"))
+        study = api.nursing_study(robot_name, options, out=out, progress=say)
     tell(study.excitation_notes, study.warnings)
     click.echo(json_result(study) if as_json else study_text(study))
     if out is not None and not as_json:

@@ -1,8 +1,9 @@
 """``kinergy optimize``: energy-optimal speeds and accelerations of a movej program.
 
-Parses the options, runs :func:`kinergy.workflows.optimize.run_optimize` (the optimum at a
-cycle time against the program as written and uniform time scaling, all re-simulated at 500 Hz,
-the Pareto front, the URScript and plot files) and prints its result as text or JSON.
+Parses the flags into :class:`~kinergy.optimize.options.ProgramOptions` (which checks them),
+runs :func:`kinergy.api.optimize_program` (the optimum at a cycle time against the program as
+written and uniform time scaling, all re-simulated at 500 Hz, the Pareto front, the URScript and
+plot files) and prints its result as text or JSON.
 """
 
 from __future__ import annotations
@@ -13,9 +14,10 @@ from typing import Any, TypeVar
 
 import click
 
+from kinergy import api
 from kinergy.cli.common import (
-    Finite,
-    flag_of,
+    as_usage,
+    choice_of,
     json_result,
     load,
     output_file_option,
@@ -25,46 +27,36 @@ from kinergy.cli.common import (
     table,
     writes,
 )
-from kinergy.errors import KinergyError
 from kinergy.optimize import ParetoPoint, ProgramResult, TimingResult
-from kinergy.optimize.options import Configurations, ProgramOptions, ToolSymmetry, ViaPoints
+from kinergy.optimize.options import MAX_CYCLE_TIME
 from kinergy.optimize.programs import Lever, supply
-from kinergy.workflows.optimize import OptimizeRun, run_optimize
-from kinergy.workflows.optimize_program import ProgramRun, run_program_optimize
 
-__all__ = ["lever_options", "optimize", "optimize_text", "program_options", "program_text"]
+__all__ = ["CycleTime", "lever_options", "optimize", "optimize_text", "program_text"]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
 _PARTS = ("friction", "copper", "inertial", "gravity")
-#: the longest cycle time optimised, s (each is re-simulated at 500 Hz, Pareto points and all)
-MAX_CYCLE_TIME = 600.0
-#: the smallest and largest speed (rad/s) and acceleration (rad/s^2) caps taken (below 1e-3,
-#: 0.06 deg/s, a move takes longer than any cycle-time budget and its profile underflows)
-_MIN_CAP = 1e-3
-_MAX_CAP = {"--v-max": 100.0, "--a-max": 1e4}
 
 
-def _cycle_time(text: str) -> float | None:
-    """``same`` -> None (the program's own); otherwise seconds > 0."""
-    if text.strip().lower() == "same":
-        return None
-    try:
-        value = float(text)
-    except ValueError:
-        raise KinergyError(f"--cycle-time: expected seconds or 'same', got {text!r}") from None
-    if not (math.isfinite(value) and 0.0 < value <= MAX_CYCLE_TIME):
-        raise KinergyError(
-            f"--cycle-time: must be > 0 and at most {MAX_CYCLE_TIME:g} s, got {text!r}"
-        )
-    return value
+class CycleTime(click.ParamType):
+    """``--cycle-time SECONDS|same``: a number of seconds, or ``same`` (None: the program's
+    own); the bounds are :class:`~kinergy.optimize.options.ProgramOptions`'."""
 
+    name = "seconds|same"
 
-def _cap(name: str, value: float | None) -> None:
-    if value is not None and not (math.isfinite(value) and _MIN_CAP <= value <= _MAX_CAP[name]):
-        raise KinergyError(
-            f"{name}: must be at least {_MIN_CAP:g} and at most {_MAX_CAP[name]:g}, got {value:g}"
-        )
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if value is None or isinstance(value, float):
+            return value
+        if str(value).strip().lower() == "same":
+            return None
+        try:
+            return float(value)
+        except ValueError:
+            self.fail(f"expected seconds or 'same', got {value!r}", param, ctx)
+
+    def shown(self, value: float | None) -> float | str:
+        """The value as ``--json`` records the options given: ``same`` for None."""
+        return "same" if value is None else value
 
 
 def _moves_table(prog: ProgramResult, opt: ProgramResult) -> str:
@@ -148,7 +140,7 @@ def _pareto_table(front: Sequence[ParetoPoint]) -> str:
     return table(["cycle [s]", "optimised [J]", "uniform [J]"], rows)
 
 
-def optimize_text(run: OptimizeRun) -> str:
+def optimize_text(run: api.OptimizeRun) -> str:
     """The ``optimize`` report: per move, the totals, the saving and limits, the Pareto front."""
     result, task = run.result, run.task
     lines = [
@@ -188,7 +180,7 @@ def _levers_table(levers: Sequence[Lever]) -> str:
     return table([*headers, "used", "note"], rows)
 
 
-def program_text(run: ProgramRun) -> str:
+def program_text(run: api.ProgramRun) -> str:
     """The ``optimize`` report of a URScript program: per move, per lever, the targets."""
     result = run.result
     own, opt = result.program.result, result.optimized.result
@@ -234,23 +226,23 @@ def lever_options(prefix: str = "") -> Callable[[F], F]:
     options = [
         click.option(
             "--configurations",
-            type=click.Choice([c.value for c in Configurations]),
-            default="keep",
+            type=choice_of(api.Configurations),
+            default=api.Configurations.KEEP.value,
             show_default=True,
             help=said("the IK branch of a movej's pose target (free: any of the eight)."),
         ),
         click.option(
             "--tool-symmetry",
             "tool_symmetry",
-            type=click.Choice([s.value for s in ToolSymmetry]),
-            default="none",
+            type=choice_of(api.ToolSymmetry),
+            default=api.ToolSymmetry.NONE.value,
             show_default=True,
             help=said("the tool may turn about its z axis (any angle, 180 or 90 deg)."),
         ),
         click.option(
             "--via",
-            type=click.Choice([v.value for v in ViaPoints]),
-            default="keep",
+            type=choice_of(api.ViaPoints),
+            default=api.ViaPoints.KEEP.value,
             show_default=True,
             help=said(
                 "joint-space via points (a movej's target followed by a movej, nothing "
@@ -261,7 +253,7 @@ def lever_options(prefix: str = "") -> Callable[[F], F]:
         click.option("--no-blends", is_flag=True, help=said("no blend radii on via points.")),
         click.option(
             "--standby",
-            type=Finite(min=0.0),
+            type=float,
             default=None,
             help=said("standby power (W) counted over the cycle time [default: the robot file's]."),
         ),
@@ -275,58 +267,24 @@ def lever_options(prefix: str = "") -> Callable[[F], F]:
     return decorate
 
 
-#: the options only a URScript program takes, and those only a task takes (the Pareto front)
-PROGRAM_ONLY = ("configurations", "tool_symmetry", "via", "no_blends", "standby", "motions")
-TASK_ONLY = ("points", "fixed_shares", "plot")
-#: the values of those options that ask for nothing (--pareto-points 0: no front)
-NEUTRAL: dict[str, object] = {"points": 0}
-
-
-def _for_its_kind(task: str) -> None:
-    """Refuse, in one line, an option given on the command line that the kind of TASK does not
-    take (it would be left unused; a value that asks for nothing, :data:`NEUTRAL`, passes)."""
-    ctx = click.get_current_context()
-    script = task.endswith(".script")
-    for name in TASK_ONLY if script else PROGRAM_ONLY:
-        unused = ctx.params[name] != NEUTRAL.get(name, object())
-        if ctx.get_parameter_source(name) is click.core.ParameterSource.COMMANDLINE and unused:
-            flag = flag_of(ctx.command, name)
-            if script:
-                raise KinergyError(
-                    f"{flag}: only for a task (the Pareto front of its timing); {task} is a "
-                    "URScript program"
-                )
-            raise KinergyError(
-                f"{flag}: only for a URScript program (*.script); {task} is a task, whose "
-                "timing alone is optimised"
-            )
-
-
 def program_options(
     *,
-    configurations: str,
-    tool_symmetry: str,
-    via: str,
+    configurations: api.Configurations,
+    tool_symmetry: api.ToolSymmetry,
+    via: api.ViaPoints,
     no_blends: bool,
     standby: float | None,
-    cycle_time: str,
+    cycle_time: float | None,
     v_max: float | None,
     a_max: float | None,
-) -> ProgramOptions:
-    """The options of a URScript program's optimisation, parsed once into their types (one
-    line naming the flag for a bad value)."""
-    _cap("--v-max", v_max)
-    _cap("--a-max", a_max)
-    return ProgramOptions(
-        configurations=Configurations.parse(configurations),
-        tool_symmetry=ToolSymmetry.parse(tool_symmetry),
-        via=ViaPoints.parse(via),
-        blends=not no_blends,
-        standby=standby,
-        cycle_time=_cycle_time(cycle_time),
-        v_max=v_max,
-        a_max=a_max,
-    )
+) -> api.ProgramOptions:
+    """The flags of the levers, the cycle time and the caps as the API's
+    :class:`~kinergy.optimize.options.ProgramOptions` (a value it refuses: a usage error)."""
+    with as_usage():
+        return api.ProgramOptions(
+            configurations=configurations, tool_symmetry=tool_symmetry, via=via,
+            blends=not no_blends, standby=standby, cycle_time=cycle_time, v_max=v_max, a_max=a_max,
+        )  # fmt: skip
 
 
 @click.command()
@@ -335,10 +293,11 @@ def program_options(
 @click.option(
     "--cycle-time",
     "cycle_time",
+    type=CycleTime(),
     default="same",
     show_default=True,
     metavar="SECONDS|same",
-    help="Cycle-time budget; 'same': the program's own.",
+    help=f"Cycle-time budget (at most {MAX_CYCLE_TIME:g} s); 'same': the program's own.",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @output_file_option(
@@ -351,12 +310,12 @@ def program_options(
 )
 @payload_option
 @click.option(
-    "--v-max", "v_max", type=Finite(), default=None, help="Cap on every joint's speed, rad/s."
+    "--v-max", "v_max", type=float, default=None, help="Cap on every joint's speed, rad/s."
 )
 @click.option(
     "--a-max",
     "a_max",
-    type=Finite(),
+    type=float,
     default=None,
     help="Cap on every joint's acceleration, rad/s² [default: the model's limits; a UR model "
     "has none, so the torque limits bound it].",
@@ -364,15 +323,15 @@ def program_options(
 @click.option(
     "--pareto-points",
     "points",
-    type=click.IntRange(0, 50),
-    default=8,
-    show_default=True,
-    help="Cycle times on the Pareto front (0: none).",
+    type=int,
+    default=None,
+    help=f"Tasks: cycle times on the Pareto front, 0 (none) to {api.MAX_POINTS} "
+    f"[{api.TASK_POINTS}].",
 )
 @click.option(
     "--fixed-shares",
     is_flag=True,
-    help="Keep each move's share of the cycle time; choose only speeds and accelerations.",
+    help="Tasks: keep each move's share of the cycle time; choose only speeds and accelerations.",
 )
 @lever_options("URScript programs: ")
 @click.option(
@@ -386,18 +345,18 @@ def program_options(
 def optimize(
     model: str,
     task_name: str,
-    cycle_time: str,
+    cycle_time: float | None,
     as_json: bool,
     urscript: str | None,
     plot: str | None,
     payload: str | None,
     v_max: float | None,
     a_max: float | None,
-    points: int,
+    points: int | None,
     fixed_shares: bool,
-    configurations: str,
-    tool_symmetry: str,
-    via: str,
+    configurations: api.Configurations,
+    tool_symmetry: api.ToolSymmetry,
+    via: api.ViaPoints,
     no_blends: bool,
     standby: float | None,
     motions: str | None,
@@ -411,57 +370,19 @@ def optimize(
     all re-simulated at 500 Hz with every speed, acceleration, torque and position limit
     checked at every sample.
     """
-    budget = _cycle_time(cycle_time)
-    _cap("--v-max", v_max)
-    _cap("--a-max", a_max)
-    _for_its_kind(task_name)
-    if task_name.endswith(".script"):
-        options = program_options(
-            configurations=configurations,
-            tool_symmetry=tool_symmetry,
-            via=via,
-            no_blends=no_blends,
-            standby=standby,
-            cycle_time=cycle_time,
-            v_max=v_max,
-            a_max=a_max,
-        )
-        with progress() as say:
-            program = run_program_optimize(
-                load(model, payload),
-                task_name,
-                urscript=urscript,
-                motions=motions,
-                options=options,
-                progress=say,
-            )
-        click.echo(json_result(program.to_dict()) if as_json else program_text(program))
-        if not as_json:
-            for path in program.written:
-                click.echo(f"wrote {path}")
-        return
-    if plot is not None and points < 2:
-        raise KinergyError("--plot: needs a Pareto front (--pareto-points of at least 2)")
-    robot = load(model, payload)
+    options = program_options(
+        configurations=configurations, tool_symmetry=tool_symmetry, via=via, no_blends=no_blends,
+        standby=standby, cycle_time=cycle_time, v_max=v_max, a_max=a_max,
+    )  # fmt: skip
     with progress() as say:
-        say(
-            f"optimising the timing of {task_name}"
-            + (f" and {points} Pareto points" if points else "")
-        )
-        run = run_optimize(
-            robot,
-            task_name,
-            cycle_time=budget,
-            v_max=v_max,
-            a_max=a_max,
-            points=points,
-            share_budget=not fixed_shares,
-            urscript=urscript,
-            plot=plot,
-        )
+        run = api.optimize_program(
+            load(model, payload), task_name, options, points=points,
+            share_budget=not fixed_shares, urscript=urscript, motions=motions, plot=plot,
+            progress=say,
+        )  # fmt: skip
     if as_json:
-        click.echo(json_result(run.to_dict()))
+        click.echo(json_result(run))
         return
-    click.echo(optimize_text(run))
+    click.echo(program_text(run) if isinstance(run, api.ProgramRun) else optimize_text(run))
     for path in run.written:
         click.echo(f"wrote {path}")

@@ -1,10 +1,9 @@
 """``kinergy place``: where the robot's base should stand for a URScript program.
 
 Parses the search area into a typed grid (:class:`kinergy.optimize.placement.PlacementGrid`) and
-the levers into :class:`kinergy.optimize.options.ProgramOptions`, runs
-:func:`kinergy.workflows.place.run_place` (every candidate checked for reach and optimised at
-today's cycle time; the best's program and the energy map written where asked) and prints the
-result as text or JSON.
+the levers into :class:`kinergy.optimize.options.ProgramOptions`, runs :func:`kinergy.api.place`
+(every candidate checked for reach and optimised at today's cycle time; the best's program and the
+energy map written where asked) and prints the result as text or JSON.
 """
 
 from __future__ import annotations
@@ -13,8 +12,9 @@ import math
 
 import click
 
+from kinergy import api
 from kinergy.cli.common import (
-    Finite,
+    as_usage,
     json_result,
     load,
     output_file_option,
@@ -24,15 +24,14 @@ from kinergy.cli.common import (
     table,
     writes,
 )
-from kinergy.cli.optimize import lever_options, program_options
+from kinergy.cli.optimize import CycleTime, lever_options, program_options
 from kinergy.errors import KinergyError
-from kinergy.optimize.placement import Candidate, PlacementGrid, Range
-from kinergy.workflows.place import PlaceRun, run_place
+from kinergy.optimize.placement import Candidate
 
 __all__ = ["parse_range", "place", "place_text"]
 
 
-def parse_range(text: str | None, flag: str, unit: str, scale: float = 1.0) -> Range:
+def parse_range(text: str | None, flag: str, unit: str, scale: float = 1.0) -> api.Range:
     """``MIN:MAX`` (in ``unit``, times ``scale`` into SI) as a :class:`Range`; None: ``0:0``.
 
     Raises
@@ -42,7 +41,7 @@ def parse_range(text: str | None, flag: str, unit: str, scale: float = 1.0) -> R
         backwards is refused by :class:`PlacementGrid`.)
     """
     if text is None:
-        return Range(0.0, 0.0)
+        return api.Range(0.0, 0.0)
     parts = text.split(":")
     try:
         low, high = (float(p) for p in parts) if len(parts) == 2 else (math.nan, math.nan)
@@ -50,14 +49,14 @@ def parse_range(text: str | None, flag: str, unit: str, scale: float = 1.0) -> R
         low = high = math.nan
     if len(parts) != 2 or not (math.isfinite(low) and math.isfinite(high)):
         raise KinergyError(f"{flag}: expected MIN:MAX in {unit} (two finite numbers), got {text!r}")
-    return Range(low * scale, high * scale)
+    return api.Range(low * scale, high * scale)
 
 
 def _energy(c: Candidate) -> str:
     return f"{c.e_supply:.1f}" if c.e_supply is not None else "-"
 
 
-def place_text(run: PlaceRun) -> str:
+def place_text(run: api.PlaceRun) -> str:
     """The ``place`` report: the candidates, today's and the best placement, what it saves."""
     search = run.search
     today, best = search.today, search.best
@@ -114,10 +113,15 @@ def place_text(run: PlaceRun) -> str:
     "--yaw", "yaw", default=None, metavar="MIN:MAX", help="Base turn about the vertical, deg [0:0]."
 )
 @click.option(
-    "--step", type=Finite(), default=0.1, show_default=True, help="Grid step of x, y, z, m."
+    "--step", type=float, default=0.1, show_default=True, help="Grid step of x, y, z, m (> 0)."
 )
 @click.option(
-    "--yaw-step", "yaw_step", type=Finite(), default=15.0, show_default=True, help="Grid step, deg."
+    "--yaw-step",
+    "yaw_step",
+    type=float,
+    default=15.0,
+    show_default=True,
+    help="Grid step, deg (> 0).",
 )
 @output_file_option("--urscript", "Write the best placement's optimised program to this file.")
 @output_file_option("--plot", "Write the energy map to this PNG.", metavar="FILE.png")
@@ -126,17 +130,18 @@ def place_text(run: PlaceRun) -> str:
 @click.option(
     "--cycle-time",
     "cycle_time",
+    type=CycleTime(),
     default="same",
     show_default=True,
     metavar="SECONDS|same",
     help="Cycle time of every candidate; 'same': today's program's own.",
 )
 @click.option(
-    "--v-max", "v_max", type=Finite(), default=None, help="Cap on every joint's speed, rad/s "
+    "--v-max", "v_max", type=float, default=None, help="Cap on every joint's speed, rad/s "
     "[default: today's program's peak]."
 )  # fmt: skip
 @click.option(
-    "--a-max", "a_max", type=Finite(), default=None, help="Cap on every joint's acceleration, "
+    "--a-max", "a_max", type=float, default=None, help="Cap on every joint's acceleration, "
     "rad/s² [default: today's program's peak]."
 )  # fmt: skip
 @lever_options()
@@ -154,12 +159,12 @@ def place(
     plot: str | None,
     as_json: bool,
     payload: str | None,
-    cycle_time: str,
+    cycle_time: float | None,
     v_max: float | None,
     a_max: float | None,
-    configurations: str,
-    tool_symmetry: str,
-    via: str,
+    configurations: api.Configurations,
+    tool_symmetry: api.ToolSymmetry,
+    via: api.ViaPoints,
     no_blends: bool,
     standby: float | None,
 ) -> None:
@@ -172,30 +177,23 @@ def place(
     and the best, whose optimised program --urscript writes (read back and simulated again).
     At most 400 candidates.
     """
-    if not (math.isfinite(yaw_step) and yaw_step > 0.0):
-        raise KinergyError(f"--yaw-step: must be a finite number of degrees > 0, got {yaw_step:g}")
-    grid = PlacementGrid(
-        x=parse_range(x, "--x", "m"),
-        y=parse_range(y, "--y", "m"),
-        z=parse_range(z, "--z", "m"),
-        yaw=parse_range(yaw, "--yaw", "deg", math.pi / 180.0),
-        step=step,
-        yaw_step=math.radians(yaw_step),
-    )
+    with as_usage():
+        grid = api.PlacementGrid(
+            x=parse_range(x, "--x", "m"),
+            y=parse_range(y, "--y", "m"),
+            z=parse_range(z, "--z", "m"),
+            yaw=parse_range(yaw, "--yaw", "deg", math.pi / 180.0),
+            step=step,
+            yaw_step=math.radians(yaw_step),
+        )
     options = program_options(
-        configurations=configurations,
-        tool_symmetry=tool_symmetry,
-        via=via,
-        no_blends=no_blends,
-        standby=standby,
-        cycle_time=cycle_time,
-        v_max=v_max,
-        a_max=a_max,
-    )
+        configurations=configurations, tool_symmetry=tool_symmetry, via=via, no_blends=no_blends,
+        standby=standby, cycle_time=cycle_time, v_max=v_max, a_max=a_max,
+    )  # fmt: skip
     robot = load(robot_name, payload)
     with progress() as say:
-        run = run_place(
-            robot, program_file, grid, options=options, urscript=urscript, plot=plot, progress=say
+        run = api.place(
+            robot, program_file, grid, options, urscript=urscript, plot=plot, progress=say
         )
     if as_json:
         click.echo(json_result(run.to_dict()))

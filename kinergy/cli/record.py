@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import click
 
-from kinergy.cli.common import Finite, log_output, output_file_option, progress, writes
-from kinergy.workflows.record import record_to_file
+from kinergy import api
+from kinergy.cli.common import as_usage, log_output, output_file_option, progress, writes
 
 __all__ = ["record"]
 
@@ -14,14 +14,18 @@ __all__ = ["record"]
 @click.argument("address", metavar="HOST[:PORT]")
 @output_file_option("--out", "Log file to write.", required=True)
 @click.option(
-    "--frequency", type=Finite(), default=500.0, show_default=True, help="Packages per second, Hz."
+    "--frequency",
+    type=float,
+    default=500.0,
+    show_default=True,
+    help="Packages per second, Hz (> 0, <= 500).",
 )
-@click.option("--duration", type=Finite(), help="Stop after this many seconds of controller time.")
+@click.option("--duration", type=float, help="Stop after this many seconds of controller time.")
 @click.option(
-    "--rotate", "rotate_minutes", type=Finite(), metavar="MINUTES", help="New file every MINUTES."
+    "--rotate", "rotate_minutes", type=float, metavar="MINUTES", help="New file every MINUTES."
 )
 @click.option(
-    "--rotate-size", "rotate_megabytes", type=Finite(), metavar="MB", help="New file every MB."
+    "--rotate-size", "rotate_megabytes", type=float, metavar="MB", help="New file every MB."
 )
 @writes(files=("out",))
 def record(
@@ -37,17 +41,16 @@ def record(
     Every package is kept, with the controller's own time stamps, in UR's record.py layout plus a
     `segment` column that counts reconnections. Ctrl-C or SIGTERM stops with complete files.
     """
-    log_output("--out", out)
-    with progress() as say:
-        result = record_to_file(
-            address,
-            out,
+    with as_usage():
+        options = api.RecordOptions(
             frequency=frequency,
             duration=duration,
             rotate_minutes=rotate_minutes,
             rotate_megabytes=rotate_megabytes,
-            status=say,
         )
+    log_output("--out", out)
+    with progress() as say:
+        result = api.record(address, out, options, status=say)
     span = 0.0 if result.first is None else (result.last or 0.0) - result.first
     files = ", ".join(result.files)
     click.echo(

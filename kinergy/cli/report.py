@@ -4,24 +4,16 @@ from __future__ import annotations
 
 import click
 
+from kinergy import api
 from kinergy.cli.common import (
-    accept_option,
-    columns_option,
-    effort_option,
-    load,
-    log_reading,
-    payload_option,
     print_tables,
     progress,
-    repair_option,
+    reading_options,
     report_folder_option,
     tell,
-    topic_option,
-    window_options,
     writes,
 )
-from kinergy.errors import KinergyError
-from kinergy.workflows.study import study_report
+from kinergy.logs.reading import LogReading
 
 __all__ = ["report"]
 
@@ -50,13 +42,7 @@ __all__ = ["report"]
     help="Account the energy of this log's or motion file's motion (repeatable).",
 )
 @report_folder_option()
-@columns_option
-@accept_option
-@topic_option
-@effort_option
-@payload_option
-@repair_option
-@window_options
+@reading_options("columns", "repair", "accept", "topic", "effort", "payload", "start", "stop")
 @writes(folders=("out",), inputs=("model", "identify_logs", "validate_logs", "energy_logs"))
 def report(
     model: str,
@@ -64,41 +50,20 @@ def report(
     validate_logs: tuple[str, ...],
     energy_logs: tuple[str, ...],
     out: str | None,
-    columns: str | None,
-    payload: str | None,
-    repair: bool,
-    accept: tuple[str, ...],
-    topic: str | None,
-    effort: str | None,
-    start: float | None,
-    stop: float | None,
+    reading: LogReading,
 ) -> None:
     """Build the study report (tables, figures, report.html) from your own model and logs."""
-    if not (identify_logs or validate_logs or energy_logs):
-        raise KinergyError("report: give logs with --identify, --validate or --energy")
-    robot = load(model, None)
-    reading = log_reading(
-        robot,
-        columns=columns,
-        repair=repair,
-        accept=accept,
-        topic=topic,
-        effort=effort,
-        payload=payload,
-        start=start,
-        stop=stop,
-    )
     with progress() as say:
-        path, tables, said = study_report(
-            robot,
-            out,
-            identify_logs=identify_logs,
-            validate_logs=validate_logs,
-            energy_logs=energy_logs,
+        study = api.report(
+            model,
+            identify=identify_logs,
+            validate=validate_logs,
+            energy=energy_logs,
             reading=reading,
+            out=out,
             model_name=model,
             progress=say,
         )
-    tell(said.notes, said.warnings)
-    print_tables(tables, ["IV", "V", "VI", "VII", "VIII", "breakdown"])
-    click.echo(f"\nreport: {path}")
+    tell(study.notes, study.warnings)
+    print_tables(study.tables, ["IV", "V", "VI", "VII", "VIII", "breakdown"])
+    click.echo(f"\nreport: {study.path}")

@@ -4,13 +4,13 @@ built-in library and robot files."""
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Sequence
-from pathlib import Path
 
 import click
 import numpy as np
 
+from kinergy import api
 from kinergy.cli.common import (
+    choice_of,
     fmt,
     fmt_vector,
     json_result,
@@ -21,21 +21,7 @@ from kinergy.cli.common import (
     table,
     writes,
 )
-from kinergy.errors import KinergyError
-from kinergy.files import atomic_write, check_outputs
-from kinergy.model import (
-    SOURCE_CATEGORIES,
-    Robot,
-    library_names,
-    load_robot,
-    robot_to_dict,
-    save_robot,
-)
-from kinergy.model.export import Export
-from kinergy.model.mjcf import robot_to_mjcf
-from kinergy.model.urdf import import_urdf
-from kinergy.model.urdf_export import robot_to_urdf
-from kinergy.workflows.calibration import CalibrationImport, import_calibration
+from kinergy.model import SOURCE_CATEGORIES, Robot
 
 __all__ = ["robot"]
 
@@ -55,11 +41,6 @@ def robot() -> None:
     """Robot models: the built-in library and robot files."""
 
 
-def _status(r: Robot, cats: Sequence[str]) -> str:
-    statuses = {r.sources[c].status for c in cats}
-    return statuses.pop() if len(statuses) == 1 else "mixed"
-
-
 @robot.command("list")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON instead of a table.")
 def robot_list(as_json: bool) -> None:
@@ -69,28 +50,15 @@ def robot_list(as_json: bool) -> None:
     from logs; calibration: fitted to the maker's joint calibration; nominal: an estimate,
     identify before trusting.
     """
-    robots = [load_robot(name) for name in library_names()]
+    robots = api.robot_list()
     if as_json:
-        out = [
-            {
-                "name": r.name,
-                "description": r.description,
-                "joints": r.n,
-                "convention": r.convention,
-                "sources": {
-                    c: {"status": r.sources[c].status, "ref": r.sources[c].ref}
-                    for c in SOURCE_CATEGORIES
-                },
-            }
-            for r in robots
-        ]
-        click.echo(json_result(out))
+        click.echo(json_result([r.to_dict() for r in robots]))
         return
     headers = ["name", "joints", "conv", *_PROVENANCE_COLUMNS, "description"]
     rows = [
-        [r.name, str(r.n), r.convention]
-        + [_status(r, cats) for cats in _PROVENANCE_COLUMNS.values()]
-        + [r.description]
+        [r.robot.name, str(r.robot.n), r.robot.convention]
+        + [r.status(cats) for cats in _PROVENANCE_COLUMNS.values()]
+        + [r.robot.description]
         for r in robots
     ]
     click.echo(table(headers, rows))
@@ -213,11 +181,11 @@ def show_text(r: Robot) -> str:
 @writes(inputs=("robot_name",))
 def robot_show(robot_name: str, as_json: bool, payload: str | None) -> None:
     """Show a robot model: a built-in name (ur5e) or a robot file (.toml, .urdf)."""
-    r = load(robot_name, payload)
-    click.echo(json_result(robot_to_dict(r)) if as_json else show_text(r))
+    shown = api.robot_show(load(robot_name, payload))
+    click.echo(json_result(shown) if as_json else show_text(shown.robot))
 
 
-def _calibration_text(result: CalibrationImport, out: str, points: bool) -> str:
+def _calibration_text(result: api.CalibrationImport, out: str, points: bool) -> str:
     rows = []
     for j in result.joints:
         measured = np.array([p.friction for p in j.points])
@@ -298,14 +266,14 @@ def robot_import_calibration(
     The summary's speeds are joint side, its friction torques motor side; its U is the
     controller's dq voltage (docs/FRICTION.md).
     """
-    inputs = [calibration] + ([robot_name] if os.path.exists(robot_name) else [])
-    check_outputs([("--out", out)], inputs)
-    result = import_calibration(load_robot(robot_name), calibration, friction=friction, out=out)
+    result = api.import_calibration(robot_name, calibration, friction=friction, out=out)
     click.echo(json_result(result) if as_json else _calibration_text(result, out, points))
 
 
-#: ``--format`` of ``robot export``: the writer of each format
-_EXPORTERS: dict[str, Callable[..., Export]] = {"urdf": robot_to_urdf, "mjcf": robot_to_mjcf}
+def _source(model: str) -> str:
+    """What an exported file says it was made from: a robot file's name, or the built-in
+    name."""
+    return os.path.basename(model) if os.path.exists(model) else model
 
 
 @robot.command("export")
@@ -313,7 +281,7 @@ _EXPORTERS: dict[str, Callable[..., Export]] = {"urdf": robot_to_urdf, "mjcf": r
 @click.option(
     "--format",
     "format_name",
-    type=click.Choice(sorted(_EXPORTERS)),
+    type=choice_of(api.ExportFormat),
     required=True,
     help="urdf: kinematics, link inertials, limits and joint-side friction, with the robot file "
     "itself in a <kinergy:robot> element (robot import-urdf reads it back); mjcf: a MuJoCo model with the "
@@ -323,7 +291,7 @@ _EXPORTERS: dict[str, Callable[..., Export]] = {"urdf": robot_to_urdf, "mjcf": r
 @output_file_option("--out", "File to write.", required=True)
 @payload_option
 @writes(files=("out",), inputs=("model",))
-def robot_export(model: str, format_name: str, out: str, payload: str | None) -> None:
+def robot_export(model: str, format_name: api.ExportFormat, out: str, payload: str | None) -> None:
     """Write MODEL (a built-in name or a robot file) as URDF or MuJoCo MJCF.
 
     What the format cannot hold exactly (a friction model that is not Coulomb + viscous, a
@@ -331,11 +299,10 @@ def robot_export(model: str, format_name: str, out: str, payload: str | None) ->
     file's comments and in a note here; docs/EXPORT.md has the details.
     """
     r = load(model, payload)
-    export = _EXPORTERS[format_name](r, source=Path(model).name if os.path.exists(model) else model)
-    atomic_write(out, lambda fh: fh.write(export.text))
+    export = api.export_robot(r, format_name, out, source=_source(model))
     for message in export.notes:
         note(message)
-    click.echo(f"wrote {out}: {r.name}, {r.n} joints, {format_name.upper()}")
+    click.echo(f"wrote {out}: {r.name}, {r.n} joints, {format_name.value.upper()}")
 
 
 @robot.command("import-urdf")
@@ -358,15 +325,8 @@ def robot_import_urdf(
     (drake:rotor_inertia) and Coulomb + viscous friction from <dynamics>; the rest of the drives
     is nominal: identify it from logs before trusting energy predictions.
     """
-    if Path(out).suffix.lower() == ".urdf":
-        raise KinergyError(
-            f"--out: {out} would be written as TOML but read back as URDF; name it .toml"
-        )
-    result = import_urdf(urdf, root=root, tip=tip, name=name)
+    result = api.import_urdf(urdf, out, root=root, tip=tip, name=name)
     r = result.robot
-    save_robot(
-        r, out, header=f"{r.name}: imported from {Path(urdf).name} by kinergy robot import-urdf"
-    )
     for text in result.notes:
         note(text)
     if not result.restored:

@@ -4,24 +4,21 @@ from __future__ import annotations
 
 import click
 
+from kinergy import api
 from kinergy.cli.common import (
-    Finite,
-    accept_option,
-    columns_option,
+    as_usage,
+    choice_of,
     load,
     log_output,
-    log_reading,
     output_file_option,
     payload_option,
     prose,
-    refuse_together,
+    reading_options,
     seed_option,
     tell,
     writes,
 )
-from kinergy.errors import KinergyError
-from kinergy.twin import MISMATCHES, TwinSettings
-from kinergy.workflows.twin import simulate_to_file
+from kinergy.logs.reading import LogReading
 
 __all__ = ["simulate"]
 
@@ -39,8 +36,8 @@ __all__ = ["simulate"]
 @output_file_option("--out", "Log to write.", required=True)
 @click.option(
     "--mismatch",
-    type=click.Choice(MISMATCHES),
-    default="none",
+    type=choice_of(api.Mismatch),
+    default=api.Mismatch.NONE.value,
     show_default=True,
     help="none: ROBOT itself is the truth; realistic: a true robot that differs from ROBOT "
     "(inertias, k_t, electrics, concave load- and temperature-dependent friction) with a real "
@@ -52,40 +49,27 @@ __all__ = ["simulate"]
     dest="truth_out",
 )
 @click.option("--exact", is_flag=True, help="No lag and no noise: the model's equations exactly.")
-@click.option("--lag", type=Finite(0.0, 1.0), help="Real motion behind the target, s [0.004].")
+@click.option("--lag", type=float, help="Real motion behind the target, s, 0 to 1 [0.004].")
+@click.option("--speed-noise", type=float, help="Measured speed noise std, rad/s, 0 to 10 [0.01].")
+@click.option("--current-noise", type=float, help="Measured current noise std, A, 0 to 100 [0.04].")
 @click.option(
-    "--speed-noise",
-    type=Finite(0.0, 10.0),
-    help="Measured speed noise std, rad/s [0.01].",
-)
-@click.option(
-    "--current-noise",
-    type=Finite(0.0, 100.0),
-    help="Measured current noise std, A [0.04].",
-)
-@click.option(
-    "--ambient",
-    type=Finite(-50.0, 100.0),
-    default=25.0,
-    show_default=True,
-    help="Air, deg C.",
+    "--ambient", type=float, default=25.0, show_default=True, help="Air, deg C, -50 to 100."
 )
 @click.option(
     "--initial-temperature",
-    type=Finite(-50.0, 200.0),
+    type=float,
     default=None,
-    help="The joints' temperature at the start, deg C [the ambient: a cold start].",
+    help="The joints' temperature at the start, deg C, -50 to 200 [the ambient: a cold start].",
 )
 @seed_option
 @payload_option
-@columns_option
-@accept_option
+@reading_options("columns", "accept")
 @writes(files=("out", "truth_out"), inputs=("robot_name", "trajectory"))
 def simulate(
     robot_name: str,
     trajectory: str,
     out: str,
-    mismatch: str,
+    mismatch: api.Mismatch,
     truth_out: str | None,
     exact: bool,
     lag: float | None,
@@ -95,50 +79,23 @@ def simulate(
     initial_temperature: float | None,
     seed: int,
     payload: str | None,
-    columns: str | None,
-    accept: tuple[str, ...],
+    reading: LogReading,
 ) -> None:
     """Run the digital twin: write the log a UR controller would record (record.py layout, 500 Hz).
 
     ROBOT is a built-in name or a model file: the model the twin's truth is (--mismatch none) or
     differs from (--mismatch realistic).
     """
-    exact_means = "--exact means no lag and no noise"
-    refuse_together(
-        ("exact", "lag", exact_means),
-        ("exact", "speed_noise", exact_means),
-        ("exact", "current_noise", exact_means),
-    )
-    if truth_out is not None and mismatch != "realistic":
-        raise KinergyError(
-            "--truth: only with --mismatch realistic (with none the twin's truth is ROBOT itself)"
-        )
+    with as_usage():
+        options = api.SimulateOptions(
+            mismatch=mismatch, seed=seed, exact=exact, lag=lag, speed_noise=speed_noise,
+            current_noise=current_noise, ambient=ambient, initial_temperature=initial_temperature,
+        )  # fmt: skip
     log_output("--out", out)
     r = load(robot_name, payload)
-    reading = log_reading(r, columns=columns, accept=accept)
-    if exact:
-        base = TwinSettings.exact()
-    elif mismatch == "realistic":
-        base = TwinSettings.realistic(seed)
-    else:
-        base = TwinSettings()
-    settings = TwinSettings(
-        lag=base.lag if lag is None else lag,
-        speed_noise=base.speed_noise if speed_noise is None else speed_noise,
-        position_noise=base.position_noise,
-        current_noise=base.current_noise if current_noise is None else current_noise,
-        seed=seed,
-        current_step=base.current_step,
-        voltage_noise=base.voltage_noise,
-        ripple=base.ripple,
-        ambient=ambient,
-        initial_temperature=initial_temperature,
-    )
-    twin, said = simulate_to_file(
-        r, trajectory, out, settings, reading=reading, mismatch=mismatch, truth_out=truth_out
-    )
-    tell(said.notes, said.warnings)
-    t = twin.t
+    twin = api.simulate(r, trajectory, options, reading=reading, out=out, truth_out=truth_out)
+    tell(twin.notes, twin.warnings)
+    t, settings = twin.log.t, twin.settings
     click.echo(
         prose(
             f"wrote {out}: {len(t)} samples, {t[-1] - t[0]:.3f} s, {r.name}, trajectory "

@@ -8,22 +8,14 @@ from pathlib import Path
 import click
 import numpy as np
 
+from kinergy import api
 from kinergy.cli.common import (
-    accept_option,
-    columns_option,
-    cutoff_option,
-    effort_option,
     json_result,
-    load,
-    log_reading,
-    payload_option,
     prose,
-    repair_option,
+    reading_options,
     swapped,
     table,
     tell,
-    topic_option,
-    window_options,
     writes,
 )
 from kinergy.identification.metrics import JointMetrics
@@ -34,7 +26,8 @@ from kinergy.identification.validation import (
     SignalMetrics,
     ValidationReport,
 )
-from kinergy.workflows.validate import validate_logs
+from kinergy.logs.reading import LogReading
+from kinergy.model import load_robot
 
 __all__ = ["report_text", "supply_text", "validate", "validation_text"]
 
@@ -136,10 +129,6 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
 @click.command()
 @click.argument("model", metavar="MODEL")
 @click.argument("logs", metavar="LOG...", nargs=-1, required=True)
-@columns_option
-@accept_option
-@topic_option
-@effort_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option(
     "--plots",
@@ -149,25 +138,14 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
     help="Write plots (measured vs predicted, error box plots) to this folder (new, empty, or "
     "one kinergy wrote: it is replaced whole).",
 )
-@cutoff_option
-@payload_option
-@repair_option
-@window_options
+@reading_options()
 @writes(folders=("plots",), inputs=("model", "logs"))
 def validate(
     model: str,
     logs: tuple[str, ...],
-    columns: str | None,
     as_json: bool,
     plots: str | None,
-    cutoff: float | None,
-    payload: str | None,
-    repair: bool,
-    accept: tuple[str, ...],
-    topic: str | None,
-    effort: str | None,
-    start: float | None,
-    stop: float | None,
+    reading: LogReading,
 ) -> None:
     """How well a model predicts logs: torque (UR5e Table V) and current (Table VII) errors and R^2.
 
@@ -175,23 +153,11 @@ def validate(
     writes running it (a simulated robot that differs from the model as a real arm does).
     """
     swapped(model, logs)
-    r = load(model, None)
-    reading = log_reading(
-        r,
-        columns=columns,
-        repair=repair,
-        cutoff=cutoff,
-        accept=accept,
-        topic=topic,
-        effort=effort,
-        payload=payload,
-        start=start,
-        stop=stop,
-    )
-    report = validate_logs(r, logs, reading, plots=plots)
+    r = load_robot(model)
+    report = api.validate(r, logs, reading=reading, plots=plots)
     tell(report.notes, report.warnings)
     if as_json:
-        click.echo(json_result(report, report.inputs))
+        click.echo(json_result(report))
         return
     click.echo(f"{r.name} on {', '.join(logs)}\n")
     click.echo(report_text(report, r.joint_names))

@@ -13,12 +13,14 @@ import datetime as dt
 from collections import defaultdict
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from kinergy.fleet.analysis import PARTS, CycleRecord, LogResult
 from kinergy.fleet.drift import Trend, trend
 from kinergy.fleet.manifest import FleetLog
+from kinergy.jsonable import to_jsonable
 
 __all__ = [
     "ChangeNote",
@@ -106,6 +108,11 @@ class FleetResult:
     seconds: float
     peak_rss_MB: float
     cycles_table: list[dict[str, object]] = field(default_factory=list, metadata={"json": False})
+
+    def to_dict(self) -> dict[str, Any]:
+        """``kinergy fleet energy --json`` (without where the command came from)."""
+        out: dict[str, Any] = to_jsonable(self)
+        return out
 
 
 def _sum(values: Sequence[float | None]) -> float | None:

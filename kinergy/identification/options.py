@@ -20,6 +20,7 @@ from kinergy.friction.registry import MODELS
 __all__ = [
     "AUTO",
     "FILTER_CUTOFF",
+    "MAX_RIDGE",
     "CurrentOptions",
     "FrictionOption",
     "FrictionSearch",
@@ -81,6 +82,8 @@ class FrictionSearch(enum.StrEnum):
 
 
 AUTO = FrictionSearch.AUTO
+#: the largest ridge weight taken
+MAX_RIDGE = 1e12
 
 #: what ``--friction`` resolves to: one family for every joint, the search among families, or
 #: None (each joint keeps its own family)
@@ -152,7 +155,7 @@ class IdentifyOptions:
     solver : Solver
         Full method only.
     ridge : float
-        The ridge weight (``solver`` ridge), >= 0.
+        The ridge weight (``solver`` ridge), from 0 to :data:`MAX_RIDGE`.
     """
 
     method: Method = Method.SEQUENTIAL
@@ -181,7 +184,7 @@ class IdentifyOptions:
                 "methods",
                 Code.UNSUPPORTED,
             )
-        ridge = checks.number(self.ridge, "--ridge", ge=0.0)
+        ridge = checks.number(self.ridge, "--ridge", ge=0.0, le=MAX_RIDGE)
         object.__setattr__(self, "ridge", ridge)
         if self.method != Method.FULL:
             return

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -38,6 +39,7 @@ from kinergy.identification.metrics import (
 from kinergy.identification.result import Prediction, Validation, predict
 from kinergy.identification.sanity import check_signals
 from kinergy.io.formats import CHUNK_ROWS
+from kinergy.jsonable import to_jsonable
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs
 from kinergy.model.robot import Robot
@@ -135,6 +137,11 @@ class ValidationReport(SegmentedValidation):
     inputs: InputLogs = field(default_factory=InputLogs, metadata={"json": lambda i: i.records()})
     notes: tuple[str, ...] = ()
     warnings: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """``kinergy validate --json`` (without where the command came from)."""
+        out: dict[str, Any] = to_jsonable(self)
+        return out
 
 
 def holding_mask(t: Array, qd: Array) -> NDArray[np.bool_]:

@@ -37,6 +37,7 @@ __all__ = [
     "MAX_COLUMNS",
     "ColumnMap",
     "Columns",
+    "check_joint_columns",
     "compact_columns",
     "group_columns",
     "parse_column_spec",
@@ -130,16 +131,28 @@ def _check_entry(
         if not vector:
             joints = n_joints if n_joints is not None else "N"
             raise KinergyError(f"--columns: {name} has one value per joint: write {name}:{joints}")
-        if n_joints is not None and width != n_joints:
-            raise KinergyError(
-                f"--columns: {name}:{width} but the robot has {n_joints} joints "
-                f"(write {name}:{n_joints})"
-            )
+        _joint_width(name, width, n_joints)
     elif isinstance(kind, int) and (width != kind or vector != (kind > 1)):
         shown = f"{name}:{kind}" if kind > 1 else name
         raise KinergyError(
             f"--columns: {name} has {kind} value{'s' if kind > 1 else ''}: write {shown}"
         )
+
+
+def _joint_width(name: str, width: int, n_joints: int | None) -> None:
+    if n_joints is not None and width != n_joints:
+        raise KinergyError(
+            f"--columns: {name}:{width} but the robot has {n_joints} joints "
+            f"(write {name}:{n_joints})"
+        )
+
+
+def check_joint_columns(names: Sequence[str], n_joints: int) -> None:
+    """Refuse column ``names`` (a parsed spec, :func:`parse_columns`) whose per-joint fields
+    (``actual_q:N``) do not have ``n_joints`` columns, in one line naming the spec's entry."""
+    for name, members in group_columns(names, "--columns").items():
+        if FIELDS.get(name) == JOINTS:
+            _joint_width(name, len(members), n_joints)
 
 
 @dataclass(frozen=True)

@@ -20,10 +20,69 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from types import FrameType
 
+from kinergy.checks import number
 from kinergy.errors import KinergyError
 from kinergy.live.rtde import Connection, Recipe
 
-__all__ = ["BACKOFF", "Gap", "Stream", "stop_on_signals"]
+__all__ = [
+    "BACKOFF",
+    "MAX_FREQUENCY",
+    "Gap",
+    "RecordOptions",
+    "Stream",
+    "StreamOptions",
+    "stop_on_signals",
+]
+
+#: Hz: the fastest a controller sends (a UR e-Series: 500)
+MAX_FREQUENCY = 500.0
+
+
+@dataclass(frozen=True)
+class StreamOptions:
+    """How long and how fast to follow a controller (``kinergy monitor``), checked on
+    construction: one line naming the option.
+
+    Attributes
+    ----------
+    frequency : float
+        Packages per second, Hz, > 0 and <= :data:`MAX_FREQUENCY`.
+    duration : float or None
+        Stop after this many seconds of controller time (> 0); None: at Ctrl-C or SIGTERM.
+    """
+
+    frequency: float = MAX_FREQUENCY
+    duration: float | None = None
+
+    def __post_init__(self) -> None:
+        frequency = number(self.frequency, "--frequency", gt=0.0, le=MAX_FREQUENCY)
+        object.__setattr__(self, "frequency", frequency)
+        if self.duration is not None:
+            object.__setattr__(self, "duration", number(self.duration, "--duration", gt=0.0))
+
+
+@dataclass(frozen=True)
+class RecordOptions(StreamOptions):
+    """:class:`StreamOptions` of ``kinergy record``, and when to start a new file.
+
+    Attributes
+    ----------
+    rotate_minutes : float or None
+        A new file every this many minutes (> 0); None: one file.
+    rotate_megabytes : float or None
+        A new file every this many MB (> 0); None: one file.
+    """
+
+    rotate_minutes: float | None = None
+    rotate_megabytes: float | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        for name, what in (("rotate_minutes", "--rotate"), ("rotate_megabytes", "--rotate-size")):
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, number(value, what, gt=0.0))
+
 
 #: seconds to wait before each reconnection attempt (the last repeats)
 BACKOFF = (0.1, 0.25, 0.5, 1.0, 2.0, 5.0)
@@ -80,8 +139,6 @@ class Stream:
         stall: float = 2.0,
         status: Callable[[str], None] | None = None,
     ) -> None:
-        if not 0 < frequency <= 500:
-            raise KinergyError(f"--frequency must be in (0, 500] Hz, got {frequency:g}")
         self.host, self.port = host, port
         self.frequency = float(frequency)
         self.stall = stall

@@ -10,31 +10,43 @@ as it is read, for the results to say which data they came from.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import os
 import queue
 import re
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TypeVar
 
 import numpy as np
 
+from kinergy.checks import number
 from kinergy.errors import KinergyError
-from kinergy.io.columns import Columns, printable
+from kinergy.io.columns import (
+    ColumnMap,
+    Columns,
+    check_joint_columns,
+    parse_column_spec,
+    printable,
+)
 from kinergy.io.fields import closest
 from kinergy.io.formats import CHUNK_ROWS, iter_log
 from kinergy.io.log import Log
 from kinergy.io.panda_layout import is_panda_layout, panda_files
-from kinergy.io.rosbag import BagOptions
-from kinergy.logs.checks import Check, LogCheck, LogChecks
+from kinergy.io.rosbag import BagOptions, bag_options
+from kinergy.logs.checks import Check, LogCheck, LogChecks, parse_accept
 from kinergy.logs.payload import PAYLOAD_SIGNALS, describe, from_columns, payload_columns
 from kinergy.logs.window import TimeWindow, WindowCut
 from kinergy.model.robot import Payload, Robot
+from kinergy.model.toml import parse_payload
 
-__all__ = ["CHECKED_SIGNALS", "CheckedLog", "InputLogs", "LogReading", "Provenance"]
+__all__ = ["CHECKED_SIGNALS", "MAX_CUTOFF", "CheckedLog", "InputLogs", "LogReading", "Provenance"]
+
+#: Hz: the highest low-pass cutoff ``--cutoff`` takes
+MAX_CUTOFF = 1e6
 
 #: the signals the checks read whenever a log has them (besides those a command asks for)
 CHECKED_SIGNALS = (
@@ -59,30 +71,35 @@ CHECKED_SIGNALS = (
 
 @dataclass(frozen=True)
 class LogReading:
-    """How a command reads its logs, parsed once from its options.
+    """How a command reads its logs, parsed once from its options (:meth:`parse`: from the
+    command line's flags), checked on construction: one line naming the flag at fault.
 
     Attributes
     ----------
     columns : tuple of str, ColumnMap or None
         The columns of a headerless file (:func:`kinergy.io.columns.parse_columns` of the
         ``--columns`` spec), or a header log's names mapped to RTDE's
-        (:class:`kinergy.io.columns.ColumnMap`); None: the file names them in a header line by
-        RTDE's names (UR's record.py layout).
+        (:class:`kinergy.io.columns.ColumnMap`); a spec given as text is parsed on construction
+        (:func:`kinergy.io.columns.parse_column_spec`). None: the file names them in a header
+        line by RTDE's names (UR's record.py layout).
     repair : bool
         Drop rows that cannot be read (each drop noted) instead of refusing the file.
     cutoff : float or None
         Low-pass cutoff for measured speeds, Hz; None: min(10 Hz, a fifth of the sample rate).
     accept : frozenset of Check
-        Checks whose failure the user accepts (``--accept``); the results record them.
+        Checks whose failure the user accepts (``--accept``; names, ``all`` or comma-separated
+        lists parsed on construction); the results record them.
     bag : BagOptions or None
         How to read a ROS 2 bag (``--topic``, ``--effort``); None: its defaults. Refused for a
         log that is not a bag.
     payload : Payload or None
         The payload at the flange (``--payload``): it replaces the one the controller logged
         (``payload``, ``payload_cog``, ``payload_inertia``, :mod:`kinergy.logs.payload`) and the
-        robot file's. None: the log's where it logs one, else the robot file's.
+        robot file's. None: the log's where it logs one, else the robot file's. Text
+        (``MASS[,CX,CY,CZ[,...]]``) is parsed on construction.
     window : TimeWindow or None
-        The samples read (``--from``/``--to``, s on the log's own time axis); None: all.
+        The samples read (``--from``/``--to``, s on the log's own time axis); None: all. A pair
+        ``(start, stop)`` becomes a :class:`~kinergy.logs.window.TimeWindow` on construction.
     """
 
     columns: Columns | None = None
@@ -96,6 +113,66 @@ class LogReading:
     def loaded(self, robot: Robot) -> Robot:
         """``robot`` with the payload :attr:`payload` gives, when it gives one."""
         return robot if self.payload is None else robot.with_payload(self.payload)
+
+    def __post_init__(self) -> None:
+        columns = self.columns
+        if isinstance(columns, str):
+            columns = parse_column_spec(columns)
+        if columns is not None and not isinstance(columns, ColumnMap):
+            columns = tuple(columns)
+        object.__setattr__(self, "columns", columns)
+        if self.cutoff is not None:
+            cutoff = number(self.cutoff, "--cutoff", gt=0.0, le=MAX_CUTOFF)
+            object.__setattr__(self, "cutoff", cutoff)
+        accept = [self.accept] if isinstance(self.accept, str) else self.accept
+        names = (c.value if isinstance(c, Check) else c for c in accept)
+        object.__setattr__(self, "accept", parse_accept(names))
+        object.__setattr__(self, "repair", bool(self.repair))
+        if isinstance(self.payload, str):
+            object.__setattr__(self, "payload", parse_payload(self.payload))
+        if isinstance(self.window, tuple):
+            window = None if self.window == (None, None) else TimeWindow(*self.window)
+            object.__setattr__(self, "window", window)
+
+    @classmethod
+    def parse(
+        cls,
+        *,
+        columns: str | None = None,
+        repair: bool = False,
+        cutoff: float | None = None,
+        accept: str | Iterable[str] = (),
+        topic: str | None = None,
+        effort: str | None = None,
+        payload: str | None = None,
+        start: float | None = None,
+        stop: float | None = None,
+    ) -> LogReading:
+        """The reading options as a command's flags give them, each parsed once: ``columns`` a
+        column spec (``"timestamp,actual_q:6,..."`` or ``"timestamp=time,actual_q=pos_*"``,
+        :func:`kinergy.io.columns.parse_column_spec`), ``accept`` check names (``--accept``,
+        repeatable or comma-separated, ``all``), ``topic`` and ``effort`` a ROS 2 bag's
+        (:func:`kinergy.io.rosbag.bag_options`), ``payload`` ``MASS[,CX,CY,CZ[,...]]``
+        (:func:`kinergy.model.toml.parse_payload`), ``start`` and ``stop`` the window, s.
+
+        The parameters are the command line's flags (``--columns``, ``--repair``,
+        ``--cutoff``, ``--accept``, ``--topic``, ``--effort``, ``--payload``, ``--from``,
+        ``--to``), which the commands build from this signature.
+
+        Raises
+        ------
+        KinergyError
+            One line naming the flag at fault.
+        """
+        return cls(
+            columns=columns,  # type: ignore[arg-type]  # parsed on construction
+            repair=repair,
+            cutoff=cutoff,
+            accept=accept,  # type: ignore[arg-type]
+            bag=bag_options(topic, effort),
+            payload=payload,  # type: ignore[arg-type]
+            window=(start, stop),  # type: ignore[arg-type]
+        )
 
 
 @dataclass(frozen=True)
@@ -267,6 +344,14 @@ class CheckedLog:
     provenance: Provenance | None = None
     notes: list[str] = field(default_factory=list)
     _told: bool = field(default=False, repr=False)
+
+    def __post_init__(self) -> None:
+        columns = self.reading.columns
+        if isinstance(columns, ColumnMap) and columns.n_joints is None:
+            mapped = dataclasses.replace(columns, n_joints=self.robot.n)
+            self.reading = dataclasses.replace(self.reading, columns=mapped)
+        elif isinstance(columns, tuple):
+            check_joint_columns(columns, self.robot.n)
 
     @property
     def path(self) -> str:

@@ -11,17 +11,23 @@ are.
 from __future__ import annotations
 
 import enum
-import math
-import re
 from dataclasses import dataclass
-from typing import Self
 
 import numpy as np
 
 from kinergy.arrays import Array
-from kinergy.errors import KinergyError
+from kinergy.checks import choice, flag, number
 
-__all__ = ["Configurations", "ProgramOptions", "ToolSymmetry", "ViaPoints"]
+__all__ = [
+    "MAX_ACCELERATION_CAP",
+    "MAX_CYCLE_TIME",
+    "MAX_SPEED_CAP",
+    "MIN_CAP",
+    "Configurations",
+    "ProgramOptions",
+    "ToolSymmetry",
+    "ViaPoints",
+]
 
 
 #: a fully symmetric tool's first search steps about its axis, rad
@@ -39,21 +45,6 @@ class ToolSymmetry(enum.Enum):
     Z = "z"
     Z2 = "z2"
     Z4 = "z4"
-
-    @classmethod
-    def parse(cls, text: str) -> ToolSymmetry:
-        """The symmetry named ``text`` (``none``, ``z``, ``z2``, ``z4``).
-
-        Raises
-        ------
-        KinergyError
-            Any other name, in one line.
-        """
-        try:
-            return cls(text)
-        except ValueError:
-            names = ", ".join(s.value for s in cls)
-            raise KinergyError(f"tool symmetry: expected one of {names}, got {text!r}") from None
 
     @property
     def turns(self) -> int:
@@ -84,27 +75,7 @@ class ToolSymmetry(enum.Enum):
         return 2.0 * np.pi * np.arange(self.turns) / self.turns
 
 
-class _KeepOrFree(enum.Enum):
-    """An option that is ``keep`` or ``free``, named in its messages after its class
-    (``ViaPoints``: "via points")."""
-
-    @classmethod
-    def parse(cls, text: str) -> Self:
-        """``keep`` or ``free``.
-
-        Raises
-        ------
-        KinergyError
-            Any other name, in one line.
-        """
-        try:
-            return cls(text)
-        except ValueError:
-            name = re.sub(r"(?<!^)(?=[A-Z])", " ", cls.__name__).lower()
-            raise KinergyError(f"{name}: expected keep or free, got {text!r}") from None
-
-
-class Configurations(_KeepOrFree):
+class Configurations(enum.Enum):
     """Whether a movej's pose target keeps the program's inverse-kinematics branch (``KEEP``: a
     new branch can collide with the cell) or may take any of the eight (``FREE``)."""
 
@@ -112,7 +83,7 @@ class Configurations(_KeepOrFree):
     FREE = "free"
 
 
-class ViaPoints(_KeepOrFree):
+class ViaPoints(enum.Enum):
     """Whether the program's joint-space via points stay where the programmer put them.
 
     A joint-space via point is the target of a ``movej`` that is followed by another ``movej``
@@ -127,13 +98,13 @@ class ViaPoints(_KeepOrFree):
     FREE = "free"
 
 
-def _positive(name: str, value: float | None) -> float | None:
-    if value is None:
-        return None
-    x = float(value)
-    if not (math.isfinite(x) and x > 0.0):
-        raise KinergyError(f"{name}: must be a finite number > 0, got {value!r}")
-    return x
+#: s: the longest cycle time optimised (each is re-simulated at 500 Hz, Pareto points and all)
+MAX_CYCLE_TIME = 600.0
+#: the smallest speed (rad/s) and acceleration (rad/s^2) caps taken (below 1e-3, 0.06 deg/s, a
+#: move takes longer than any cycle-time budget and its profile underflows), and the largest
+MIN_CAP = 1e-3
+MAX_SPEED_CAP = 100.0
+MAX_ACCELERATION_CAP = 1e4
 
 
 @dataclass(frozen=True)
@@ -150,15 +121,19 @@ class ProgramOptions:
     standby : float or None
         Standby power, W (>= 0), counted over the cycle time; None: the robot file's.
     cycle_time : float or None
-        The cycle time, s (> 0); None: the program's own.
+        The cycle time, s (> 0, <= :data:`MAX_CYCLE_TIME`); None: the program's own.
     v_max, a_max : float or None
-        Caps on every joint's speed (rad/s) and acceleration (rad/s^2), > 0; None: the
-        program's own peaks.
+        Caps on every joint's speed (rad/s) and acceleration (rad/s^2), from :data:`MIN_CAP`
+        to :data:`MAX_SPEED_CAP` and :data:`MAX_ACCELERATION_CAP`; None: the program's own
+        peaks (a task: the robot's limits).
+
+    A name given for an enum (``tool_symmetry="z"``) is parsed into it.
 
     Raises
     ------
     KinergyError
-        A value of the wrong type or out of range, in one line naming it.
+        A value not one of an option's or out of range, in one line naming it by its flag
+        (``--cycle-time: must be a finite number > 0 and <= 600, got 700``).
     """
 
     configurations: Configurations = Configurations.KEEP
@@ -176,15 +151,25 @@ class ProgramOptions:
             ("tool_symmetry", ToolSymmetry),
             ("via", ViaPoints),
         ):
-            if not isinstance(getattr(self, name), kind):
-                raise KinergyError(
-                    f"{name}: expected a {kind.__name__}, got {getattr(self, name)!r}"
-                )
-        if self.standby is not None:
-            standby = float(self.standby)
-            if not (math.isfinite(standby) and standby >= 0.0):
-                raise KinergyError(f"standby: must be a finite power >= 0 W, got {self.standby!r}")
-            object.__setattr__(self, "standby", standby)
-        for name in ("cycle_time", "v_max", "a_max"):
-            object.__setattr__(self, name, _positive(name, getattr(self, name)))
+            object.__setattr__(self, name, choice(getattr(self, name), kind, flag(name)))
+        bounds: tuple[tuple[str, dict[str, float]], ...] = (
+            ("standby", {"ge": 0.0}),
+            ("cycle_time", {"gt": 0.0, "le": MAX_CYCLE_TIME}),
+            ("v_max", {"ge": MIN_CAP, "le": MAX_SPEED_CAP}),
+            ("a_max", {"ge": MIN_CAP, "le": MAX_ACCELERATION_CAP}),
+        )
+        for name, bound in bounds:
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, number(value, flag(name), **bound))
         object.__setattr__(self, "blends", bool(self.blends))
+
+    def levers(self) -> list[str]:
+        """The flags of the levers these options ask for (a value other than the default): those
+        only a URScript program takes."""
+        default = ProgramOptions()
+        return [
+            "--no-blends" if name == "blends" else flag(name)
+            for name in ("configurations", "tool_symmetry", "via", "blends", "standby")
+            if getattr(self, name) != getattr(default, name)
+        ]

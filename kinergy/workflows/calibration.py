@@ -21,6 +21,7 @@ from __future__ import annotations
 import dataclasses
 import os
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -38,6 +39,7 @@ from kinergy.identification.friction_curve import (
 )
 from kinergy.identification.options import AUTO, FrictionSearch, friction_option
 from kinergy.io.ur_calibration import JointCalibration, read_ur_calibration
+from kinergy.jsonable import to_jsonable
 from kinergy.model.library import library_names, load_robot
 from kinergy.model.robot import Friction, Robot, Source
 from kinergy.model.toml import save_robot
@@ -99,6 +101,11 @@ class CalibrationImport:
     robot: Robot = field(metadata={"json": lambda r: r.name})
     file: str
     joints: tuple[CalibrationJoint, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        """``kinergy robot import-calibration --json`` (without where the command came from)."""
+        out: dict[str, Any] = to_jsonable(self)
+        return out
 
 
 def _points(robot: Robot, j: int, cal: JointCalibration) -> FrictionPoints:

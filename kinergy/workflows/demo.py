@@ -24,8 +24,10 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
+from kinergy.checks import choice
 from kinergy.drives.electrics import back_emf_constants, winding_resistances
 from kinergy.files import output_folder
 from kinergy.friction.model import SMOOTHING
@@ -42,11 +44,11 @@ from kinergy.model.robot import Friction, Robot
 from kinergy.report.html import Section, Table
 from kinergy.trajectory.motion import Motion
 from kinergy.trajectory.programs import paper_trajectory
-from kinergy.twin import TwinSettings, realistic_truth, simulate
+from kinergy.twin import Mismatch, TwinSettings, realistic_truth, simulate
 from kinergy.workflows.identify import identify_model
 from kinergy.workflows.study import run_study, write_study
 
-__all__ = ["nominal_drives", "run_demo", "truth_tables"]
+__all__ = ["DemoRun", "nominal_drives", "run_demo", "truth_tables"]
 
 #: the realistic twin's seed
 SEED = 1
@@ -164,21 +166,13 @@ def _identify(model: Robot, data: IdentData, realistic: bool) -> IdentificationR
     return identify_sequential(nominal_drives(model), [data])
 
 
-def run_demo(
-    out: Path | None = None,
-    progress: Callable[[str], None] | None = None,
-    *,
-    mismatch: str = "realistic",
-) -> tuple[dict[str, list[Table]], Path, float]:
-    """Run the demo into folder ``out``, built beside it and renamed into place at the end
-    (:func:`kinergy.files.atomic_folder`: a failure or an interruption leaves no half-written
-    folder). ``out`` None: a new folder ``kinergy-demo-*`` in the system's temporary folder
-    (nothing is written to the current folder unless asked). ``mismatch``: ``"realistic"`` or
-    ``"none"`` (module docstring).
+@dataclass(frozen=True, eq=False)
+class DemoRun:
+    """What ``kinergy demo`` wrote.
 
-    Returns
-    -------
-    tables
+    Attributes
+    ----------
+    tables : dict of str to list of Table
         The report's tables (keyed ``"IV"``, ``"V"``, ``"VI"``, ``"VII"``, ``"VIII"``,
         ``"breakdown"``, ``"timing"``, and ``"truth"`` with the realistic twin).
     report : Path
@@ -186,16 +180,35 @@ def run_demo(
     seconds : float
         Wall time.
     """
+
+    tables: dict[str, list[Table]]
+    report: Path
+    seconds: float
+
+
+def run_demo(
+    out: Path | None = None,
+    progress: Callable[[str], None] | None = None,
+    *,
+    mismatch: Mismatch | str = Mismatch.REALISTIC,
+) -> DemoRun:
+    """Run the demo into folder ``out``, built beside it and renamed into place at the end
+    (:func:`kinergy.files.atomic_folder`: a failure or an interruption leaves no half-written
+    folder). ``out`` None: a new folder ``kinergy-demo-*`` in the system's temporary folder
+    (nothing is written to the current folder unless asked). ``mismatch``: ``"realistic"`` or
+    ``"none"`` (module docstring).
+    """
+    kind = choice(mismatch, Mismatch, "--mismatch")
     begin = time.perf_counter()
     with output_folder(out, prefix="kinergy-demo") as (folder, target):
-        tables = _demo(folder, progress or (lambda _msg: None), mismatch)
-    return tables, target / "report.html", time.perf_counter() - begin
+        tables = _demo(folder, progress or (lambda _msg: None), kind)
+    return DemoRun(tables, target / "report.html", time.perf_counter() - begin)
 
 
-def _demo(out: Path, say: Callable[[str], None], mismatch: str) -> dict[str, list[Table]]:
+def _demo(out: Path, say: Callable[[str], None], mismatch: Mismatch) -> dict[str, list[Table]]:
     """The demo's steps, writing into folder ``out``; returns the report's tables."""
     model = load_robot("ur5e")
-    realistic = mismatch == "realistic"
+    realistic = mismatch == Mismatch.REALISTIC
     truth = realistic_truth(model, SEED) if realistic else model
     logs = out / "logs"
     logs.mkdir(parents=True, exist_ok=True)

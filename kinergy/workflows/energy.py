@@ -39,6 +39,7 @@ from kinergy.workflows.twin import check_source, is_builtin
 
 __all__ = [
     "ENERGY_ROWS",
+    "EnergyOptions",
     "LogEnergy",
     "energy_of_log",
     "energy_with_outputs",
@@ -46,6 +47,28 @@ __all__ = [
     "program_energy",
     "unused_payload",
 ]
+
+
+@dataclass(frozen=True)
+class EnergyOptions:
+    """How ``kinergy energy`` accounts a log, checked on construction.
+
+    Attributes
+    ----------
+    source : MotionSource
+        Which motion of a log: commanded (``target_*``), measured (``actual_*``), or ``auto``:
+        the commanded one where the log has it.
+    recovery : bool
+        Signed integrals: braking energy returns to the bus (UR5e eqs 25-26); False clips
+        negative power.
+    """
+
+    source: MotionSource = MotionSource.AUTO
+    recovery: bool = True
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "source", checks.choice(self.source, MotionSource, "--source"))
+        object.__setattr__(self, "recovery", bool(self.recovery))
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -207,9 +230,8 @@ def energy_of_log(
     robot: Robot,
     path: str | os.PathLike[str],
     reading: LogReading | None = None,
+    options: EnergyOptions | None = None,
     *,
-    source: MotionSource | str = MotionSource.AUTO,
-    recovery: bool = True,
     rows: int = ENERGY_ROWS,
     sinks: Sequence[PowerSink] = (),
 ) -> LogEnergy:
@@ -226,6 +248,8 @@ def energy_of_log(
     the loads it sets (:func:`program_energy`). Each of ``sinks`` gets the power of every chunk
     (:class:`~kinergy.accounting.trace.PowerSink`: the supply's, predicted and measured, and each
     motor's)."""
+    options = options or EnergyOptions()
+    source, recovery = options.source, options.recovery
     inputs = InputLogs()
     reading = reading or LogReading()
     robot = reading.loaded(robot)
@@ -248,7 +272,6 @@ def energy_of_log(
     measured = False
     peak = np.zeros(robot.n)
     log = CheckedLog(path, robot, reading, rows=rows, ahead=True)
-    source = checks.choice(source, MotionSource, "source")
     log.select = _signals_used(log, source)
     for part in iter_motion(log.chunks(), n_joints=robot.n, source=source):
         m = part.motion
@@ -271,7 +294,7 @@ def log_energy_report(
     path: str | os.PathLike[str],
     reading: LogReading | None = None,
     *,
-    source: str = "auto",
+    source: MotionSource = MotionSource.AUTO,
 ) -> tuple[EnergyReport, InputLogs]:
     """The energy of a log's motion with its time series (:class:`EnergyReport`, as the study
     report plots it), each sample with the payload the log's controller logged (else the
@@ -290,9 +313,8 @@ def energy_with_outputs(
     robot: Robot,
     path: str | os.PathLike[str],
     reading: LogReading | None = None,
+    options: EnergyOptions | None = None,
     *,
-    source: str = "auto",
-    recovery: bool = True,
     trace: str | os.PathLike[str] | None = None,
     plot: str | os.PathLike[str] | None = None,
 ) -> LogEnergy:
@@ -315,7 +337,7 @@ def energy_with_outputs(
         if trace is not None and fmt is not None:
             writer = TraceWriter(stack.enter_context(atomic_open(trace, binary=True)), robot, fmt)
             sinks.append(writer)
-        result = energy_of_log(robot, path, reading, source=source, recovery=recovery, sinks=sinks)
+        result = energy_of_log(robot, path, reading, options, sinks=sinks)
         if writer is not None:
             writer.close()
     if plot is not None and series is not None:

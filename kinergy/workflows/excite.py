@@ -12,14 +12,18 @@ runs it: all files or none.
 from __future__ import annotations
 
 import contextlib
+import enum
+import math
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from kinergy.checks import choice, flag, integer, number
+from kinergy.errors import KinergyError
 from kinergy.experiments.excitation_design import (
     Excitation,
     Progress,
@@ -28,33 +32,79 @@ from kinergy.experiments.excitation_design import (
 )
 from kinergy.experiments.excitation_limits import DEFAULT_RANGE, excitation_limits
 from kinergy.experiments.excitation_problem import ExcitationProblem, excitation_problem
+from kinergy.experiments.excitation_regression import CRITERIA
 from kinergy.io.rtde import write_log
 from kinergy.io.urscript import servoj_program, write_script
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion
+from kinergy.workflows.twin import MAX_SEED
 
-__all__ = ["ExciteOptions", "ExciteRun", "run_excite"]
+__all__ = ["COUNTS", "LIMITS", "ExciteOptions", "ExciteRun", "FloorFrames", "run_excite"]
 
 #: report progress every this many SLSQP iterations
 _PROGRESS_EVERY = 10
 
 
+#: flags that count something: the least and most each may be (the most: sizes that fit in
+#: memory and finish in minutes)
+COUNTS = {
+    "harmonics": (2, 50),
+    "periods": (1, 100),
+    "starts": (1, 1000),
+    "maxiter": (1, 100_000),
+    "samples": (1, 20_000),
+    "compare": (0, 10_000),
+}
+#: flags that must be > 0 when given, with their least and most values (s, deg, rad/s, rad/s^2)
+LIMITS = {
+    "period": (1e-2, 600.0),
+    "range_deg": (1e-3, 360.0),
+    "speed": (1e-3, 100.0),
+    "acceleration": (1e-3, 1e4),
+}
+#: m: the highest (and lowest) floor taken
+MAX_FLOOR = 100.0
+
+
+class FloorFrames(enum.Enum):
+    """What keeps above the floor: the flange and the link frames from the elbow on
+    (``LINKS``), or the flange only."""
+
+    LINKS = "links"
+    FLANGE = "flange"
+
+
+def _angles(value: str | Sequence[float], what: str) -> tuple[float, ...]:
+    """``"0,-90,0"`` (or a sequence of numbers) as a tuple of finite numbers."""
+    parts = value.split(",") if isinstance(value, str) else list(value)
+    try:
+        out = tuple(float(x) for x in parts)
+    except ValueError:
+        out = ()
+    if not out or not all(math.isfinite(x) for x in out):
+        raise KinergyError(
+            f"{what}: must be comma-separated finite angles in deg, got {str(value)!r}"
+        )
+    return out
+
+
 @dataclass(frozen=True, kw_only=True)
 class ExciteOptions:
-    """What ``kinergy excite`` designs and writes, SI units (one field per command-line flag).
+    """What ``kinergy excite`` designs and writes (one field per command-line flag), checked on
+    construction: one line naming the flag.
 
     Attributes
     ----------
     out : path
         Motion file to write (record.py layout, every ``dt``).
     urscript : path or None
-        URScript program to write (movej to the start, then servoj every ``dt``).
+        URScript program to write (movej to the start, then servoj every ``dt``; 6-joint arms).
     harmonics : int
-        ``L`` of nursing eq 22.
+        ``L`` of nursing eq 22 (2 to 50).
     period : float
-        ``T``, s.
+        ``T``, s (0.01 to 600).
     periods : int
-        Periods written to the motion file.
+        Periods written to the motion file (1 to 100).
     criterion : {"cond", "dopt"}
     seed, starts, maxiter : int
         Seed of the random starts, their number, SLSQP iterations per start.
@@ -62,11 +112,12 @@ class ExciteOptions:
         Grid points per period for the criterion.
     floor : float or None
         Height above the base plane the checked frames keep, m (None: no floor).
-    floor_frames : {"links", "flange"}
-    start : tuple of float or None
-        Start and end pose, rad (None: the default of :func:`excitation_problem`).
-    position_range : float
-        Half-width of each joint's range about the start pose, rad.
+    floor_frames : FloorFrames
+    start_deg : tuple of float or None
+        Start and end pose, deg, one per joint (text ``"0,-90,0,..."`` parsed on construction;
+        None: the default of :func:`excitation_problem`).
+    range_deg : float
+        Half-width of each joint's range about the start pose, deg (0.001 to 360).
     speed, acceleration : float or None
         Limits, rad/s and rad/s^2 (None: the robot's).
     include_drives : bool
@@ -86,13 +137,49 @@ class ExciteOptions:
     maxiter: int = 100
     samples: int = 200
     floor: float | None = 0.05
-    floor_frames: str = "links"
-    start: tuple[float, ...] | None = None
-    position_range: float = DEFAULT_RANGE
+    floor_frames: FloorFrames = FloorFrames.LINKS
+    start_deg: tuple[float, ...] | None = None
+    range_deg: float = math.degrees(DEFAULT_RANGE)
     speed: float | None = None
     acceleration: float | None = None
     include_drives: bool = True
     compare: int = 0
+
+    def __post_init__(self) -> None:
+        for name, (least, most) in COUNTS.items():
+            object.__setattr__(
+                self, name, integer(getattr(self, name), flag(name), ge=least, le=most)
+            )
+        object.__setattr__(self, "seed", integer(self.seed, "--seed", ge=0, le=MAX_SEED))
+        for name, (low, high) in LIMITS.items():
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, number(value, flag(name), ge=low, le=high))
+        if self.floor is not None:
+            floor = number(self.floor, "--floor", ge=-MAX_FLOOR, le=MAX_FLOOR)
+            object.__setattr__(self, "floor", floor)
+        if self.criterion not in CRITERIA:
+            known = ", ".join(CRITERIA)
+            raise KinergyError(f"--criterion: must be one of {known}, got {self.criterion!r}")
+        object.__setattr__(
+            self, "floor_frames", choice(self.floor_frames, FloorFrames, "floor_frames")
+        )
+        if self.start_deg is not None:
+            object.__setattr__(self, "start_deg", _angles(self.start_deg, "--start-deg"))
+        object.__setattr__(self, "include_drives", bool(self.include_drives))
+
+    def check(self, robot: Robot) -> None:
+        """Refuse what ``robot`` cannot take: a start pose of another joint count, URScript for
+        an arm that is not a 6-joint UR."""
+        if self.start_deg is not None and len(self.start_deg) != robot.n:
+            raise KinergyError(
+                f"--start-deg: must be {robot.n} comma-separated angles in deg, got "
+                f"{len(self.start_deg)}"
+            )
+        if self.urscript is not None and robot.n != 6:
+            raise KinergyError(
+                f"--urscript: URScript runs 6-joint UR arms; {robot.name} has {robot.n}"
+            )
 
 
 @dataclass(frozen=True, eq=False)
@@ -148,14 +235,15 @@ class ExciteRun:
 
 
 def _problem(robot: Robot, options: ExciteOptions) -> ExcitationProblem:
+    start = None if options.start_deg is None else np.radians(options.start_deg)
     limits = excitation_limits(
         robot,
-        start=options.start,
-        position_range=options.position_range,
+        start=start,
+        position_range=math.radians(options.range_deg),
         speed=options.speed,
         acceleration=options.acceleration,
         floor=options.floor,
-        floor_frames=options.floor_frames,
+        floor_frames=options.floor_frames.value,
     )
     return excitation_problem(
         robot,
@@ -227,6 +315,7 @@ def run_excite(
     KinergyError
         Bad options (:func:`excitation_problem`), an unwritable file.
     """
+    options.check(robot)
     problem = _problem(robot, options)
     best = design_excitation(
         problem,

@@ -44,7 +44,6 @@ from kinergy.predict import drive_state
 from kinergy.workflows.logs import chunked_logs, one_payload
 
 __all__ = [
-    "METHODS",
     "MIN_MOTION_SHARE",
     "MIN_SECONDS",
     "PayloadRun",
@@ -57,8 +56,6 @@ __all__ = [
     "unsupported_fit",
 ]
 
-#: identification methods by the name ``--method`` takes
-METHODS = tuple(m.value for m in Method)
 #: s: the shortest logs (all together) an identification accepts
 MIN_SECONDS = 1.0
 

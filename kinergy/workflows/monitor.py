@@ -5,44 +5,67 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
 
-from kinergy import checks
 from kinergy.live.monitor import MONITOR_FIELDS, CycleEnergy, CycleTracker, rows_log
 from kinergy.live.rtde import parse_address
-from kinergy.live.stream import Gap, Stream, stop_on_signals
-from kinergy.logs.checks import Check, LogCheck
+from kinergy.live.stream import Gap, Stream, StreamOptions, stop_on_signals
+from kinergy.logs.checks import LogCheck
+from kinergy.logs.reading import LogReading
 from kinergy.model.robot import Robot
 
-__all__ = ["monitor_cycles"]
+__all__ = ["MonitorRun", "monitor_cycles"]
+
+
+@dataclass(frozen=True, eq=False)
+class MonitorRun:
+    """What ``kinergy monitor`` followed: the program's period and every cycle, measured (where
+    the controller logs its supply) and predicted. :meth:`to_dict` is the command's ``--json``
+    (without where the command came from)."""
+
+    robot: Robot
+    period: float | None
+    supply_logged: bool
+    cycles: tuple[CycleEnergy, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "robot": self.robot.name,
+            "period": self.period,
+            "supply_logged": self.supply_logged,
+            "cycles": [{**vars(c), "error": c.error} for c in self.cycles],
+        }
 
 
 def monitor_cycles(
     address: str,
     robot: Robot,
+    options: StreamOptions | None = None,
     *,
-    frequency: float = 500.0,
-    duration: float | None = None,
+    reading: LogReading | None = None,
     on_cycle: Callable[[CycleEnergy], None] | None = None,
     status: Callable[[str], None] | None = None,
-    accept: frozenset[Check] = frozenset(),
     waiting: Callable[[float, int, float | None], None] | None = None,
-) -> CycleTracker:
+) -> MonitorRun:
     """Follow the controller at ``address`` (``HOST[:PORT]``) until ``duration`` s of
     controller time, SIGINT or SIGTERM; ``on_cycle`` receives each cycle as it ends.
 
     The stream is folded into the plausibility checks (:mod:`kinergy.logs.checks`) as it comes;
     before the first cycle is reported their verdict is taken on what has been seen (a check
-    that fails, unless in ``accept``, stops the monitor with its line), and again at the end.
+    that fails, unless in ``reading.accept``, stops the monitor with its line), and again at the
+    end.
 
     Until the first cycle ends, ``waiting(seconds, samples, period)`` is told once a second
     (wall clock) how much of the stream has come (controller time, s; samples) and the period
     found so far (s; None before it is).
 
-    Returns the tracker (its ``period`` and ``cycles``).
+    Returns the period and the cycles.
     """
+    options = options or StreamOptions()
+    frequency, duration = options.frequency, options.duration
+    accept = (reading or LogReading()).accept
     host, port = parse_address(address)
-    if duration is not None:
-        duration = checks.number(duration, "--duration", gt=0.0)
     stop = threading.Event()
     with stop_on_signals(stop):
         stream = Stream(
@@ -92,4 +115,4 @@ def monitor_cycles(
         finally:
             stream.close()
     report(tracker.update())
-    return tracker
+    return MonitorRun(robot, tracker.period, tracker.supply, tuple(tracker.cycles))

@@ -23,9 +23,11 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from kinergy.checks import integer
 from kinergy.drives.coupled import joint_kind, joint_side_makkar, joint_torques_from_current
 from kinergy.errors import KinergyError
 from kinergy.experiments.friction_runs import back_and_forth_motion
@@ -36,16 +38,19 @@ from kinergy.identification.friction_points import FrictionPoints, friction_poin
 from kinergy.identification.makkar_fit import MakkarFit, fit_makkar_lsq, fit_makkar_pso
 from kinergy.identification.nursing import MotorFrictionFit, NursingFit, identify_nursing
 from kinergy.identification.options import MakkarMethod
+from kinergy.jsonable import to_jsonable
 from kinergy.logs.prepare import IdentData, prepare
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion
 from kinergy.twin import TwinSettings, simulate
+from kinergy.workflows.twin import MAX_SEED
 
 __all__ = [
     "DocFriction",
     "FitComparison",
     "FrictionStudy",
     "NursingStudy",
+    "NursingStudyOptions",
     "RidgeStudy",
     "StudyTimings",
     "nursing_study",
@@ -138,6 +143,32 @@ class NursingStudy:
     warnings: tuple[str, ...]
     timings: StudyTimings
 
+    def to_dict(self) -> dict[str, Any]:
+        """``kinergy nursing --json`` (without where the command came from)."""
+        out: dict[str, Any] = to_jsonable(self)
+        return out
+
+
+@dataclass(frozen=True)
+class NursingStudyOptions:
+    """How :func:`nursing_study` runs the twin, checked on construction.
+
+    Attributes
+    ----------
+    noise : bool
+        The twin's default lag and noise (``TwinSettings(seed=...)``) or none.
+    seed : int
+        Seed of the twin's noise (log k uses ``seed + k``) and of the swarm, 0 to
+        :data:`~kinergy.workflows.twin.MAX_SEED`.
+    """
+
+    noise: bool = True
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "noise", bool(self.noise))
+        object.__setattr__(self, "seed", integer(self.seed, "--seed", ge=0, le=MAX_SEED))
+
 
 def _twin_log(robot: Robot, name: str, motion: Motion, settings: TwinSettings) -> IdentData:
     return prepare(simulate(robot, motion, settings, name=name), robot.n)
@@ -210,7 +241,10 @@ def _ridge_study(robot: Robot, fit: NursingFit) -> RidgeStudy:
 
 
 def nursing_study(
-    robot: Robot, *, noise: bool = True, seed: int = 0, progress: Progress | None = None
+    robot: Robot,
+    options: NursingStudyOptions | None = None,
+    *,
+    progress: Progress | None = None,
 ) -> NursingStudy:
     """Run the nursing doc's identification on ``robot``'s twin (module docstring).
 
@@ -218,10 +252,8 @@ def nursing_study(
     ----------
     robot : Robot
         The twin's model (6 joints, for Table 6's excitation).
-    noise : bool
-        The twin's default lag and noise (``TwinSettings(seed=...)``) or none.
-    seed : int
-        Seed of the twin's noise (log k uses ``seed + k``) and of the swarm.
+    options : NursingStudyOptions, optional
+        Noise and seed (default: the twin's noise, seed 0).
     progress : callable, optional
         Called with a line of text at each stage.
 
@@ -229,6 +261,8 @@ def nursing_study(
     -------
     NursingStudy
     """
+    options = options or NursingStudyOptions()
+    noise, seed = options.noise, options.seed
     say = progress or (lambda _msg: None)
     if robot.n != 6:
         raise KinergyError(

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from kinergy.arrays import Array
 from kinergy.files import all_or_none, atomic_folder, check_outputs
 from kinergy.io.rtde import write_log
 from kinergy.io.urscript import program_script, write_script
@@ -86,7 +87,7 @@ def optimized_script(result: ProgramOptimization) -> str:
     return program_script(result.written, header)
 
 
-def _motion_signals(motion: Motion) -> dict[str, Any]:
+def _motion_signals(motion: Motion) -> dict[str, Array]:
     return {"target_q": motion.q, "target_qd": motion.qd, "target_qdd": motion.qdd}
 
 

@@ -6,11 +6,10 @@ import os
 import threading
 from collections.abc import Callable
 
-from kinergy import checks
 from kinergy.files import check_output
 from kinergy.live.recorder import FIELDS, OPTIONAL_FIELDS, Recording, record
 from kinergy.live.rtde import parse_address
-from kinergy.live.stream import Stream, stop_on_signals
+from kinergy.live.stream import RecordOptions, Stream, stop_on_signals
 
 __all__ = ["record_to_file"]
 
@@ -18,14 +17,12 @@ __all__ = ["record_to_file"]
 def record_to_file(
     address: str,
     out: str | os.PathLike[str],
+    options: RecordOptions | None = None,
     *,
-    frequency: float = 500.0,
-    duration: float | None = None,
-    rotate_minutes: float | None = None,
-    rotate_megabytes: float | None = None,
     status: Callable[[str], None] | None = None,
 ) -> Recording:
-    """Record every field kinergy uses from the controller at ``address`` (``HOST[:PORT]``).
+    """Record every field kinergy uses from the controller at ``address`` (``HOST[:PORT]``) as
+    ``options`` say (default: 500 Hz until Ctrl-C, one file).
 
     SIGINT and SIGTERM end the recording with complete files (``Recording.stopped`` names the
     signal); see :func:`kinergy.live.recorder.record`.
@@ -34,16 +31,15 @@ def record_to_file(
     ------
     KinergyError
         A bad address, host or output path, a refused connection, a controller that refuses the
-        protocol or the recipe, a non-positive duration or rotation.
+        protocol or the recipe.
     """
+    options = options or RecordOptions()
+    frequency, minutes, megabytes = (
+        options.frequency,
+        options.rotate_minutes,
+        options.rotate_megabytes,
+    )
     host, port = parse_address(address)
-    for flag, value in (
-        ("--duration", duration),
-        ("--rotate", rotate_minutes),
-        ("--rotate-size", rotate_megabytes),
-    ):
-        if value is not None:
-            checks.number(value, flag, gt=0.0)
     check_output(out)
     stop = threading.Event()
     with stop_on_signals(stop) as seen:
@@ -58,9 +54,9 @@ def record_to_file(
             stream,
             out,
             stop=stop,
-            duration=duration,
-            rotate_seconds=None if rotate_minutes is None else 60.0 * rotate_minutes,
-            rotate_bytes=None if rotate_megabytes is None else int(rotate_megabytes * 1e6),
+            duration=options.duration,
+            rotate_seconds=None if minutes is None else 60.0 * minutes,
+            rotate_bytes=None if megabytes is None else int(megabytes * 1e6),
             status=status,
         )
     if "signal" in seen:

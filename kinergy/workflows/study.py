@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 from kinergy._version import __version__
@@ -29,9 +30,20 @@ from kinergy.workflows.logs import chunked_logs
 from kinergy.workflows.optimize import optimize_task
 from kinergy.workflows.twin import is_builtin
 
-__all__ = ["optimal_timing", "run_study", "study_report", "write_study"]
+__all__ = ["StudyReport", "optimal_timing", "run_study", "study_report", "write_study"]
 
 Progress = Callable[[str], None]
+
+
+@dataclass(frozen=True, eq=False)
+class StudyReport:
+    """What ``kinergy report`` wrote: the path of ``report.html``, its tables by UR5e table
+    (``"IV"`` ... ``"VIII"``, ``"breakdown"``), and what reading the logs and identifying said."""
+
+    path: Path
+    tables: dict[str, list[Table]]
+    notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
 
 def _comparisons(
@@ -150,14 +162,13 @@ def study_report(
     reading: LogReading | None = None,
     model_name: str = "",
     progress: Progress | None = None,
-) -> tuple[Path, dict[str, list[Table]], Messages]:
+) -> StudyReport:
     """``kinergy report``: identify (sequential method) on ``identify_logs`` if any, validate on
     ``validate_logs``, account the energy of ``energy_logs``, and write ``out/report.html``.
 
     The folder is built beside ``out`` and renamed into place at the end
     (:func:`kinergy.files.atomic_folder`); ``out`` None: a new folder ``kinergy-report-*`` in the
-    system's temporary folder. Returns the path of ``report.html``, the tables, and what the
-    logs' reading and the identification said (notes and warnings).
+    system's temporary folder.
     """
     say = progress or (lambda _msg: None)
     reading = reading or LogReading()
@@ -205,4 +216,4 @@ def study_report(
                 "logs": ", ".join([*identify_logs, *validate_logs, *energy_logs]),
             },
         )
-    return target / "report.html", tables, said
+    return StudyReport(target / "report.html", tables, tuple(said.notes), tuple(said.warnings))

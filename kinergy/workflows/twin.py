@@ -1,13 +1,16 @@
-"""``kinergy simulate``: run the digital twin on a built-in program or a motion file, write its log."""
+"""``kinergy simulate``: run the digital twin on a built-in program, a motion or a motion file,
+write its log (:func:`run_twin`, with :class:`SimulateOptions`)."""
 
 from __future__ import annotations
 
+import dataclasses
 import os
+from dataclasses import dataclass
 from typing import TypeGuard
 
 import numpy as np
 
-from kinergy import checks
+from kinergy.checks import choice, integer, number
 from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 from kinergy.io.rtde import write_log
@@ -22,13 +25,21 @@ from kinergy.trajectory.programs import TEST_TRAJECTORIES, paper_trajectory
 from kinergy.twin import Mismatch, TwinSettings, realistic_truth, simulate
 from kinergy.workflows.logs import read_motion
 
-__all__ = ["builtin_log", "check_source", "is_builtin", "simulate_to_file", "twin_truth"]
+__all__ = [
+    "MAX_SEED",
+    "SimulateOptions",
+    "Simulation",
+    "builtin_log",
+    "check_source",
+    "is_builtin",
+    "run_twin",
+    "twin_truth",
+]
 
 
-def twin_truth(robot: Robot, mismatch: Mismatch | str, seed: int) -> Robot:
+def twin_truth(robot: Robot, mismatch: Mismatch, seed: int) -> Robot:
     """The twin's true robot for ``--mismatch``: the model itself (``none``) or
     :func:`kinergy.twin.realistic_truth` of it, seeded (``realistic``)."""
-    mismatch = checks.choice(mismatch, Mismatch, "mismatch")
     return realistic_truth(robot, seed) if mismatch == Mismatch.REALISTIC else robot
 
 
@@ -57,7 +68,7 @@ def check_source(name: str | os.PathLike[str] | Log) -> None:
 def builtin_log(robot: Robot, name: str, seed: int = 0) -> Log:
     """The log the realistic twin of ``robot`` (:func:`twin_truth`, seeded) writes running the
     built-in motion ``name`` planned on ``robot``: what a real arm's log of it looks like."""
-    truth = twin_truth(robot, "realistic", seed)
+    truth = twin_truth(robot, Mismatch.REALISTIC, seed)
     motion = paper_trajectory(robot, name)
     return simulate(truth, motion, TwinSettings.realistic(seed), name=name)
 
@@ -108,28 +119,146 @@ def _target(robot: Robot, trajectory: str, reading: LogReading) -> tuple[Motion,
     return motion, said
 
 
-def simulate_to_file(
+#: the most the seed of ``--seed`` may be
+MAX_SEED = 2**32 - 1
+#: the lag and noises :class:`SimulateOptions` may set: name, flag, most (s, rad/s, A)
+_IMPERFECTIONS = (
+    ("lag", "--lag", 1.0),
+    ("speed_noise", "--speed-noise", 10.0),
+    ("current_noise", "--current-noise", 100.0),
+)
+
+
+@dataclass(frozen=True)
+class SimulateOptions:
+    """How ``kinergy simulate`` runs the twin, checked on construction (one line naming the
+    option): the truth it runs and the imperfections of its controller and measurements.
+
+    Attributes
+    ----------
+    mismatch : Mismatch
+        ``none``: the model itself is the truth; ``realistic``: a true robot that differs from
+        it as a real arm does (:func:`kinergy.twin.realistic_truth`, seeded), with a real
+        controller's current steps, voltage noise and supply ripple.
+    seed : int
+        Of the random generator (0 to :data:`MAX_SEED`).
+    exact : bool
+        No lag and no noise: the model's equations exactly (not with ``lag`` or a noise).
+    lag : float or None
+        Real motion behind the target, s, 0 to 1 (None: 0.004).
+    speed_noise : float or None
+        Measured speed noise std, rad/s, 0 to 10 (None: 0.01).
+    current_noise : float or None
+        Measured current noise std, A, 0 to 100 (None: 0.04).
+    ambient : float
+        Air, deg C, -50 to 100.
+    initial_temperature : float or None
+        The joints' temperature at the start, deg C, -50 to 200 (None: the ambient).
+    """
+
+    mismatch: Mismatch = Mismatch.NONE
+    seed: int = 0
+    exact: bool = False
+    lag: float | None = None
+    speed_noise: float | None = None
+    current_noise: float | None = None
+    ambient: float = 25.0
+    initial_temperature: float | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "mismatch", choice(self.mismatch, Mismatch, "--mismatch"))
+        object.__setattr__(self, "seed", integer(self.seed, "--seed", ge=0, le=MAX_SEED))
+        for name, what, most in _IMPERFECTIONS:
+            value = getattr(self, name)
+            if value is not None:
+                if self.exact:
+                    raise KinergyError(
+                        f"--exact and {what} together: --exact means no lag and no noise"
+                    )
+                object.__setattr__(self, name, number(value, what, ge=0.0, le=most))
+        object.__setattr__(self, "ambient", number(self.ambient, "--ambient", ge=-50.0, le=100.0))
+        if self.initial_temperature is not None:
+            start = number(self.initial_temperature, "--initial-temperature", ge=-50.0, le=200.0)
+            object.__setattr__(self, "initial_temperature", start)
+
+    def settings(self) -> TwinSettings:
+        """The twin's :class:`~kinergy.twin.TwinSettings`: those of the mismatch (or exact),
+        with the lag and noises given."""
+        if self.exact:
+            base = TwinSettings.exact()
+        elif self.mismatch == Mismatch.REALISTIC:
+            base = TwinSettings.realistic(self.seed)
+        else:
+            base = TwinSettings()
+        return dataclasses.replace(
+            base,
+            lag=base.lag if self.lag is None else self.lag,
+            speed_noise=base.speed_noise if self.speed_noise is None else self.speed_noise,
+            current_noise=base.current_noise if self.current_noise is None else self.current_noise,
+            seed=self.seed,
+            ambient=self.ambient,
+            initial_temperature=self.initial_temperature,
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Simulation:
+    """What the twin wrote: its log, its true robot, and what reading the trajectory said.
+
+    Attributes
+    ----------
+    log : Log
+        The controller's log (record.py signals, 500 Hz unless the motion says otherwise).
+    truth : Robot
+        The robot the twin ran (the model, or the realistic truth).
+    settings : TwinSettings
+    notes, warnings : tuple of str
+    """
+
+    log: Log
+    truth: Robot
+    settings: TwinSettings
+    notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
+
+
+def run_twin(
     robot: Robot,
-    trajectory: str,
-    out: str | os.PathLike[str],
-    settings: TwinSettings,
+    trajectory: str | os.PathLike[str] | Motion,
+    options: SimulateOptions,
     *,
     reading: LogReading | None = None,
-    mismatch: str = "none",
+    out: str | os.PathLike[str] | None = None,
     truth_out: str | os.PathLike[str] | None = None,
-) -> tuple[Log, Messages]:
-    """Simulate ``trajectory`` (``test-a``, ``test-b`` or a motion file's target motion) on the
-    twin of ``robot`` and write the log to ``out`` (record.py layout, atomically).
+) -> Simulation:
+    """Simulate ``trajectory`` (``test-a``, ``test-b``, a :class:`Motion`, or a motion file's
+    or URScript program's target motion) on the twin of ``robot`` and write the log to ``out``
+    (record.py layout, atomically) when given.
 
-    ``mismatch``: ``none`` runs the model itself, ``realistic`` a true robot that differs from
-    it (:func:`twin_truth`, seeded with ``settings.seed``), whose robot file goes to
-    ``truth_out`` when given. The program is planned on the model, as a user would. Returns the
-    log and what reading ``trajectory`` said (its checks' notes and warnings).
+    The twin's truth is ``robot`` or a robot that differs from it (``options.mismatch``, seeded
+    with ``options.seed``), whose robot file goes to ``truth_out`` when given. The program is
+    planned on the model, as a user would.
+
+    Raises
+    ------
+    KinergyError
+        ``truth_out`` without the realistic mismatch; an unknown trajectory; a motion file that
+        fails its checks.
     """
-    truth = twin_truth(robot, mismatch, settings.seed)
-    motion, said = _target(robot, trajectory, reading or LogReading())
-    twin = simulate(truth, motion, settings, name=os.fspath(out))
-    write_log(out, twin.t, twin.signals)
+    if truth_out is not None and options.mismatch != Mismatch.REALISTIC:
+        raise KinergyError(
+            "--truth: only with --mismatch realistic (with none the twin's truth is ROBOT itself)"
+        )
+    settings = options.settings()
+    truth = twin_truth(robot, options.mismatch, settings.seed)
+    if isinstance(trajectory, Motion):
+        motion, said = trajectory, Messages()
+    else:
+        motion, said = _target(robot, os.fspath(trajectory), reading or LogReading())
+    name = os.fspath(out) if out is not None else os.fspath(getattr(trajectory, "name", "twin"))
+    log = simulate(truth, motion, settings, name=name)
+    if out is not None:
+        write_log(out, log.t, log.signals)
     if truth_out is not None:
         save_robot(truth, truth_out, header=truth.description)
-    return twin, said
+    return Simulation(log, truth, settings, tuple(said.notes), tuple(said.warnings))

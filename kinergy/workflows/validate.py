@@ -6,8 +6,8 @@ import dataclasses
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
+from kinergy.arrays import Array
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_folder
 from kinergy.identification.validation import (
@@ -124,7 +124,7 @@ def write_validation_plots(
 
 
 def _plots(robot: Robot, logs: Sequence[LogValidation], out: Path) -> None:
-    errors: dict[str, dict[str, Any]] = {"torque": {}, "current": {}}
+    errors: dict[str, dict[str, Array]] = {"torque": {}, "current": {}}
     for log, stem in zip(logs, _stems([log.log for log in logs]), strict=True):
         for key, unit, label in (
             ("torque", "N m", "target_moment"),
