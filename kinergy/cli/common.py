@@ -172,7 +172,7 @@ PAYLOAD_METAVAR = "MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]"
 payload_option = click.option(
     "--payload",
     metavar=PAYLOAD_METAVAR,
-    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2 about its "
+    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m² about its "
     "centre of mass.",
 )
 
@@ -285,7 +285,7 @@ _READING_FLAGS: dict[str, Callable[[Any], Any]] = {
     "payload": click.option(
         "--payload",
         metavar=PAYLOAD_METAVAR,
-        help="Payload at the flange: kg, m (flange frame), kg m^2 about its centre of mass. It "
+        help="Payload at the flange: kg, m (flange frame), kg m² about its centre of mass. It "
         "replaces the model's and the one a log's controller logged (payload, payload_cog, "
         "payload_inertia), which is used otherwise.",
     ),
