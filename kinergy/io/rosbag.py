@@ -47,7 +47,7 @@ import datetime
 import enum
 import functools
 import os
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -491,20 +491,7 @@ def _read(
         stamp = int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
         if chunks is None:
             have = [s for s, f in fields.items() if len(getattr(msg, f)) > 0]
-            if "actual_q" not in have:
-                raise KinergyError(f"{where}: the joint states have no positions")
-            wanted = have if select is None else [s for s in have if s in select]
-            if select is not None:
-                possible = [*have, *(["robot_mode"] if modes is not None else [])]
-                missing = [s for s in select if s not in possible]
-                if missing:
-                    raise KinergyError(
-                        f"{path}: no field(s) for {', '.join(missing)}; the bag has: "
-                        f"{', '.join(possible)}"
-                    )
-                if "robot_mode" not in select:
-                    modes = None
-            chunks = _Chunks(path, len(joints), wanted, rows, modes)
+            chunks = _start(path, where, len(joints), have, select, rows, modes)
             chunks.notes += _first_notes(path, names, joints, order, prefix, effort, have)
         if stamp <= previous:
             if not repair:
@@ -514,15 +501,7 @@ def _read(
                 )
             dropped += 1
             continue
-        arrays = {}
-        for signal in chunks.values:
-            values = np.asarray(getattr(msg, fields[signal]), dtype=float)
-            if values.shape != (len(names),):
-                raise KinergyError(
-                    f"{where}: message {count}: {values.size} {fields[signal]} value(s) for "
-                    f"{len(names)} joint names"
-                )
-            arrays[signal] = values[order]
+        arrays = _values(msg, chunks.values, fields, order, f"{where}: message {count}")
         bad = next((k for k, x in arrays.items() if not np.all(np.isfinite(x))), None)
         if bad is not None:
             if not repair:
@@ -550,6 +529,51 @@ def _read(
         yield pending
     if last is not None:
         yield last
+
+
+def _start(
+    path: Path,
+    where: str,
+    n: int,
+    have: list[str],
+    select: Sequence[str] | None,
+    rows: int,
+    modes: tuple[NDArray[np.int64], Array] | None,
+) -> _Chunks:
+    """The chunks of a bag whose first joint state has the signals ``have``: those of
+    ``select`` (all when None), ``robot_mode`` only when selected."""
+    if "actual_q" not in have:
+        raise KinergyError(f"{where}: the joint states have no positions")
+    wanted = have if select is None else [s for s in have if s in select]
+    if select is not None:
+        possible = [*have, *(["robot_mode"] if modes is not None else [])]
+        missing = [s for s in select if s not in possible]
+        if missing:
+            raise KinergyError(
+                f"{path}: no field(s) for {', '.join(missing)}; the bag has: {', '.join(possible)}"
+            )
+        if "robot_mode" not in select:
+            modes = None
+    return _Chunks(path, n, wanted, rows, modes)
+
+
+def _values(
+    msg: Any,
+    signals: Iterable[str],
+    fields: dict[str, str],
+    order: NDArray[np.intp],
+    where: str,
+) -> dict[str, Array]:
+    """Each signal's values of one joint state, (n,) in the robot's joint order."""
+    arrays = {}
+    for signal in signals:
+        values = np.asarray(getattr(msg, fields[signal]), dtype=float)
+        if values.shape != (len(msg.name),):
+            raise KinergyError(
+                f"{where}: {values.size} {fields[signal]} value(s) for {len(msg.name)} joint names"
+            )
+        arrays[signal] = values[order]
+    return arrays
 
 
 def _first_notes(
