@@ -38,6 +38,7 @@ __all__ = [
     "check_folder",
     "check_output",
     "check_outputs",
+    "check_parent",
     "check_replaceable",
     "output_folder",
     "raise_pending",
@@ -160,6 +161,19 @@ def check_output(path: PathLike) -> Path:
     return target
 
 
+def check_parent(path: PathLike) -> Path:
+    """``path`` as a user's output whose folder must exist: kinergy does not create folders for
+    it (a mistyped folder would be made silently).
+
+    Returns the path. Raises KinergyError, ``PATH: no such folder FOLDER``.
+    """
+    target = Path(path)
+    parent = target.parent
+    if not parent.is_dir():
+        raise KinergyError(f"{target}: no such folder {parent}; create it first")
+    return target
+
+
 def check_replaceable(path: PathLike) -> Path:
     """``path`` as a user's output (``--out``, ``out=``): :func:`check_output`, and refused when
     it exists with content kinergy did not write (:func:`_marked`: a log, a program, any file
@@ -168,6 +182,7 @@ def check_replaceable(path: PathLike) -> Path:
     Returns the path. Raises KinergyError, one line naming the path.
     """
     target = check_output(path)
+    check_parent(target)
     if target.is_file():
         size = target.stat().st_size
         if size > 0 and not _marked(target, size):
@@ -356,6 +371,7 @@ def check_folder(path: PathLike) -> Path:
             )
     if target.parent.exists() and not target.parent.is_dir():
         raise KinergyError(f"{target}: {target.parent} is not a folder")
+    check_parent(target)
     return target
 
 

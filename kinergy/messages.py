@@ -9,15 +9,54 @@ on stderr (``kinergy: note: ...``, ``kinergy: warning: ...``; ``--quiet`` drops 
 A message is a :class:`Message`: its text, and a :class:`~kinergy.errors.Code` where a caller
 must pick it out (``PayloadRun.lacks`` takes the warnings coded ``PAYLOAD_MISSING``), so that no
 caller searches the text.
+
+Long work says how far it is through a :class:`Say` hook: a step's name, and where the step has
+parts (placements, logs, starts) how many of them are done, so that a terminal shows a fraction
+and the time left (the command line's progress bar; nothing on a pipe).
 """
 
 from __future__ import annotations
 
+import inspect
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Protocol, cast
 
 from kinergy.errors import Code
 
-__all__ = ["Message", "Messages", "coded"]
+__all__ = ["Message", "Messages", "Say", "as_say", "coded", "silent"]
+
+
+class Say(Protocol):
+    """A progress hook: ``say(message)`` starts a step; ``say(message, done=k, total=n)``
+    starts or advances a step of ``n`` parts, ``k`` of them done (``0 <= k <= n``)."""
+
+    def __call__(self, message: str, *, done: int | None = None, total: int | None = None) -> None:
+        """Say where the work is."""
+
+
+def silent(message: str, *, done: int | None = None, total: int | None = None) -> None:
+    """A :class:`Say` hook that says nothing."""
+
+
+def as_say(hook: Say | Callable[[str], None] | None) -> Say:
+    """``hook`` as a :class:`Say`: itself when it takes ``done`` and ``total``; a hook that
+    takes only the message (``print``) gets the parts done appended to it (``placement
+    (3/25)``); None: :func:`silent`."""
+    if hook is None:
+        return silent
+    try:
+        takes = {"done", "total"} <= set(inspect.signature(hook).parameters)
+    except (TypeError, ValueError):  # a builtin without a signature
+        takes = False
+    if takes:
+        return cast(Say, hook)
+    plain = cast(Callable[[str], None], hook)
+
+    def say(message: str, *, done: int | None = None, total: int | None = None) -> None:
+        plain(message if total is None else f"{message} ({done}/{total})")
+
+    return say
 
 
 class Message(str):

@@ -59,7 +59,7 @@ def test_the_python_recipe_runs_and_matches_the_commands(tmp_path: Path) -> None
     )
     assert run.returncode == 0, run.stderr
     printed = dict(line.split(": ", 1) for line in run.stdout.splitlines() if ": " in line)
-    r2 = ast.literal_eval(printed["held-out current R^2"])
+    r2 = ast.literal_eval(printed["held-out current R²"])
     drawn = float(printed["drawn from the supply"].removesuffix(" J"))
     held_out = str(UR10E / "validation_data" / "ur-20_01_17-ptp_10_points.csv")
     runs = [str(UR10E / "identification_data" / f"{name}.csv") for name in RUNS]

@@ -143,6 +143,13 @@ def test_monitor_text(ur5e_twin, capsys):
     assert lines[0].split()[:3] == ["cycle", "start", "[s]"]
     assert len(lines) >= 2 and lines[1].split()[0] == "1"
     assert "cycle(s), period" in captured.err
+    # the server runs in real time: the first cycle ends after two periods (5 s); until then a
+    # line a second says how much has come, the controller time growing
+    waiting = [x for x in captured.err.splitlines() if x.startswith("waiting for the first cycle")]
+    assert len(waiting) >= 2, captured.err
+    seconds = [float(x.split(": ")[1].split(" s ")[0]) for x in waiting]
+    assert seconds == sorted(seconds) and seconds[-1] > seconds[0]
+    assert "samples, period" in waiting[-1]
 
 
 @pytest.mark.parametrize(

@@ -76,8 +76,8 @@ def test_time_series_six_joints(tmp_path: Path) -> None:
     image = saved(fig, tmp_path / "torque.png")
     assert image.shape[:2] == (880, 1210)  # 11 x 8 in at 110 dpi
 
-    axes = fig.axes
-    assert len(axes) == 6
+    axes, below = fig.axes[:6], fig.axes[6:]
+    assert len(fig.axes) == 12  # each joint with its residual panel below it
     for ax, name, r2 in zip(axes, NAMES, r2_reference(y, p), strict=True):
         assert name in ax.get_title()
         assert f"R² = {r2:.4f}" in ax.get_title()
@@ -85,12 +85,15 @@ def test_time_series_six_joints(tmp_path: Path) -> None:
         assert len(ax.get_lines()) == 2
     # y labels on the left column, time on the bottom row, axes share x
     assert [ax.get_ylabel() for ax in axes] == ["Joint torque [N m]", ""] * 3
-    assert [ax.get_xlabel() for ax in axes] == [""] * 4 + ["Time [s]"] * 2
-    assert axes[0].get_shared_x_axes().joined(axes[0], axes[5])
+    assert [ax.get_xlabel() for ax in below] == [""] * 4 + ["Time [s]"] * 2
+    assert axes[0].get_shared_x_axes().joined(axes[0], below[5])
+    for res, j in zip(below, range(6), strict=True):
+        assert np.array_equal(res.get_lines()[0].get_ydata(), y[:, j] - p[:, j])
     # one legend for the figure, none per axes
     assert len(fig.legends) == 1
-    assert [x.get_text() for x in fig.legends[0].get_texts()] == ["target_moment", "model"]
-    assert all(ax.get_legend() is None for ax in axes)
+    legend = [x.get_text() for x in fig.legends[0].get_texts()]
+    assert legend == ["target_moment", "model", "target_moment - model"]
+    assert all(ax.get_legend() is None for ax in fig.axes)
     assert isinstance(fig.canvas, FigureCanvasAgg)
 
 
@@ -99,19 +102,23 @@ def test_time_series_odd_joint_count_keeps_time_labels(tmp_path: Path) -> None:
     fig = plots.time_series(t, y, p, joint_names=NAMES[:5], quantity="Motor current", unit="A")
     saved(fig, tmp_path / "current.png")
     axes = fig.axes
-    assert len(axes) == 5  # the spare cell of the 3 x 2 grid is removed
-    # both columns end with a time axis whose tick labels are shown
-    assert [ax.get_xlabel() for ax in axes] == ["", "", "", "Time [s]", "Time [s]"]
-    for ax in axes[3:]:
+    assert len(axes) == 10  # 5 joints and their residuals; the spare cell of the grid left empty
+    # both columns end with a residual panel whose time axis is labelled and shown
+    assert [ax.get_xlabel() for ax in axes[5:]] == ["", "", "", "Time [s]", "Time [s]"]
+    for ax in axes[8:]:
         assert all(lab.get_visible() for lab in ax.get_xticklabels())
-    assert [x.get_text() for x in fig.legends[0].get_texts()] == ["measured", "model"]
+    legend = [x.get_text() for x in fig.legends[0].get_texts()]
+    assert legend == ["measured", "model", "measured - model"]
+    # the residual panel holds measured - predicted
+    _, y, p = signals(2, n=5)
+    assert np.array_equal(axes[5].get_lines()[0].get_ydata(), y[:, 0] - p[:, 0])
 
 
 def test_time_series_single_joint_and_constant_signal() -> None:
     t = np.linspace(0.0, 1.0, 50)
     y = np.full((50, 1), 3.0)  # SS_tot = 0: R² undefined
     fig = plots.time_series(t, y, y + 0.1, joint_names=["j1"], quantity="Torque", unit="N m")
-    assert len(fig.axes) == 1
+    assert len(fig.axes) == 2  # the joint and its residual
     assert fig.axes[0].get_title() == "j1  (R² = n/a)"
 
 

@@ -347,7 +347,7 @@ def test_identify_and_validate_from_bags_print_what_the_csv_logs_give(
             if str(tmp_path) not in line and str(DATASETS) not in line
         ]
     assert out["bag"] == out["csv"]
-    assert any("R^2" in line for line in out["bag"])
+    assert any("R²" in line for line in out["bag"])
     held_out = out["bag"][out["bag"].index("Current against actual_current (UR5e Table VII)", 20) :]
     assert len(held_out) > 6
     values = {route: tomllib.loads(models[route].read_text()) for route in models}

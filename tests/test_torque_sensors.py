@@ -238,10 +238,10 @@ def test_validate_plots_draw_measured_torque_with_residuals(
     # a residual panel under each joint's panel
     fig = time_series(
         np.arange(3.0), np.zeros((3, 6)), np.ones((3, 6)), joint_names=list("abcdef"),
-        quantity="q", unit="u", residual=True,
+        quantity="q", unit="u",
     )  # fmt: skip
-    assert len(fig.axes) == 12 and fig.axes[1].get_ylabel() == "residual [u]"
-    np.testing.assert_array_equal(fig.axes[1].lines[0].get_ydata(), -np.ones(3))
+    assert len(fig.axes) == 12 and fig.axes[6].get_ylabel() == "residual [u]"
+    np.testing.assert_array_equal(fig.axes[6].lines[0].get_ydata(), -np.ones(3))
 
 
 def test_validation_compares_with_the_sensor_model(truth: kinergy.Robot, torque_logs: list) -> None:

@@ -20,6 +20,8 @@ with the same ``inputs`` (each input log by content, with its checks), ``notes``
 =====================================  ======================================================
 ``read_log(path, reading, robot)``     a log read whole (through the plausibility checks when
                                        a robot is given)
+``convert(log, out, to, robot)``       ``kinergy convert``: a log as a ROS 2 bag or a CSV,
+                                       :class:`Converted`
 ``identify(logs, robot, options)``     ``kinergy identify``: :class:`IdentificationResult`
 ``identify_payload(logs, robot)``      ``kinergy identify --payload-only``: :class:`PayloadRun`
 ``validate(model, logs)``              ``kinergy validate``: :class:`ValidationReport`
@@ -55,6 +57,7 @@ from typing import TYPE_CHECKING, Any
 _API = {
     # functions, one per command
     "read_log": "kinergy.api.logs",
+    "convert": "kinergy.api.logs",
     "identify": "kinergy.api.logs",
     "identify_payload": "kinergy.api.logs",
     "validate": "kinergy.api.logs",
@@ -78,6 +81,7 @@ _API = {
     "import_urdf": "kinergy.api.robots",
     # the options they take
     "LogReading": "kinergy.logs.reading",
+    "LogKind": "kinergy.workflows.convert",
     "IdentifyOptions": "kinergy.identification.options",
     "Method": "kinergy.identification.options",
     "Target": "kinergy.identification.options",
@@ -101,6 +105,7 @@ _API = {
     "RecordOptions": "kinergy.live.stream",
     # the results they return
     "IdentificationResult": "kinergy.identification.result",
+    "Converted": "kinergy.workflows.convert",
     "PayloadRun": "kinergy.workflows.identify",
     "ValidationReport": "kinergy.identification.validation",
     "LogEnergy": "kinergy.workflows.energy",
@@ -128,6 +133,7 @@ __all__ = [
     "PLOT_POINTS",
     "CalibrationImport",
     "Configurations",
+    "Converted",
     "CycleEnergy",
     "DemoRun",
     "EnergyOptions",
@@ -143,6 +149,7 @@ __all__ = [
     "IdentifyOptions",
     "LibraryRobot",
     "LogEnergy",
+    "LogKind",
     "LogReading",
     "Method",
     "Mismatch",
@@ -169,6 +176,7 @@ __all__ = [
     "UrdfImport",
     "ValidationReport",
     "ViaPoints",
+    "convert",
     "demo",
     "energy",
     "excite",
@@ -194,7 +202,15 @@ __all__ = [
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from kinergy.accounting.energy import EnergyReport
     from kinergy.api.live import fleet_energy, monitor, record
-    from kinergy.api.logs import energy, identify, identify_payload, read_log, report, validate
+    from kinergy.api.logs import (
+        convert,
+        energy,
+        identify,
+        identify_payload,
+        read_log,
+        report,
+        validate,
+    )
     from kinergy.api.optimize import MAX_POINTS, PLOT_POINTS, optimize_program, place
     from kinergy.api.robots import (
         export_robot,
@@ -219,6 +235,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from kinergy.trajectory.motion import MotionSource
     from kinergy.twin import Mismatch
     from kinergy.workflows.calibration import CalibrationImport
+    from kinergy.workflows.convert import Converted, LogKind
     from kinergy.workflows.demo import DemoRun
     from kinergy.workflows.energy import EnergyOptions, LogEnergy
     from kinergy.workflows.excite import ExciteOptions, ExciteRun, FloorFrames

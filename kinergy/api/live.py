@@ -42,13 +42,22 @@ def monitor(
     reading: LogReading | None = None,
     on_cycle: Callable[[CycleEnergy], None] | None = None,
     status: Progress | None = None,
+    waiting: Callable[[float, int, float | None], None] | None = None,
 ) -> MonitorRun:
     """``kinergy monitor``: the energy of every program cycle of the controller at ``address``,
     its supply's (where logged) beside ``robot``'s prediction, until ``options.duration``,
     Ctrl-C or SIGTERM; ``on_cycle`` receives each cycle as it ends. The stream passes the
-    plausibility checks but those ``reading.accept`` names."""
+    plausibility checks but those ``reading.accept`` names. Until the first cycle ends,
+    ``waiting(seconds, samples, period)`` is told once a second how much has come (controller
+    time, s; samples; the period found so far, s, or None)."""
     return monitor_cycles(
-        address, robot_of(robot), options, reading=reading, on_cycle=on_cycle, status=status
+        address,
+        robot_of(robot),
+        options,
+        reading=reading,
+        on_cycle=on_cycle,
+        status=status,
+        waiting=waiting,
     )
 
 

@@ -10,14 +10,16 @@ from kinergy.accounting.energy import energy as _energy_of_motion
 from kinergy.api.common import PathLike, Progress, RobotLike, robot_of
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.files import check_replaceable
+from kinergy.files import check_parent, check_replaceable
 from kinergy.identification.options import IdentifyOptions
 from kinergy.identification.result import IdentificationResult
 from kinergy.identification.validation import ValidationReport
 from kinergy.io.formats import read_log as _read_file
 from kinergy.io.log import Log
 from kinergy.logs.reading import CheckedLog, LogReading
+from kinergy.messages import as_say
 from kinergy.trajectory.motion import Motion
+from kinergy.workflows.convert import Converted, LogKind, convert_log
 from kinergy.workflows.energy import EnergyOptions, LogEnergy, energy_with_outputs
 from kinergy.workflows.identify import PayloadRun, identify_logs, identify_payload_model
 from kinergy.workflows.study import StudyReport, study_report
@@ -48,6 +50,39 @@ def read_log(
     return CheckedLog(path, robot_of(robot), reading).read()
 
 
+def convert(
+    log: PathLike,
+    out: PathLike,
+    to: LogKind,
+    robot: RobotLike = "ur5e",
+    *,
+    reading: LogReading | None = None,
+) -> Converted:
+    """``kinergy convert``: the log at ``log`` (any log kinergy reads) written to ``out`` as a
+    ROS 2 bag (:attr:`LogKind.BAG`: a rosbag2 folder, MCAP; the motion and one effort) or a CSV
+    log in UR's record.py layout (:attr:`LogKind.CSV`, every signal, each value read back as the
+    same number). ``robot`` gives the joints' names and count; of ``reading``, the columns of a
+    headerless text log, ``repair`` and a bag's topic and effort (read or written) apply.
+
+    Raises
+    ------
+    KinergyError
+        ``out`` exists or its folder does not; a bad log; an effort the log lacks.
+    """
+    r = robot_of(robot)
+    check_parent(out)
+    reading = reading or LogReading()
+    return convert_log(
+        log,
+        out,
+        to,
+        tuple(r.joint_names),
+        columns=reading.columns,
+        repair=reading.repair,
+        bag=reading.bag,
+    )
+
+
 def identify(
     logs: Sequence[PathLike | Log],
     robot: RobotLike,
@@ -55,10 +90,12 @@ def identify(
     *,
     reading: LogReading | None = None,
     out: PathLike | None = None,
+    progress: Progress | None = None,
 ) -> IdentificationResult:
     """``kinergy identify``: a model identified from ``logs`` (files or logs in memory) starting
     from ``robot``, as ``options`` say (default: the sequential method); written to ``out`` when
-    given (with where it came from).
+    given (with where it came from). ``progress`` is told each log read, of all, and when the
+    identification starts.
 
     Raises
     ------
@@ -69,7 +106,9 @@ def identify(
     r = robot_of(robot)
     if out is not None:
         check_replaceable(out)
-    return identify_logs(r, list(logs), out, reading=reading, options=options)
+    return identify_logs(
+        r, list(logs), out, reading=reading, options=options, progress=as_say(progress)
+    )
 
 
 def identify_payload(

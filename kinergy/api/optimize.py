@@ -5,6 +5,7 @@ from __future__ import annotations
 from kinergy.api.common import PathLike, Progress, RobotLike, robot_of
 from kinergy.checks import integer
 from kinergy.files import check_replaceable
+from kinergy.messages import as_say
 from kinergy.optimize.options import ProgramOptions
 from kinergy.optimize.placement import PlacementGrid
 from kinergy.workflows.optimize import OptimizeRun, run_optimize
@@ -82,5 +83,5 @@ def place(
             check_replaceable(path)
     return run_place(
         robot_of(robot), program, grid, options=options, urscript=urscript, plot=plot,
-        progress=progress,
+        progress=as_say(progress),
     )  # fmt: skip

@@ -46,6 +46,7 @@ COMMANDS = {
     "record": "kinergy.cli.record:record",
     "monitor": "kinergy.cli.monitor:monitor",
     "fleet": "kinergy.cli.fleet:fleet",
+    "convert": "kinergy.cli.convert:convert",
 }
 
 

@@ -15,18 +15,29 @@ from typing import Any, TypeVar
 import click
 import numpy as np
 from rich.console import Console
-from rich.progress import Progress, SpinnerColumn, TaskID, TextColumn, TimeElapsedColumn
+from rich.progress import (
+    BarColumn,
+    Progress,
+    ProgressColumn,
+    SpinnerColumn,
+    Task,
+    TaskID,
+    TextColumn,
+    TimeElapsedColumn,
+)
+from rich.text import Text
 
 from kinergy._version import __version__
 from kinergy.checks import choice
 from kinergy.cli.app import NOTES, QUIET
 from kinergy.errors import KinergyError
-from kinergy.files import check_folder, check_outputs, check_replaceable
+from kinergy.files import check_folder, check_outputs, check_parent, check_replaceable
 from kinergy.io.formats import NOT_LOGS
 from kinergy.io.rosbag import Effort
 from kinergy.jsonable import dumps, to_jsonable
 from kinergy.logs.checks import Check
 from kinergy.logs.reading import MAX_CUTOFF, InputLogs, LogReading
+from kinergy.messages import Say, silent
 from kinergy.model import Robot, load_robot, parse_payload
 
 __all__ = [
@@ -48,6 +59,7 @@ __all__ = [
     "refuse_together",
     "report_folder_option",
     "seed_option",
+    "swapped",
     "table",
     "tell",
     "warn",
@@ -129,6 +141,26 @@ def fmt_vector(v: Any) -> str:
     return "[" + ", ".join(fmt(float(x)) for x in np.asarray(v)) + "]"
 
 
+#: suffixes of logs (a model file is never one of them)
+_LOG_SUFFIXES = (".csv", ".txt", ".mcap", ".db3", ".log")
+#: suffixes of robot files (a log is never one of them)
+_MODEL_SUFFIXES = (".toml", ".urdf", ".json")
+
+
+def swapped(model: str, logs: Sequence[str]) -> None:
+    """Refuse, in one line, MODEL and LOG given in each other's place (``validate LOG.csv
+    model.toml``): the model names a log (by its suffix, or a folder: a bag) and a log names a
+    robot file."""
+    is_log = Path(model).suffix.lower() in _LOG_SUFFIXES or Path(model).is_dir()
+    robot_file = next((x for x in logs if Path(x).suffix.lower() in _MODEL_SUFFIXES), None)
+    if is_log and robot_file is not None:
+        command = click.get_current_context().command_path
+        raise KinergyError(
+            f"MODEL {model} looks like a log and LOG {robot_file} like a robot file: the "
+            f"arguments are swapped; the model comes first: {command} {robot_file} {model}"
+        )
+
+
 def load(robot_name: str, payload: str | None) -> Robot:
     """The robot called ``robot_name`` (built-in or file), with ``--payload`` if given."""
     return load_robot(robot_name, payload=None if payload is None else parse_payload(payload))
@@ -140,7 +172,7 @@ PAYLOAD_METAVAR = "MASS[,CX,CY,CZ[,IXX,IYY,IZZ,IXY,IYZ,IXZ]]"
 payload_option = click.option(
     "--payload",
     metavar=PAYLOAD_METAVAR,
-    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m^2 about its "
+    help="Payload at the flange (replaces the model's): kg, m (flange frame), kg m² about its "
     "centre of mass.",
 )
 
@@ -253,7 +285,7 @@ _READING_FLAGS: dict[str, Callable[[Any], Any]] = {
     "payload": click.option(
         "--payload",
         metavar=PAYLOAD_METAVAR,
-        help="Payload at the flange: kg, m (flange frame), kg m^2 about its centre of mass. It "
+        help="Payload at the flange: kg, m (flange frame), kg m² about its centre of mass. It "
         "replaces the model's and the one a log's controller logged (payload, payload_cog, "
         "payload_inertia), which is used otherwise.",
     ),
@@ -394,9 +426,11 @@ def writes(
                             f"{flag_of(cmd, name)} {folder}: holds an input ({inside[0]}), which "
                             "replacing the folder would delete; choose another folder"
                         )
-            for name, check in [(n, check_replaceable) for n in files] + [
-                (n, check_folder) for n in folders
-            ]:
+            for name, check in (
+                [(n, check_replaceable) for n in files]
+                + [(n, check_folder) for n in folders]
+                + [(n, check_parent) for n in into]
+            ):
                 for path in _given(kwargs[name]):
                     try:
                         check(path)
@@ -410,32 +444,60 @@ def writes(
     return decorate
 
 
+class _Parts(ProgressColumn):
+    """``k/n`` and the time left (rich's estimate) of a step of parts; nothing for a plain
+    step."""
+
+    def render(self, task: Task) -> Text:
+        if not task.fields.get("parts") or task.total is None:
+            return Text("")
+        left = task.time_remaining
+        clock = "" if left is None else f", {int(left) // 60}:{int(left) % 60:02d} left"
+        return Text(f"{task.completed:.0f}/{task.total:.0f}{clock}")
+
+
 @contextlib.contextmanager
-def progress(*, quiet: bool = False) -> Iterator[Callable[[str], None]]:
-    """A progress display on stderr for the steps of a long command: ``say(message)`` starts a
-    step (a spinner and its running time) and ends the one before.
+def progress(*, quiet: bool = False) -> Iterator[Say]:
+    """A progress display on stderr for the steps of a long command
+    (:class:`kinergy.messages.Say`): ``say(message)`` starts a step (a spinner and its running
+    time) and ends the one before; ``say(message, done=k, total=n)`` shows a step of ``n``
+    parts as a bar with ``k/n`` and the time left (rich's estimate from the parts done so far),
+    the same step advanced while ``n`` stays.
 
     Silent when stderr is not a terminal, with ``quiet``, or with the global ``--quiet``.
     """
     ctx = click.get_current_context(silent=True)
     console = Console(stderr=True)
     if quiet or (ctx is not None and ctx.meta.get(QUIET)) or not console.is_terminal:
-        yield lambda _message: None
+        yield silent
         return
-    columns = (SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn())
+    columns = (
+        SpinnerColumn(),
+        TextColumn("{task.description}"),
+        BarColumn(bar_width=24),
+        TimeElapsedColumn(),
+        _Parts(),
+    )
     with Progress(*columns, console=console) as bar:
-        current: list[TaskID] = []
+        current: list[tuple[TaskID, int | None]] = []
 
-        def say(message: str) -> None:
+        def end() -> None:
             if current:
-                bar.update(current[-1], completed=1)
-            current.append(bar.add_task(message, total=1))
+                task, total = current[-1]
+                bar.update(task, total=total or 1, completed=total or 1)
+
+        def say(message: str, *, done: int | None = None, total: int | None = None) -> None:
+            if total is not None and current and current[-1][1] == total:
+                bar.update(current[-1][0], description=message, completed=done or 0)
+                return
+            end()
+            task = bar.add_task(message, total=total, completed=done or 0, parts=total is not None)
+            current.append((task, total))
 
         try:
             yield say
         finally:
-            if current:
-                bar.update(current[-1], completed=1)
+            end()
 
 
 def _say(level: str, message: str) -> None:

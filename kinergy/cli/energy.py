@@ -15,6 +15,7 @@ from kinergy.cli.common import (
     json_result,
     prose,
     reading_options,
+    swapped,
     table,
     tell,
     writes,
@@ -184,6 +185,7 @@ def energy(
     with --columns), a motion file, a URScript program (.script) or a built-in motion (test-a,
     test-b: the UR5e doc's tests A and B planned for MODEL).
     """
+    swapped(model, [motion_path])
     with as_usage():
         options = api.EnergyOptions(source=source, recovery=not no_recovery)
     result = api.energy(model, motion_path, options, reading=reading, trace=trace, plot=plot)

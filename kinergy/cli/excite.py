@@ -32,7 +32,7 @@ __all__ = ["excite", "excite_text"]
 
 
 def _fmt_margins(margins: Mapping[str, float]) -> str:
-    units = {"position": "rad", "speed": "rad/s", "acceleration": "rad/s^2", "floor": "m"}
+    units = {"position": "rad", "speed": "rad/s", "acceleration": "rad/s²", "floor": "m"}
     return ", ".join(f"{k} {margins[k]:.4g} {u}" for k, u in units.items() if k in margins)
 
 
@@ -136,7 +136,7 @@ def excite_text(run: api.ExciteRun) -> str:
     "--acceleration",
     type=float,
     default=None,
-    help="Acceleration limit, rad/s^2 [the robot's; 2/s times the speed limit where it has none].",
+    help="Acceleration limit, rad/s² [the robot's; 2/s times the speed limit where it has none].",
 )
 @click.option(
     "--no-drives",

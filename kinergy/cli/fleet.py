@@ -65,8 +65,7 @@ def energy(
     def tick(done: int, total: int, result: LogResult) -> None:
         if result.error is not None:  # a log left out: the robot's figures lack it
             warn(f"{result.error} (left out of {result.robot}'s figures)")
-        if done == total or done % max(1, total // 10) == 0:
-            say(f"{done}/{total} logs")
+        say("energy of the fleet's logs", done=done, total=total)
 
     with as_usage():
         options = api.FleetOptions(scheduler=scheduler, workers=workers, min_rise=min_rise)

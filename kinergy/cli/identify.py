@@ -38,10 +38,8 @@ __all__ = ["identify"]
 
 def _payload_text(report: PayloadEstimate, out: str) -> str:
     lines = [
-        f"payload: {report.mass:.4f} +- {report.mass_std:.4f} kg at ["
-        + ", ".join(
-            f"{c:.4f} +- {sd:.4f}" for c, sd in zip(report.com, report.com_std, strict=True)
-        )
+        f"payload: {report.mass:.4f} ± {report.mass_std:.4f} kg at ["
+        + ", ".join(f"{c:.4f} ± {sd:.4f}" for c, sd in zip(report.com, report.com_std, strict=True))
         + f"] m (flange frame), from {report.signal}; wrote {out}"
     ]
     return "\n".join(lines)
@@ -50,7 +48,7 @@ def _payload_text(report: PayloadEstimate, out: str) -> str:
 def _with_std(j: DriveEstimate, key: str, value: float, spec: str) -> str:
     """``value +- std`` of parameter ``key`` of joint ``j``, with its flag when not identified."""
     std = j.std.get(key)
-    text = f"{value:{spec}}" + (f" +- {std:.2g}" if std is not None else "")
+    text = f"{value:{spec}}" + (f" ± {std:.2g}" if std is not None else "")
     flag = j.flags.get(key, IDENTIFIED)
     return text if flag == IDENTIFIED else f"{text} ({flag})"
 
@@ -153,7 +151,7 @@ def _result_text(result: IdentificationResult, logs: int, out: str) -> str:
         for j in result.joints
     ]
     samples = result.fit.samples
-    headers = ["joint", "J_m+J_r [kg m^2]", "J_m [kg m^2]", "k_t [N m/A]"]
+    headers = ["joint", "J_m+J_r [kg m²]", "J_m [kg m²]", "k_t [N m/A]"]
     offsets = [getattr(j, "torque_sensor_offset", None) for j in result.joints]
     if any(o is not None for o in offsets):  # against measured torques: the sensors' offsets
         headers.append("sensor offset [N m]")
@@ -272,8 +270,7 @@ def identify(
             say(f"reading {len(logs)} log(s) and identifying the payload")
             run = api.identify_payload(logs, r, out=out, reading=reading)
         else:
-            say(f"reading and identifying {len(logs)} log(s) ({method.value} method)")
-            result = api.identify(logs, r, options, reading=reading, out=out)
+            result = api.identify(logs, r, options, reading=reading, out=out, progress=say)
     if payload_only:
         tell(run.notes, run.warnings)
         click.echo(json_result(run) if as_json else _payload_text(run.payload, out))

@@ -42,7 +42,9 @@ def monitor(
 ) -> None:
     """Energy of every program cycle, live: the supply's (voltage x current) against the model's.
 
-    Cycles are found from the repeating commanded joint angles; Ctrl-C stops.
+    Cycles are found from the repeating commanded joint angles (a cycle is reported once the
+    motion has repeated); until the first one, a line a second on stderr says how much has come.
+    Ctrl-C stops.
     """
     with as_usage():
         options = api.StreamOptions(frequency=frequency, duration=duration)
@@ -56,8 +58,18 @@ def monitor(
         if not as_json:
             click.echo(_line(cycle))
 
+    def waiting(seconds: float, samples: int, period: float | None) -> None:
+        found = "period not found yet" if period is None else f"period {fmt(period)} s"
+        click.echo(
+            f"waiting for the first cycle: {seconds:.1f} s of controller time, {samples} "
+            f"samples, {found}",
+            err=True,
+        )
+
     with progress() as say:
-        run = api.monitor(address, robot, options, reading=reading, on_cycle=show, status=say)
+        run = api.monitor(
+            address, robot, options, reading=reading, on_cycle=show, status=say, waiting=waiting
+        )
     period = "not found" if run.period is None else f"{fmt(run.period)} s"
     if as_json:
         click.echo(json_result(run))

@@ -96,7 +96,7 @@ def _pareto_table(front: Sequence[ParetoPoint]) -> str:
         ]
         for p in front
     ]
-    return table(["cycle [s]", "optimized [J]", "uniform [J]"], rows)
+    return table(["cycle [s]", "optimised [J]", "uniform [J]"], rows)
 
 
 def _saving_interval(iv: Interval | None) -> str:
@@ -312,7 +312,7 @@ def program_options(
     "a_max",
     type=float,
     default=None,
-    help="Cap on every joint's acceleration, rad/s^2 [default: the program's own peak].",
+    help="Cap on every joint's acceleration, rad/s² [default: the program's own peak].",
 )
 @click.option(
     "--pareto-points",

@@ -149,7 +149,7 @@ def place_text(run: api.PlaceRun) -> str:
 )  # fmt: skip
 @click.option(
     "--a-max", "a_max", type=float, default=None, help="Cap on every joint's acceleration, "
-    "rad/s^2 [default: today's program's peak]."
+    "rad/s² [default: today's program's peak]."
 )  # fmt: skip
 @lever_options()
 @writes(files=("urscript", "plot"), inputs=("robot_name", "program_file"))

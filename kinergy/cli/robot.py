@@ -71,13 +71,13 @@ def robot_list(as_json: bool) -> None:
 def _summary(r: Robot) -> list[str]:
     lines = [
         f"{r.name}: {r.description}" if r.description else r.name,
-        f"convention: {r.convention}   joints: {r.n}   gravity: {fmt_vector(r.gravity)} m/s^2",
+        f"convention: {r.convention}   joints: {r.n}   gravity: {fmt_vector(r.gravity)} m/s²",
     ]
     if r.payload is not None:
         p = r.payload
         lines.append(
             f"payload: {fmt(p.mass)} kg at {fmt_vector(p.com)} m (flange), "
-            f"inertia {fmt_vector(p.inertia)} kg m^2"
+            f"inertia {fmt_vector(p.inertia)} kg m²"
         )
     if not np.array_equal(r.base, np.eye(4)):
         lines.append(f"base: frame 0 at {fmt_vector(r.base[:3, 3])} m")
@@ -94,7 +94,7 @@ def _links(r: Robot) -> str:
     a_name = "a_{i-1} [m]" if r.convention == "mdh" else "a [m]"
     al_name = "alpha_{i-1} [deg]" if r.convention == "mdh" else "alpha [deg]"
     headers = ["joint", "d [m]", a_name, al_name, "offset [deg]", "mass [kg]", "com [m]"]
-    headers.append("inertia Ixx Iyy Izz Ixy Iyz Ixz [kg m^2]")
+    headers.append("inertia Ixx Iyy Izz Ixy Iyz Ixz [kg m²]")
     rows = [
         [
             j.name,
@@ -112,7 +112,7 @@ def _links(r: Robot) -> str:
 
 
 def _drives(r: Robot) -> str:
-    headers = ["joint", "gear", "J_m [kg m^2]", "J_r [kg m^2]", "k_t [N m/A]"]
+    headers = ["joint", "gear", "J_m [kg m²]", "J_r [kg m²]", "k_t [N m/A]"]
     headers += ["k_m [N m/sqrt(W)]", "k_t/k_b", "friction"]
     rows = []
     for j in r.joints:
@@ -134,7 +134,7 @@ def _drives(r: Robot) -> str:
 
 
 def _limits(r: Robot) -> str:
-    headers = ["joint", "position [deg]", "speed [deg/s]", "acceleration [deg/s^2]", "torque [N m]"]
+    headers = ["joint", "position [deg]", "speed [deg/s]", "acceleration [deg/s²]", "torque [N m]"]
     rows = [
         [
             j.name,

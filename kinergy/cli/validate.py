@@ -13,6 +13,7 @@ from kinergy.cli.common import (
     json_result,
     prose,
     reading_options,
+    swapped,
     table,
     tell,
     writes,
@@ -45,7 +46,7 @@ def _metrics_table(metrics: Sequence[JointMetrics], names: Sequence[str], unit: 
         if isinstance(m, SignalMetrics) and normalised:
             row.append(f"{m.nrms:.3f}")
         rows.append([*row, _r2(m)])
-    return table(headers + (["NRMS"] if normalised else []) + ["R^2"], rows)
+    return table(headers + (["NRMS"] if normalised else []) + ["R²"], rows)
 
 
 #: the tables of a validation: field, title, unit
@@ -84,7 +85,7 @@ def _per_log_text(report: ValidationReport, names: Sequence[str]) -> str:
             rows.append([Path(log.log).stem, f"{log.holding_fraction:.0%}", *cells])
         if rows:
             parts += [
-                f"{title}: R^2 while moving / RMS [{unit}] while holding",
+                f"{title}: R² while moving / RMS [{unit}] while holding",
                 table(["log", "holding", *names], rows),
                 "",
             ]
@@ -98,7 +99,7 @@ def supply_text(report: ValidationReport) -> str:
         return ""
     return (
         f"Supply power against actual_robot_voltage x actual_robot_current ({s.samples} samples):"
-        f" RMSE {s.rms:.2f} W, R^2 {s.r2:.4f}, mean error {s.mean:+.2f} W; energy predicted "
+        f" RMSE {s.rms:.2f} W, R² {s.r2:.4f}, mean error {s.mean:+.2f} W; energy predicted "
         f"{s.predicted:.1f} J against {s.measured:.1f} J measured ({s.error:+.1f} %). Predicted: "
         "the motors summed on the DC bus plus the model's standing draw."
     )
@@ -151,6 +152,7 @@ def validate(
     A LOG may also be a built-in motion (test-a, test-b): the log the realistic twin of MODEL
     writes running it (a simulated robot that differs from the model as a real arm does).
     """
+    swapped(model, logs)
     r = load_robot(model)
     report = api.validate(r, logs, reading=reading, plots=plots)
     tell(report.notes, report.warnings)

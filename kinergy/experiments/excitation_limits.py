@@ -200,7 +200,7 @@ def _rate_limits(
         )
     else:
         acc = _as_vector(acceleration, n, "acceleration")
-    for name, arr, unit in (("speed", v, "rad/s"), ("acceleration", acc, "rad/s^2")):
+    for name, arr, unit in (("speed", v, "rad/s"), ("acceleration", acc, "rad/s²")):
         if np.any(arr <= 0):
             j = int(np.argmin(arr))
             raise KinergyError(

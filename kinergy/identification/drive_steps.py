@@ -214,9 +214,9 @@ def rotor_step(
     for j, joint in enumerate(robot.joints):
         if rotor[j] < 0:
             said.warn(
-                f"joint {j + 1} ({joint.name}): identified rotor inertia {rotor[j]:.3g} kg m^2 "
+                f"joint {j + 1} ({joint.name}): identified rotor inertia {rotor[j]:.3g} kg m² "
                 "is negative, not a physical value (target_moment does not fit this model): "
-                f"kept the model's {joint.drive.rotor_inertia:.4g} kg m^2"
+                f"kept the model's {joint.drive.rotor_inertia:.4g} kg m²"
             )
             rotor[j], rotor_std[j] = joint.drive.rotor_inertia, np.nan
     return rotor, rotor_std, cond

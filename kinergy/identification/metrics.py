@@ -9,7 +9,19 @@ from numpy.typing import ArrayLike
 
 from kinergy.arrays import Array
 
-__all__ = ["JointMetrics", "MetricSums", "fit_metrics", "r_squared", "rmse"]
+__all__ = [
+    "EXCITED_RANGE",
+    "ExcitedSums",
+    "JointMetrics",
+    "MetricSums",
+    "SignalMetrics",
+    "fit_metrics",
+    "r_squared",
+    "rmse",
+]
+
+#: rad: a joint whose position spans less than this over the samples is not excited
+EXCITED_RANGE = 0.02
 
 
 def r_squared(measured: ArrayLike, predicted: ArrayLike) -> Array:
@@ -113,3 +125,48 @@ class MetricSums:
             )
             for j in range(self.mean.size)
         )
+
+
+@dataclass(frozen=True)
+class SignalMetrics(JointMetrics):
+    """:class:`JointMetrics` with the RMS error over the RMS of the measured signal (``nrms``)
+    and a ``note`` where R² means nothing (``not excited``, ``signal constant``; None
+    otherwise, R² then NaN, JSON null)."""
+
+    nrms: float = float("nan")
+    note: str | None = None
+
+
+class ExcitedSums:
+    """One signal's figures over some samples, accumulated block by block: the error
+    statistics (:class:`MetricSums`) and each joint's position
+    range (which joints were excited)."""
+
+    def __init__(self, n: int):
+        self.sums = MetricSums(n)
+        self.low = np.full(n, np.inf)
+        self.high = np.full(n, -np.inf)
+
+    def add(self, measured: Array, predicted: Array, q: Array) -> None:
+        """Fold in a block of (N, n) signals and joint positions."""
+        if len(q):
+            self.sums.add(measured, predicted)
+            self.low = np.minimum(self.low, q.min(axis=0))
+            self.high = np.maximum(self.high, q.max(axis=0))
+
+    def metrics(self) -> tuple[SignalMetrics, ...] | None:
+        """Per joint :class:`SignalMetrics`; None without samples."""
+        if self.sums.count == 0:
+            return None
+        level = np.sqrt(self.sums.sq / self.sums.count)
+        out = []
+        for j, m in enumerate(self.sums.metrics()):
+            note = None
+            if self.high[j] - self.low[j] < EXCITED_RANGE:
+                note = "not excited"
+            elif not np.isfinite(m.r2):
+                note = "signal constant"
+            r2 = m.r2 if note is None else float("nan")
+            nrms = m.rms / level[j] if level[j] > 0 else float("nan")
+            out.append(SignalMetrics(m.mean, m.max, m.rms, r2, nrms, note))
+        return tuple(out)

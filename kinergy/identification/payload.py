@@ -237,8 +237,7 @@ def _disagreement(fits: list[tuple[Array, Array]]) -> tuple[tuple[str, ...], set
             continue
         axes.update("xyz"[k] for k in bad)
         said = ", ".join(
-            f"{'xyz'[k]} {c1[k]:.3f} +- {s1[k]:.3f} against {c2[k]:.3f} +- {s2[k]:.3f} m"
-            for k in bad
+            f"{'xyz'[k]} {c1[k]:.3f} ± {s1[k]:.3f} against {c2[k]:.3f} ± {s2[k]:.3f} m" for k in bad
         )
         note = f"logs {i + 1} and {j + 1} disagree on the centre of mass beyond 2 sigma: {said}"
         if {0, 1} & set(bad):
@@ -298,17 +297,17 @@ def _uncertainty_notes(
     ``disputed`` (the logs disagree), that the error is their disagreement instead."""
     notes = [
         f"standard errors from a jackknife over {BLOCKS} time blocks (correlated residuals): "
-        f"mass +- {report.mass_std:.2g} kg against {white_mass_std:.2g} kg by the white-noise formula"
+        f"mass ± {report.mass_std:.2g} kg against {white_mass_std:.2g} kg by the white-noise formula"
     ]
     for axis, value, std in zip("xyz", report.com, report.com_std, strict=True):
         if std > MAX_COM_STD and axis in disputed:
             notes.append(
-                f"pooled centre of mass {axis} = {value:.3f} +- {std:.3f} m: that error is the "
+                f"pooled centre of mass {axis} = {value:.3f} ± {std:.3f} m: that error is the "
                 "logs' disagreement (below), not a motion too poor to show it"
             )
         elif std > MAX_COM_STD:
             notes.append(
-                f"centre of mass {axis} = {value:.3f} +- {std:.3f} m is not identifiable from "
+                f"centre of mass {axis} = {value:.3f} ± {std:.3f} m is not identifiable from "
                 f"this motion; it needs {_COM_MOTION[axis]}"
             )
     return tuple(notes)
@@ -456,7 +455,7 @@ def _finish(
     mass = float(x[0])
     if mass <= 0 or std[0] > 0.5 * abs(mass):
         raise KinergyError(
-            f"the logs do not show a payload: identified mass {mass:.3g} +- {std[0]:.2g} kg"
+            f"the logs do not show a payload: identified mass {mass:.3g} ± {std[0]:.2g} kg"
         )
     com = _com(robot, x)
     inertia6, note = _inertia(robot, x) if inertia_ok else (np.zeros(6), None)

@@ -175,12 +175,12 @@ def link_consistency(standard: ArrayLike) -> list[str | None]:
         if eig[0] <= 0.0:
             out.append(
                 "identified inertia about the centre of mass is not positive definite "
-                f"(principal moments {moments} kg m^2, centre of mass "
+                f"(principal moments {moments} kg m², centre of mass "
                 f"{np.array2string(c, precision=4)} m)"
             )
         elif eig[0] + eig[1] < eig[2] * (1.0 - 1e-9):
             out.append(
-                f"identified inertia violates the triangle inequality (principal moments {moments} kg m^2)"
+                f"identified inertia violates the triangle inequality (principal moments {moments} kg m²)"
             )
         else:
             out.append(None)

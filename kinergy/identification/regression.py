@@ -337,7 +337,7 @@ def _merge_note(k: int, cols: Columns, kept: Index, coef: Array | None) -> tuple
     """Warning text and entry for the dropped column ``k`` (``coef``: its column as a combination
     of the kept columns, ``None`` when it is zero)."""
     name, value = cols.names[k], float(cols.prior[k])
-    unit = " kg m^2" if cols.group[k] == "rotor" else " (motor side)"
+    unit = " kg m²" if cols.group[k] == "rotor" else " (motor side)"
     if coef is None:
         text = f"{name} is not excited by the logs (its column is zero): kept the model's {value:.4g}{unit}"
         return text, MergedColumn(name, value, ())
@@ -370,11 +370,15 @@ def merged_columns(ols: OlsFit, cols: Columns) -> Merging:
     entries, said, rotor = [], Messages(), {}
     for i, k in enumerate(dropped):
         text, entry = _merge_note(int(k), cols, kept, coef[:, i] if excited[i] else None)
-        said.note(text)
         entries.append(entry)
         if cols.group[k] == "rotor" and entry.into and all(e.index < n_link for e in entry.into):
             c_vec = np.zeros(n_link)
             for e in entry.into:
                 c_vec[e.index] = e.coefficient
             rotor[int(k - n_link)] = c_vec
+            # the physically constrained fit may move it: "kept" would not be true then
+            text = text.replace("kept the model's", "the regression keeps the model's") + (
+                " (a physically constrained fit may move it: the model file holds what is written)"
+            )
+        said.note(text)
     return Merging(tuple(entries), said, rotor)

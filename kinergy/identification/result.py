@@ -23,7 +23,7 @@ from kinergy.arrays import Array
 from kinergy.drives.bus import supply_power
 from kinergy.identification.chunks import LogChunks, data_history
 from kinergy.identification.electrics import StandingDraw
-from kinergy.identification.metrics import JointMetrics, MetricSums
+from kinergy.identification.metrics import ExcitedSums, JointMetrics
 from kinergy.jsonable import to_jsonable
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs
@@ -254,12 +254,13 @@ def fit_fields(
 
 
 def validation_metrics(robot: Robot, logs: LogChunks | Sequence[IdentData]) -> Validation:
-    """UR5e Tables V and VII over several logs (pooled): per joint mean, max, RMS error and R^2
-    of the torque (against ``target_moment``), the current (against ``actual_current``) and, for
+    """UR5e Tables V and VII over several logs (pooled): per joint mean, max, RMS error and R²
+    (:class:`~kinergy.identification.metrics.SignalMetrics`: none, with a note, for a joint
+    that did not move, as validation says) of the torque (against ``target_moment``), the current (against ``actual_current``) and, for
     arms with torque sensors, the joint torque. Where every log measures the supply, the
     predicted currents are kept (:attr:`LogChunks.currents`) for the standing draw's fit."""
     logs = logs if isinstance(logs, LogChunks) else LogChunks.of(logs)
-    sums: dict[str, MetricSums] = {}
+    sums: dict[str, ExcitedSums] = {}
     keep = logs.every("supply_voltage", "current")
     kept = logs.derived() if keep else None
     for _, chunk, pred in predictions(robot, logs):
@@ -269,7 +270,7 @@ def validation_metrics(robot: Robot, logs: LogChunks | Sequence[IdentData]) -> V
             ("joint_torque", chunk.torque, pred.joint_torque),
         ):
             if measured is not None and predicted is not None:
-                sums.setdefault(key, MetricSums(robot.n)).add(measured, predicted)
+                sums.setdefault(key, ExcitedSums(robot.n)).add(measured, predicted, chunk.q)
         if kept is not None:
             kept.put([pred.current])
     if kept is not None:

@@ -30,7 +30,12 @@ from numpy.typing import NDArray
 
 from kinergy.arrays import Array
 from kinergy.identification.chunks import Segment, WholeSegment, data_history
-from kinergy.identification.metrics import JointMetrics, MetricSums
+from kinergy.identification.metrics import (
+    EXCITED_RANGE,
+    ExcitedSums,
+    MetricSums,
+    SignalMetrics,
+)
 from kinergy.identification.result import Prediction, Validation, predict
 from kinergy.identification.sanity import check_signals
 from kinergy.io.formats import CHUNK_ROWS
@@ -59,23 +64,11 @@ __all__ = [
 HOLD_SPEED = 0.02
 #: s: shortest static hold (shorter pauses count as motion)
 HOLD_SECONDS = 0.5
-#: rad: a joint whose position spans less than this over the samples is not excited
-EXCITED_RANGE = 0.02
 #: most samples of one log kept for plots (:attr:`LogValidation.series`); a longer log's plots
 #: show every k-th sample
 PLOT_SAMPLES = 200_000
 #: the signals compared, as (name, measured attribute of IdentData)
 SIGNALS = (("torque", "tau_ref"), ("current", "current"), ("joint_torque", "torque"))
-
-
-@dataclass(frozen=True)
-class SignalMetrics(JointMetrics):
-    """:class:`JointMetrics` with the RMS error over the RMS of the measured signal (``nrms``)
-    and a ``note`` where R^2 means nothing (``not excited``, ``signal constant``; None
-    otherwise, R^2 then NaN, JSON null)."""
-
-    nrms: float = float("nan")
-    note: str | None = None
 
 
 @dataclass(frozen=True)
@@ -160,46 +153,11 @@ def holding_mask(t: Array, qd: Array) -> NDArray[np.bool_]:
 def _signal_metrics(measured: Array, predicted: Array, q: Array) -> tuple[SignalMetrics, ...]:
     """Per joint metrics of (N, n) signals, with the joint positions ``q`` (N, n) deciding which
     joints were excited."""
-    part = _Part(q.shape[1])
+    part = ExcitedSums(q.shape[1])
     part.add(measured, predicted, q)
     metrics = part.metrics()
     assert metrics is not None, "no samples"
     return metrics
-
-
-class _Part:
-    """One signal's figures over some samples, accumulated block by block: the error
-    statistics (:class:`~kinergy.identification.metrics.MetricSums`) and each joint's position
-    range (which joints were excited)."""
-
-    def __init__(self, n: int):
-        self.sums = MetricSums(n)
-        self.low = np.full(n, np.inf)
-        self.high = np.full(n, -np.inf)
-
-    def add(self, measured: Array, predicted: Array, q: Array) -> None:
-        """Fold in a block of (N, n) signals and joint positions."""
-        if len(q):
-            self.sums.add(measured, predicted)
-            self.low = np.minimum(self.low, q.min(axis=0))
-            self.high = np.maximum(self.high, q.max(axis=0))
-
-    def metrics(self) -> tuple[SignalMetrics, ...] | None:
-        """Per joint :class:`SignalMetrics`; None without samples."""
-        if self.sums.count == 0:
-            return None
-        level = np.sqrt(self.sums.sq / self.sums.count)
-        out = []
-        for j, m in enumerate(self.sums.metrics()):
-            note = None
-            if self.high[j] - self.low[j] < EXCITED_RANGE:
-                note = "not excited"
-            elif not np.isfinite(m.r2):
-                note = "signal constant"
-            r2 = m.r2 if note is None else float("nan")
-            nrms = m.rms / level[j] if level[j] > 0 else float("nan")
-            out.append(SignalMetrics(m.mean, m.max, m.rms, r2, nrms, note))
-        return tuple(out)
 
 
 @dataclass(frozen=True, eq=False)
@@ -277,11 +235,11 @@ _PARTS = ("whole", "moving", "holding")
 
 class _Tally:
     """The figures of one log (or of all): per signal over all, the moving and the holding
-    samples (:class:`_Part`), and how many samples and holding samples there were."""
+    samples (:class:`ExcitedSums`), and how many samples and holding samples there were."""
 
     def __init__(self, n: int):
         self.n = n
-        self.parts: dict[str, dict[str, _Part]] = {}
+        self.parts: dict[str, dict[str, ExcitedSums]] = {}
         self.samples = 0
         self.held = 0
 
@@ -289,7 +247,7 @@ class _Tally:
         self.samples += len(holding)
         self.held += int(holding.sum())
         for name, (measured, predicted) in rows.signals.items():
-            parts = self.parts.setdefault(name, {key: _Part(self.n) for key in _PARTS})
+            parts = self.parts.setdefault(name, {key: ExcitedSums(self.n) for key in _PARTS})
             parts["whole"].add(measured, predicted, rows.q)
             for key, sel in (("moving", ~holding), ("holding", holding)):
                 parts[key].add(measured[sel], predicted[sel], rows.q[sel])

@@ -142,16 +142,16 @@ def _links(
             x = x.copy()
             x[col] = cols.prior[col]
         return _Links(pi - payload, x, CLOSEST, None, flagged)
-    instead = (
-        "the returned robot is the least-squares fit constrained to physical links, rotor "
-        f"inertias and friction (chi^2 up by {refit.chi2:.3g}; "
-        "fit['physical_fit'], while fit['base_parameters'] and fit['regression'] are the "
-        "unconstrained fit)"
-    )
     for j, p in flagged.items():
-        said.note(f"link {j + 1} ({robot.joints[j].name}): {p}; {instead}")
+        said.note(f"link {j + 1} ({robot.joints[j].name}): {p}")
     for phrase in outside.values():
-        said.note(f"{phrase}; {instead}")
+        said.note(phrase)
+    said.note(
+        f"for the {len(flagged) + len(outside)} finding(s) above, the returned robot is the "
+        "least-squares fit constrained to physical links, rotor inertias and friction (chi² up "
+        f"by {refit.chi2:.3g}; fit['physical_fit'], while fit['base_parameters'] and "
+        "fit['regression'] are the unconstrained fit)"
+    )
     return _Links(refit.pi - payload, refit.x, CONSTRAINED, refit, flagged)
 
 
@@ -165,6 +165,7 @@ def _with_links(
     model = inertial_parameters(robot, include_payload=False)
     joints: list[Joint] = []
     physical: list[bool] = []
+    kept: list[str] = []
     for j, (joint, problem) in enumerate(zip(robot.joints, link_consistency(links), strict=True)):
         link = joint.link
         if problem is None:
@@ -174,32 +175,31 @@ def _with_links(
             except KinergyError as err:
                 problem = str(err)
         if problem is not None:
-            said.warn(
-                f"link {j + 1} ({joint.name}): {problem}; kept the model's mass, centre of mass "
-                "and inertia for this link, so the returned robot's torques differ from the "
-                "identified base parameters' (fit['regression'] is the identified fit, "
-                "fit['torque'], fit['current'] and fit['joint_torque'] the returned robot's)"
-            )
+            said.warn(f"link {j + 1} ({joint.name}): {problem}")
+            kept.append(str(j + 1))
             links[10 * j : 10 * j + 10] = model[10 * j : 10 * j + 10]
         joints.append(dataclasses.replace(joint, link=link))
         physical.append(problem is None)
+    if kept:
+        said.warn(
+            f"kept the model's mass, centre of mass and inertia for link(s) {', '.join(kept)}, "
+            "so the returned robot's torques differ from the identified base parameters' "
+            "(fit['regression'] is the identified fit, fit['torque'], fit['current'] and "
+            "fit['joint_torque'] the returned robot's)"
+        )
     return joints, links, physical
 
 
-def _with_rotor(m: int, joint: Joint, rotor: float, said: Messages) -> Drive:
-    """``joint``'s drive with rotor inertia ``rotor`` = J_m + J_r (kg m^2, motor side)."""
+def _with_rotor(m: int, joint: Joint, rotor: float, low: list[str]) -> Drive:
+    """``joint``'s drive with rotor inertia ``rotor`` = J_m + J_r (kg m^2, motor side); where it
+    is below the model's reducer inertia, ``low`` receives the joint and both values."""
     drive = joint.drive
     if rotor >= drive.reducer_inertia:
         return dataclasses.replace(drive, motor_inertia=rotor - drive.reducer_inertia)
     # motor inertia clipped at 0; the reducer inertia gives way too, so the written J_m + J_r is
     # the identified one (arms with link-side torque sensors see about 0)
     reducer = max(rotor, 0.0)
-    said.note(
-        f"joint {m + 1} ({joint.name}): identified rotor inertia {rotor:.3g} kg m^2 is "
-        + ("not positive" if rotor <= 0.0 else "below the model's reducer inertia")
-        + f" ({drive.reducer_inertia:.3g}): motor inertia set to 0 and reducer inertia "
-        f"to {reducer:.3g} kg m^2"
-    )
+    low.append(f"joint {m + 1} ({joint.name}) {rotor:.3g} (reducer {drive.reducer_inertia:.3g})")
     return dataclasses.replace(drive, motor_inertia=0.0, reducer_inertia=reducer)
 
 
@@ -256,12 +256,19 @@ def _flags(cols: Columns, problem: Solved, written: _Links) -> tuple[Flag, ...]:
 
 
 def _with_drive(
-    m: int, joint: Joint, reg: Regression, x: Array, commanded: bool, said: Messages
+    m: int,
+    joint: Joint,
+    reg: Regression,
+    x: Array,
+    commanded: bool,
+    said: Messages,
+    low: list[str],
 ) -> Joint:
-    """``joint`` with motor ``m``'s rotor inertia, friction (not ``commanded``) and, against
-    measured torques, joint ``m``'s torque sensor offset from the unknowns ``x``."""
+    """``joint`` with motor ``m``'s rotor inertia (one below the reducer's into ``low``),
+    friction (not ``commanded``) and, against measured torques, joint ``m``'s torque sensor
+    offset from the unknowns ``x``."""
     cols = reg.cols
-    drive = _with_rotor(m, joint, float(x[cols.n_link + m]), said)
+    drive = _with_rotor(m, joint, float(x[cols.n_link + m]), low)
     joint = dataclasses.replace(joint, drive=drive)
     if not commanded:
         friction = (reg.models[m], reg.params[m])
@@ -289,10 +296,17 @@ def write_back(
     cols = reg.cols
     written = _links(robot, base, problem, reg, merged_rotor, said)
     link_joints, links, physical = _with_links(robot, written.links, said)
+    low: list[str] = []
     final = [
-        _with_drive(m, joint, reg, written.x, commanded, said)
+        _with_drive(m, joint, reg, written.x, commanded, said, low)
         for m, joint in enumerate(link_joints)
     ]
+    if low:
+        said.note(
+            "identified rotor inertia J_m + J_r below the model's reducer inertia, kg m² (arms "
+            "with link-side torque sensors see about 0): motor inertia set to 0 and reducer "
+            f"inertia to the identified value: {', '.join(low)}"
+        )
     sources = _sources(robot, written.method, physical, commanded)
     refit = written.refit
     return WriteBack(

@@ -46,6 +46,7 @@ from __future__ import annotations
 import datetime
 import enum
 import functools
+import os
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -79,6 +80,7 @@ __all__ = [
     "bag_options",
     "default_effort",
     "effort_scale",
+    "first_stamp",
     "is_bag",
     "match_joints",
 ]
@@ -335,6 +337,22 @@ def _topic(reader: Reader, path: Path, topic: str) -> list[Connection]:
     if info.msgcount < 2:
         raise KinergyError(f"{path}: topic {topic} has {info.msgcount} message(s); need 2 or more")
     return list(info.connections)
+
+
+def first_stamp(path: str | os.PathLike[str], bag: BagOptions | None = None) -> int:
+    """The header stamp (ns) of the first ``JointState`` message of the bag at ``path`` (on
+    ``bag``'s topic): what a bag read as a log takes as time 0 s."""
+    path = Path(path)
+    options = bag or BagOptions()
+    reader = _open(path.parent if path.name == "metadata.yaml" else path)
+    try:
+        conns = _topic(reader, path, options.topic)
+        for conn, _, raw in reader.messages(conns):
+            msg: Any = _typestore().deserialize_cdr(raw, conn.msgtype)
+            return int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
+    finally:
+        reader.close()
+    raise KinergyError(f"{path}: no message on {options.topic}")  # _topic saw messages
 
 
 def _robot_modes(reader: Reader) -> tuple[NDArray[np.int64], NDArray[np.float64]] | None:

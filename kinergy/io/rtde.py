@@ -29,7 +29,7 @@ import numpy as np
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.files import atomic_write
+from kinergy.files import atomic_open, atomic_write
 from kinergy.io.columns import Columns, group_columns, parse_columns
 from kinergy.io.formats import LogFormat, iter_log, read_log, register
 from kinergy.io.log import TIME_UNITS, Log, time_unit
@@ -37,7 +37,15 @@ from kinergy.io.log_arrow import NotPlain, arrow_chunks
 from kinergy.io.log_layout import LogLayout, log_layout
 from kinergy.io.log_text import read_text_table
 
-__all__ = ["RTDE", "iter_log", "parse_columns", "read_log", "write_log"]
+__all__ = [
+    "RTDE",
+    "exact_text",
+    "iter_log",
+    "parse_columns",
+    "read_log",
+    "write_log",
+    "write_log_chunks",
+]
 
 
 def _selection(layout: LogLayout, select: Sequence[str] | None) -> dict[str, list[int]]:
@@ -182,3 +190,59 @@ def write_log(
         np.savetxt(fh, data, fmt="%.10g", delimiter=" ")
 
     atomic_write(path, write)
+
+
+def exact_text(values: Array) -> list[str]:
+    """printf formats for the columns of ``values`` (shape (N, m)): per column the shortest of
+    ``%.10g``, ``%.12g``, ``%.15g`` and ``%.17g`` whose text reads back as the same float64, so
+    that a log written with them is read back bit for bit."""
+    out = []
+    for column in np.asarray(values, dtype=float).T:
+        for digits in (10, 12, 15, 17):
+            fmt = f"%.{digits}g"
+            if digits == 17 or np.array_equal(np.char.mod(fmt, column).astype(float), column):
+                out.append(fmt)
+                break
+    return out
+
+
+def _header(log: Log, order: Sequence[str]) -> list[str]:
+    """``timestamp`` and the column names of ``log``'s signals in ``order`` (vectors
+    ``name_0..``)."""
+    header = ["timestamp"]
+    for name in order:
+        arr = log[name]
+        header += [name] if arr.ndim == 1 else [f"{name}_{k}" for k in range(arr.shape[1])]
+    return header
+
+
+def write_log_chunks(
+    path: str | os.PathLike[str], chunks: Iterable[Log], *, order: Sequence[str] | None = None
+) -> int:
+    """Write a log given in chunks in record.py layout (header line, space separated), whole or
+    not at all, each value as the text that reads back as the same float64 (:func:`exact_text`).
+
+    Parameters
+    ----------
+    path : path
+    chunks : iterable of Log
+        In time order, each with the signals of the first (in ``order``, default the first
+        chunk's).
+
+    Returns
+    -------
+    int
+        The rows written.
+    """
+    rows = 0
+    with atomic_open(path) as fh:
+        names: Sequence[str] | None = order
+        for chunk in chunks:
+            if names is None:
+                names = list(chunk.signals)
+            if rows == 0:
+                fh.write(" ".join(_header(chunk, names)) + "\n")
+            data = np.column_stack([chunk.t, *[chunk[n] for n in names]])
+            np.savetxt(fh, data, fmt=exact_text(data), delimiter=" ")
+            rows += len(chunk)
+    return rows

@@ -562,13 +562,29 @@ def judge_robot(robot: Robot, rows: dict[str, Array], found: Findings) -> None:
     _judge_mismatch(robot, rows, match, found)
 
 
+def _payload_misfit(robot: Robot, rows: dict[str, Array], match: RobotMatch) -> str:
+    """The robot's payload named as what does not fit the log, when the robot without it
+    (nor any logged one) fits better; "" otherwise (no payload, or it is not the cause)."""
+    if robot.payload is None or robot.payload.mass <= 0:
+        return ""
+    bare = {k: v for k, v in rows.items() if k != LOADS}
+    with np.errstate(all="ignore"):
+        without = robot_match(robot.with_payload(None), bare)
+    if not without.fits or not without.score < match.score:
+        return ""
+    return (
+        f"the payload {describe(robot.payload)} does not fit this log: {robot.name}'s model "
+        "fits it without that payload; check --payload (or the robot file's payload)"
+    )
+
+
 def _judge_mismatch(
     robot: Robot, rows: dict[str, Array], match: RobotMatch, found: Findings
 ) -> None:
     """The verdict on a log no payload explains: a failure where the model does not follow the
     log, another robot fits far better, or a swap or flip explains it; else warnings."""
     if match.failures or match.off:
-        hint = explain_mismatch(robot, rows, match)
+        hint = _payload_misfit(robot, rows, match) or explain_mismatch(robot, rows, match)
         seen = first(match.failures) or match.off
         if match.failures or hint:
             found.fail(Check.ROBOT, f"{hint}: {seen}" if hint else seen)
@@ -584,8 +600,11 @@ def _judge_mismatch(
         # a current's scale carries the robot file's nominal torque constants (off by up to 2):
         # only a torque's tells one robot from another this finely
         with np.errstate(all="ignore"):
-            best = better_robot(robot, rows, CLOSE_SCORE)
-        if best:
+            misfit = _payload_misfit(robot, rows, match)
+            best = "" if misfit else better_robot(robot, rows, CLOSE_SCORE)
+        if misfit:
+            found.fail(Check.ROBOT, misfit)
+        elif best:
             found.fail(
                 Check.ROBOT,
                 f"{robot.name}'s model is {math.exp(match.score):.2f} times off the "

@@ -39,7 +39,7 @@ CHECKS: dict[Check, str] = {
     Check.CONSTANT: "no measured signal stuck at one value while its joint moves",
     Check.ROBOT: "the robot model's torques and currents match the logged ones (ratio and sign "
     "per joint)",
-    Check.FIT: "identify: the fit explains the identification logs (R^2 >= 0 for every joint that "
+    Check.FIT: "identify: the fit explains the identification logs (R² >= 0 for every joint that "
     "moved)",
 }
 

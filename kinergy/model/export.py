@@ -251,5 +251,5 @@ def reflected_comment(robot: Robot, side: JointSide) -> str:
     return (
         "URDF holds no rotor inertia. Reflected rotor and reducer inertia per joint, the diagonal "
         f"of N^T diag(J_m + J_r) N (gear_ratio^2 (J_m + J_r) for a joint with its own motor), "
-        f"kg m^2: {values} (Pinocchio: model.armature; the MJCF export's armature)."
+        f"kg m²: {values} (Pinocchio: model.armature; the MJCF export's armature)."
     )

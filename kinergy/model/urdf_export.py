@@ -151,7 +151,7 @@ def _comments(robot: Robot, side: JointSide, source: str) -> tuple[list[str], li
         "viscous friction, gear ratios; <kinergy:robot> (namespace "
         f"{NAMESPACE}, ignored by other tools) holds the robot file itself, as JSON; kinergy "
         "robot import-urdf reads it back and checks the standard elements against it.",
-        f"Gravity {numbers(robot.gravity)} m/s^2 in the base frame (URDF has no gravity; set "
+        f"Gravity {numbers(robot.gravity)} m/s² in the base frame (URDF has no gravity; set "
         "your tool's).",
         reflected_comment(robot, side),
     ]

@@ -351,7 +351,7 @@ def _transmission(element: ET.Element, where: str) -> tuple[str, Actuation] | st
     if ratio == 0.0:
         raise _fail(twhere, "its mechanical reduction is 0 (it must be non-zero)", Code.NUMBER)
     if rotor is not None and rotor < 0.0:
-        raise _fail(twhere, f"rotor inertia {rotor:g} kg m^2 is negative", Code.NUMBER)
+        raise _fail(twhere, f"rotor inertia {rotor:g} kg m² is negative", Code.NUMBER)
     return str(joints[0].get("name")), Actuation(ratio, rotor, name)
 
 

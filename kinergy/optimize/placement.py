@@ -26,7 +26,6 @@ import enum
 import math
 import multiprocessing
 import os
-from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, replace
 from typing import Any
@@ -34,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from kinergy.errors import KinergyError
+from kinergy.messages import Say, silent
 from kinergy.model.robot import Robot
 from kinergy.optimize.levers import CYCLE_TOLERANCE
 from kinergy.optimize.options import ProgramOptions
@@ -330,7 +330,7 @@ def place_program(
     grid: PlacementGrid,
     options: ProgramOptions | None = None,
     *,
-    progress: Callable[[str], None] | None = None,
+    progress: Say | None = None,
     workers: int | None = None,
 ) -> PlacementSearch:
     """Every placement of ``grid`` and today's, each checked and optimised (module docstring).
@@ -344,8 +344,8 @@ def place_program(
     options : ProgramOptions, optional
         The levers (as :func:`kinergy.optimize.programs.optimize_program`); the cycle time and
         caps default to today's program's own and hold for every candidate.
-    progress : callable, optional
-        Called with a line as each candidate is done.
+    progress : Say, optional
+        Told each step, and as each candidate is done how many of them are.
     workers : int, optional
         Processes the candidates are optimised on (default: one per core). Each candidate's
         optimisation is independent of the others and of the order they run in: the same
@@ -357,7 +357,7 @@ def place_program(
         Today's program cannot run; no candidate reaches every pose within every limit (one line
         with the commonest reason).
     """
-    say = progress if progress is not None else (lambda _: None)
+    say = progress if progress is not None else silent
     options = ProgramOptions() if options is None else options
     placements = grid.placements()
     say(f"checking the reach of {len(placements)} placements")
@@ -409,7 +409,7 @@ def _optimise_all(
     robot: Robot,
     todo: list[tuple[int, BasePlacement, RobotProgram]],
     options: ProgramOptions,
-    say: Callable[[str], None],
+    say: Say,
     workers: int | None,
 ) -> dict[int, Candidate]:
     """Every reachable candidate optimised (:func:`_optimised`), on ``workers`` processes (None:
@@ -419,7 +419,7 @@ def _optimise_all(
     out: dict[int, Candidate] = {}
     if n <= 1:
         for done, (i, placement, moved) in enumerate(todo):
-            say(f"placement {done + 1}/{count}: {placement.label()}")
+            say(f"placement {placement.label()}", done=done + 1, total=count)
             out[i] = _optimised(robot, moved, placement, options)
         return out
     say(f"optimising {count} placements on {n} processes")
@@ -432,7 +432,7 @@ def _optimise_all(
         for done, future in enumerate(as_completed(futures)):
             i = futures[future]
             out[i] = future.result()
-            say(f"placement {done + 1}/{count} done: {out[i].placement.label()}")
+            say(f"placement {out[i].placement.label()}", done=done + 1, total=count)
     return out
 
 

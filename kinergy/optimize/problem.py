@@ -174,7 +174,7 @@ def fastest_acceleration(
         raise KinergyError(
             f"{f'move {k + 1}' if where is None else where(int(k))}: the joint torques exceed "
             f"their limits even at "
-            f"{coarse[0, k]:g} rad/s^2 (a static overload: the payload or the pose)"
+            f"{coarse[0, k]:g} rad/s² (a static overload: the payload or the pose)"
         )
     cols = np.arange(travel.size)
     best = coarse[np.maximum(idx, 0), cols]

@@ -6,7 +6,7 @@ safe to build in scripts, servers and tests and are freed like any other object.
 writes one as a PNG atomically.
 
 ==========================  ==================================================================
-:func:`time_series`         measured vs predicted per joint over time, R² in each title
+:func:`time_series`         measured vs predicted per joint over time, R² in each title, residuals
                             (UR5e Figs 8-9 for torques, Figs 11-12 for currents)
 :func:`error_boxplot`       box plots of the errors per joint, one panel per data set
                             (UR5e Figs 10 and 13)
@@ -73,6 +73,7 @@ _LEGEND = 9
 
 _MEASURED: dict[str, Any] = {"color": "tab:green", "linewidth": 1.6, "alpha": 0.85}
 _PREDICTED: dict[str, Any] = {"color": "tab:orange", "linewidth": 1.0, "linestyle": "--"}
+_RESIDUAL: dict[str, Any] = {"color": "tab:purple", "linewidth": 0.8}
 
 # Colours of the energy parts, so a part has the same colour in every figure.
 _PART_COLOURS = {
@@ -192,24 +193,23 @@ def _joint_grid(fig: Figure, n: int) -> list[Axes]:
 
 
 def _residual_grid(fig: Figure, n: int) -> tuple[list[Axes], list[Axes]]:
-    """``n`` joint panels, each with a residual panel a third its height below it, on the grid
-    of :func:`_joint_grid` (every panel shares the x axis): the panels and their residuals."""
+    """``n`` joint panels on :func:`_joint_grid`'s grid, each with a residual panel a third of
+    its height below it sharing its time axis: the joint panels first in ``fig.axes`` (joint
+    order), then the residual panels; the time axis is labelled on each column's last one."""
     ncols = _ncols(n)
     nrows = math.ceil(n / ncols)
-    spec = fig.add_gridspec(2 * nrows, ncols, height_ratios=[3.0, 1.0] * nrows)
+    outer = fig.add_gridspec(nrows, ncols)
+    cells = [outer[j // ncols, j % ncols].subgridspec(2, 1, height_ratios=[3, 1]) for j in range(n)]
     axes: list[Axes] = []
-    below: list[Axes] = []
-    for j in range(n):
-        r, c = divmod(j, ncols)
-        top = fig.add_subplot(spec[2 * r, c], sharex=axes[0] if axes else None)
-        bottom = fig.add_subplot(spec[2 * r + 1, c], sharex=top)
-        top.xaxis.set_tick_params(labelbottom=False)
-        if j + ncols < n:  # a panel below in the same column carries the time axis
-            bottom.xaxis.set_tick_params(labelbottom=False)
-        else:
-            bottom.set_xlabel("Time [s]", fontsize=_LABEL)
-        axes.append(top)
-        below.append(bottom)
+    for cell in cells:
+        axes.append(fig.add_subplot(cell[0], sharex=axes[0] if axes else None))
+    below = [fig.add_subplot(cell[1], sharex=ax) for cell, ax in zip(cells, axes, strict=True)]
+    for j, (ax, res) in enumerate(zip(axes, below, strict=True)):
+        ax.xaxis.set_tick_params(labelbottom=False)
+        last = j + ncols >= n
+        res.xaxis.set_tick_params(labelbottom=last)
+        if last:
+            res.set_xlabel("Time [s]", fontsize=_LABEL)
     return axes, below
 
 
@@ -234,16 +234,17 @@ def time_series(
     unit: str,
     measured_label: str = "measured",
     predicted_label: str = "model",
-    residual: bool = False,
 ) -> Figure:
-    """Measured against predicted signal per joint over time, with R² per joint (and, with
-    ``residual``, each joint's residual ``measured - predicted`` in a panel below it).
+    """Measured against predicted signal per joint over time, with R² per joint and each
+    joint's residual ``measured - predicted`` in a panel below it.
 
     One panel per joint (a 3 x 2 grid for six joints) sharing the time axis, the measured signal
     solid and the prediction dashed on top of it, as in UR5e Figs 8-9 (``target_moment`` against
     the inverse dynamic model, eq 2) and Figs 11-12 (measured against estimated motor current,
     eq 18). Each title carries the joint name and the coefficient of determination
-    ``R² = 1 - SS_res / SS_tot`` of that joint (UR5e Tables V and VII), to four decimals.
+    ``R² = 1 - SS_res / SS_tot`` of that joint (UR5e Tables V and VII), to four decimals. Below
+    each joint's panel, on the same time axis, its residual (measured - predicted): where the
+    two lines lie on top of each other, the residual shows what they hide.
 
     Parameters
     ----------
@@ -258,13 +259,11 @@ def time_series(
         Its unit, e.g. ``"N m"`` or ``"A"``.
     measured_label, predicted_label : str
         Legend entries of the two signals.
-    residual : bool
-        Add a residual panel (``measured - predicted``, in ``unit``) below each joint's.
 
     Returns
     -------
     matplotlib.figure.Figure
-        ``n`` axes in joint order (with ``residual``, each followed by its residual's).
+        ``2 n`` axes: the ``n`` joint panels in joint order, then their ``n`` residual panels.
 
     Raises
     ------
@@ -276,30 +275,26 @@ def time_series(
     n = len(names)
     r2 = r_squared(y, p)
 
-    width, height = _grid_size(n)
-    fig = _figure(width, height * (4.0 / 3.0 if residual else 1.0))
-    if residual:
-        axes, below = _residual_grid(fig, n)
-        for j, ax in enumerate(below):
-            ax.plot(ts, y[:, j] - p[:, j], color="tab:red", linewidth=0.6)
-            ax.axhline(0.0, color="black", linewidth=0.5)
-            if j % _ncols(n) == 0:
-                ax.set_ylabel(f"residual [{unit}]", fontsize=_LABEL)
-            _style(ax)
-    else:
-        axes = _joint_grid(fig, n)
-    for j, ax in enumerate(axes):
+    fig = _figure(*_grid_size(n))
+    axes, below = _residual_grid(fig, n)
+    for j, (ax, res) in enumerate(zip(axes, below, strict=True)):
         ax.plot(ts, y[:, j], label=measured_label, **_MEASURED)
         ax.plot(ts, p[:, j], label=predicted_label, **_PREDICTED)
+        res.plot(ts, y[:, j] - p[:, j], label=f"{measured_label} - {predicted_label}", **_RESIDUAL)
+        res.axhline(0.0, color="0.5", linewidth=0.6)
         score = "n/a" if np.isnan(r2[j]) else f"{r2[j]:.4f}"
         ax.set_title(f"{names[j]}  (R² = {score})", fontsize=_TITLE)
         if j % _ncols(n) == 0:
             ax.set_ylabel(f"{quantity} [{unit}]", fontsize=_LABEL)
+            res.set_ylabel(f"residual [{unit}]", fontsize=_TICK)
         ax.set_xlim(ts[0], ts[-1])
         _style(ax)
+        _style(res)
     handles, labels = axes[0].get_legend_handles_labels()
+    more, more_labels = below[0].get_legend_handles_labels()
+    handles, labels = [*handles, *more], [*labels, *more_labels]
     fig.legend(
-        handles, labels, loc="outside lower center", ncols=2, fontsize=_LEGEND, frameon=False
+        handles, labels, loc="outside lower center", ncols=3, fontsize=_LEGEND, frameon=False
     )
     fig.suptitle(f"{quantity}: {measured_label} vs {predicted_label}", fontsize=_SUPTITLE)
     return fig
@@ -664,7 +659,7 @@ def timing_pareto(result: Any) -> Figure:
     x = np.array([p.cycle_time for p in front])
     own, opt = result.program.result, result.optimized.result
     marked = {"program as written": (own.cycle_time, own.e_supply)}
-    marked["optimized"] = (opt.cycle_time, opt.e_supply)
+    marked["optimised"] = (opt.cycle_time, opt.e_supply)
     fig = pareto(x, np.array([p.optimized for p in front]), marked=marked)
     ax = fig.axes[0]
     for points in ax.collections:

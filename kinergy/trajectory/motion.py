@@ -48,7 +48,7 @@ def sample_times(duration: float, dt: float, longest: str = "") -> Array:
             f"the program lasts {duration:.4g} s{what}: sampled every {dt:g} s it would take "
             f"{steps:.4g} samples, more than the {MAX_SAMPLES:,} kinergy plans "
             f"({MAX_SAMPLES * dt / 60:.0f} min); a speed or acceleration far too small? "
-            "(rad/s and rad/s^2, m/s and m/s^2 for a linear move)"
+            "(rad/s and rad/s², m/s and m/s² for a linear move)"
         )
     return np.arange(int(steps) + 1, dtype=float) * dt
 

@@ -35,7 +35,7 @@ from kinergy.trajectory.program_motion import payload_index, program_motion
 from kinergy.trajectory.program_path import program_path
 from kinergy.trajectory.programs import paper_trajectory
 from kinergy.trajectory.robot_program import Move
-from kinergy.workflows.twin import is_builtin
+from kinergy.workflows.twin import check_source, is_builtin
 
 __all__ = [
     "ENERGY_ROWS",
@@ -256,6 +256,7 @@ def energy_of_log(
     reading = reading or LogReading()
     robot = reading.loaded(robot)
     inputs.notes.extend(standing_draw_notes(robot))
+    check_source(path)
     if is_builtin(path) or os.fspath(path).endswith(".script"):
         if is_builtin(path):  # test-a, test-b: the motion as planned for the robot
             motion = paper_trajectory(robot, os.fspath(path))

@@ -43,7 +43,7 @@ from kinergy.jsonable import to_jsonable
 from kinergy.logs.checks import Check
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs, LogReading
-from kinergy.messages import coded
+from kinergy.messages import Say, coded, silent
 from kinergy.model import Robot, save_robot
 from kinergy.model.robot import Identified, InputRecord, Source
 from kinergy.predict import drive_state
@@ -156,7 +156,7 @@ def unsupported_fit(result: IdentificationResult, share: float = 1.0) -> str:
             continue
         for k, m in enumerate(metrics):
             if moved[k] and m.r2 < 0:
-                worst.append(f"{result.robot.joints[k].name} {unit} R^2 {m.r2:.2f}")
+                worst.append(f"{result.robot.joints[k].name} {unit} R² {m.r2:.2f}")
     if worst and share < MIN_MOTION_SHARE:
         return (
             f"too little motion to identify from: the joints move on {100 * share:.0f} % of the "
@@ -196,9 +196,11 @@ def identify_logs(
     reading: LogReading | None = None,
     options: IdentifyOptions | None = None,
     rows: int = CHUNK_ROWS,
+    progress: Say = silent,
 ) -> IdentificationResult:
     """Read (through the checks), prepare and identify ``logs`` (files or logs in memory) and
-    write the model to ``out`` when given.
+    write the model to ``out`` when given; ``progress`` is told each log read (of all) and
+    when the identification starts.
 
     ``reading`` says how to read the logs (:class:`~kinergy.logs.reading.LogReading`),
     ``options`` what to identify. The logs are read in chunks of ``rows`` samples and never held
@@ -214,7 +216,11 @@ def identify_logs(
     """
     reading = reading or LogReading()
     options = options or IdentifyOptions()
-    with chunked_logs(logs, robot, reading, rows=max(rows, 2)) as (segments, inputs):
+    with chunked_logs(logs, robot, reading, rows=max(rows, 2), progress=progress) as (
+        segments,
+        inputs,
+    ):
+        progress(f"identifying ({options.method.value} method)")
         start = one_payload(reading.loaded(robot), segments, inputs.notes)
         chunks = LogChunks(segments, rows, check=_checks)
         try:
@@ -331,7 +337,7 @@ def measured_electrics(result: IdentificationResult, logs: LogChunks) -> Identif
             robot = dataclasses.replace(robot, uncertainty=errors)
         sources["supply"] = Source(
             "identified",
-            f"kinergy identify: standing draw {draw.power:.4g} +- {draw.std:.2g} W (standard "
+            f"kinergy identify: standing draw {draw.power:.4g} ± {draw.std:.2g} W (standard "
             "error) from actual_robot_voltage x actual_robot_current less the motors' draw",
         )
         notes.append(

@@ -28,6 +28,7 @@ from kinergy.logs.prepare import (
 )
 from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.logs.samples import used_bounds
+from kinergy.messages import Say, silent
 from kinergy.model.robot import Robot
 from kinergy.trajectory.motion import Motion, MotionSource
 from kinergy.trajectory.program_motion import program_motion
@@ -95,6 +96,27 @@ def prepared_logs(
         return [s.whole() for s in segments], inputs
 
 
+def _resampled_notes(resampled: Sequence[tuple[str, int, int, float]]) -> list[str]:
+    """The note on a log's segments resampled onto a regular grid (name, rows, samples, step
+    in s each): one note for all of a log's segments."""
+    if len(resampled) == 1:
+        name, rows, samples, step = resampled[0]
+        return [
+            f"{name}: irregular time stamps: its {rows} rows resampled to {samples} samples "
+            f"{step * 1e3:.4g} ms apart (the counts identify and validate give)"
+        ]
+    if not resampled:
+        return []
+    each = ", ".join(
+        f"{name} {rows} to {samples} ({step * 1e3:.4g} ms)"
+        for name, rows, samples, step in resampled
+    )
+    return [
+        f"irregular time stamps: segments resampled onto a regular grid, rows to samples (the "
+        f"counts identify and validate give): {each}"
+    ]
+
+
 @contextlib.contextmanager
 def chunked_logs(
     paths: Sequence[str | os.PathLike[str] | Log],
@@ -102,30 +124,32 @@ def chunked_logs(
     reading: LogReading,
     *,
     rows: int = CHUNK_ROWS,
+    progress: Say = silent,
 ) -> Iterator[tuple[list[PreparedSegment], InputLogs]]:
     """Every log read once, through the checks (:class:`~kinergy.logs.reading.CheckedLog`, in
     chunks of ``rows``), into a temporary spill removed on leaving the context, and its segments
     prepared (:func:`kinergy.logs.prepare.prepare_segment`): each yields its samples in chunks of
-    any size, equal to the whole segment's preparation."""
+    any size, equal to the whole segment's preparation. ``progress`` is told each log read, of
+    all."""
     inputs = InputLogs()
     with contextlib.ExitStack() as stack:
         segments: list[PreparedSegment] = []
-        for path in paths:
+        for k, path in enumerate(paths):
+            name = path.path if isinstance(path, Log) else os.fspath(path)
+            progress(f"reading and preparing {os.path.basename(name)}", done=k, total=len(paths))
             checked = CheckedLog(path, robot, reading, select=SPILLED, rows=rows)
             spill = spill_log(checked)
             stack.callback(spill.close)
             inputs.add(checked)
             cuts = [start for start, _ in spill.loads[1:]]
+            resampled: list[tuple[str, int, int, float]] = []
             for name, ab in _segments(checked.path, spill.state, inputs.notes, cuts):
                 prepared = prepare_segment(spill, ab, name, robot.n, reading.cutoff)
                 if prepared.grid is not None:
                     rows = prepared.rows.stop - prepared.rows.start
-                    inputs.notes.append(
-                        f"{name}: irregular time stamps: its {rows} rows resampled to "
-                        f"{prepared.grid[1]} samples {prepared.grid[0] * 1e3:.4g} ms apart (the "
-                        "counts identify and validate give)"
-                    )
+                    resampled.append((name, rows, prepared.grid[1], prepared.grid[0]))
                 segments.append(prepared)
+            inputs.notes += _resampled_notes(resampled)
         yield segments, inputs
 
 

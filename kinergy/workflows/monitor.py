@@ -46,6 +46,7 @@ def monitor_cycles(
     reading: LogReading | None = None,
     on_cycle: Callable[[CycleEnergy], None] | None = None,
     status: Callable[[str], None] | None = None,
+    waiting: Callable[[float, int, float | None], None] | None = None,
 ) -> MonitorRun:
     """Follow the controller at ``address`` (``HOST[:PORT]``) until ``duration`` s of
     controller time, SIGINT or SIGTERM; ``on_cycle`` receives each cycle as it ends.
@@ -54,6 +55,10 @@ def monitor_cycles(
     before the first cycle is reported their verdict is taken on what has been seen (a check
     that fails, unless in ``reading.accept``, stops the monitor with its line), and again at the
     end.
+
+    Until the first cycle ends, ``waiting(seconds, samples, period)`` is told once a second
+    (wall clock) how much of the stream has come (controller time, s; samples) and the period
+    found so far (s; None before it is).
 
     Returns the period and the cycles.
     """
@@ -74,7 +79,8 @@ def monitor_cycles(
         pending: list[Sequence[float]] = []
         judged = False
         first: float | None = None
-        updated = time.monotonic()
+        last, samples = 0.0, 0
+        updated = told = time.monotonic()
 
         def report(cycles: list[CycleEnergy]) -> None:
             nonlocal judged, pending
@@ -99,9 +105,13 @@ def monitor_cycles(
                         break
                     tracker.add(item)
                     pending.append(item)
+                    last, samples = float(item[0]) - first, samples + 1
                 if time.monotonic() - updated >= 0.25 or item is None:
                     report(tracker.update())
                     updated = time.monotonic()
+                if waiting is not None and not judged and updated - told >= 1.0:
+                    waiting(last, samples, tracker.period)
+                    told = updated
         finally:
             stream.close()
     report(tracker.update())

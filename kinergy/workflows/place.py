@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -23,6 +22,7 @@ from typing import Any
 from kinergy.files import all_or_none, check_outputs
 from kinergy.io.urscript import write_script
 from kinergy.io.urscript_reader import parse_program, read_program
+from kinergy.messages import Say
 from kinergy.model.robot import Robot
 from kinergy.optimize.options import ProgramOptions
 from kinergy.optimize.placement import Candidate, PlacementGrid, PlacementSearch, place_program
@@ -145,7 +145,7 @@ def run_place(
     options: ProgramOptions | None = None,
     urscript: str | os.PathLike[str] | None = None,
     plot: str | os.PathLike[str] | None = None,
-    progress: Callable[[str], None] | None = None,
+    progress: Say | None = None,
 ) -> PlaceRun:
     """``kinergy place``: read, search the placements, read the best back, write.
 

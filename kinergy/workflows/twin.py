@@ -30,6 +30,7 @@ __all__ = [
     "SimulateOptions",
     "Simulation",
     "builtin_log",
+    "check_source",
     "is_builtin",
     "run_twin",
     "twin_truth",
@@ -45,6 +46,23 @@ def twin_truth(robot: Robot, mismatch: Mismatch, seed: int) -> Robot:
 def is_builtin(name: object) -> TypeGuard[str]:
     """Whether ``name`` names a built-in motion (``test-a``, ``test-b``) rather than a file."""
     return isinstance(name, str) and name in TEST_TRAJECTORIES and not os.path.exists(name)
+
+
+def check_source(name: str | os.PathLike[str] | Log) -> None:
+    """Refuse a log or motion named ``name`` that is neither a file or folder nor a built-in
+    motion, listing the built-in motions (``test-c`` is a slip for ``test-a`` or ``test-b``).
+
+    Raises
+    ------
+    KinergyError
+        ``test-c: no such file or folder, nor a built-in motion (test-a, test-b)``.
+    """
+    if isinstance(name, Log) or is_builtin(name) or os.path.lexists(name):
+        return
+    raise KinergyError(
+        f"{os.fspath(name)}: no such file or folder, nor a built-in motion "
+        f"({', '.join(TEST_TRAJECTORIES)})"
+    )
 
 
 def builtin_log(robot: Robot, name: str, seed: int = 0) -> Log:

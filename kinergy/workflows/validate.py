@@ -21,7 +21,7 @@ from kinergy.logs.reading import InputLogs, LogReading
 from kinergy.model.robot import Robot
 from kinergy.report.plots import error_boxplot, save, time_series
 from kinergy.workflows.logs import MIN_SEGMENT, chunked_logs
-from kinergy.workflows.twin import builtin_log, is_builtin
+from kinergy.workflows.twin import builtin_log, check_source, is_builtin
 
 __all__ = ["identified_from", "validate_logs", "write_validation_plots"]
 
@@ -51,6 +51,8 @@ def validate_logs(
     log, moving and holding apart (:func:`~kinergy.identification.validation.validation_report`);
     with ``plots``, also write the measured-against-predicted figures to that folder. A log the
     model was identified from is named in a warning."""
+    for log in logs:
+        check_source(log)
     sources = [builtin_log(robot, str(log)) if is_builtin(log) else log for log in logs]
     reading = reading or LogReading()
     robot = reading.loaded(robot)
@@ -146,7 +148,6 @@ def _plots(robot: Robot, logs: Sequence[LogValidation], out: Path) -> None:
                 unit=unit,
                 measured_label=label,
                 predicted_label="model",
-                residual=True,
             )
             save(fig, out / f"{stem}_{key}.png")
             errors[key][stem] = series.measured - series.predicted
