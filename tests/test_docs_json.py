@@ -276,7 +276,8 @@ def _twin_logs(folder: Path) -> dict[str, Path]:
 
 
 def _robot_file(folder: Path) -> list[str]:
-    """``robot show --json`` of a robot file that gives the optional winding resistances."""
+    """``robot show --json`` of a robot file that gives the optional winding resistances and
+    motor-side torque sensors (what the twin's ``target_moment`` read as measured torques is)."""
     import tomli_w
 
     from kinergy.model.toml import robot_to_dict
@@ -284,6 +285,7 @@ def _robot_file(folder: Path) -> list[str]:
     data = robot_to_dict(load_robot("ur5e"))
     for joint in data["joints"]:
         joint["drive"]["winding_resistance"] = 0.5  # ohm
+        joint["torque_sensor"] = {"side": "motor", "offset": 0.0}
     path = folder / "with-resistance.toml"
     path.write_text(tomli_w.dumps(data), encoding="utf-8")
     return ["robot", "show", str(path), "--json"]
@@ -320,13 +322,17 @@ def documents(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[tuple[
                 "--out", str(folder / "auto.toml"), "--json",
             ],
             "full, joint torques, wls": [
-                "identify", logs["torque"], "--robot", "ur5e", "--method", "full",
+                "identify", logs["torque"], "--robot", str(folder / "with-resistance.toml"),
+                "--method", "full",
                 "--target", "torque", "--solver", "wls", "--accept", "robot",
                 "--out", str(folder / "full.toml"), "--json",
             ],
         },
         "json-validate": {
-            "joint torques": ["validate", "ur5e", logs["torque"], "--accept", "robot", "--json"],
+            "joint torques": [
+                "validate", str(folder / "with-resistance.toml"), logs["torque"], "--accept",
+                "robot", "--json",
+            ],
         },
         "json-energy": {
             "a gap": ["energy", "ur5e", logs["gap"], "--json"],

@@ -148,7 +148,11 @@ def unsupported_fit(result: IdentificationResult, share: float = 1.0) -> str:
     moved = [getattr(j, "identified", True) for j in result.joints]
     worst = []
     signals = [("torque", "target_moment"), ("current", "actual_current")]
-    if getattr(result.fit, "target", "") == Target.TORQUE.value:  # the full method's target
+    fit = result.fit  # the full method against measured torques, its friction from them
+    if (
+        getattr(fit, "target", "") == Target.TORQUE.value
+        and getattr(fit, "drives", "") != "currents"
+    ):
         signals.append(("joint_torque", "measured joint torque"))
     for key, unit in signals:
         metrics = getattr(result.fit, key)
