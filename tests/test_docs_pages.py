@@ -123,3 +123,28 @@ def test_nothing_points_outside_the_repository(path: Path) -> None:
     text = path.read_text(encoding="utf-8")
     for pattern in (r"DESIGN\.md", r"\.\./shared", r"datasets/", r"/work/", r"/tmp/pytest"):
         assert not re.search(pattern, text), f"{path.name} points outside the repository: {pattern}"
+
+
+def test_the_built_cli_page_has_whole_summaries_and_no_sentinel(tmp_path: Path) -> None:
+    """The command-line reference as the site shows it (docs/hooks/cli_page.py): no click
+    ``Sentinel.UNSET`` in the Default column, and every command's summary a whole sentence."""
+    pytest.importorskip("mkdocs_click")
+    import os
+    import subprocess
+    import sys
+
+    site = tmp_path / "site"
+    build = subprocess.run(
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "--quiet", "-d", str(site)],
+        cwd=ROOT,
+        env={**os.environ, "NO_MKDOCS_2_WARNING": "1"},
+        capture_output=True,
+        text=True,
+    )
+    assert build.returncode == 0, build.stderr
+    page = (site / "cli" / "index.html").read_text(encoding="utf-8")
+    assert "Sentinel" not in page
+    summaries = re.findall(r'<li><em><a href="#kinergy[^"]*">[^<]+</a></em>: ([^<]*)</li>', page)
+    assert len(summaries) >= 20
+    cut = [s for s in summaries if not s.rstrip().endswith((".", ".)"))]
+    assert not cut, cut
