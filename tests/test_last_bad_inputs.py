@@ -47,8 +47,9 @@ def test_a_task_too_slow_to_plan_is_one_line(
     assert main(["optimize", "ur5e", str(task)]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err
-    assert "slow: the program lasts" in err and f"at v = {speed:.4g} rad/s" in err
-    assert f"more than the {MAX_SAMPLES:,} kinergy plans" in err
+    # the file, line and move, the speed, the time it would take
+    assert "slow.toml:8: move[2]: " in err and f"at v={speed:.4g} and a=2 the move takes" in err
+    assert "more than an hour" in err
 
 
 def test_a_script_too_slow_to_plan_is_one_line(
@@ -61,7 +62,8 @@ def test_a_script_too_slow_to_plan_is_one_line(
     )
     assert main(["energy", "ur5e", str(script)]) == 1
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "the program lasts 1e+09 s (move 2 alone" in err
+    assert err.count("\n") == 1 and "slow.script:3: movej(" in err
+    assert "at v=1e-09 and a=2 the move takes 1e+09 s, more than an hour" in err
 
 
 def test_a_plan_at_the_limit_is_still_planned() -> None:
