@@ -219,12 +219,12 @@ def test_negative_torque_fit_is_refused_then_accepted(
     assert main(args) == 1 and not out.exists()
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1, lines
-    assert "(wrist_3 measured joint torque R^2 -0.90)" in lines[0], lines[0]
+    assert "(wrist_3 measured joint torque R² -0.90)" in lines[0], lines[0]
     assert "no model written (if the logs are right, --accept fit)" in lines[0]
     assert main([*args, "--accept", "fit", "--json"]) == 0 and out.exists()
     report = json.loads(capsys.readouterr().out)
     assert report["fit"]["joint_torque"][5]["r2"] == -0.9
-    assert any("wrist_3 measured joint torque R^2 -0.90" in a for a in report["accepted"])
+    assert any("wrist_3 measured joint torque R² -0.90" in a for a in report["accepted"])
 
 
 def test_validate_plots_draw_measured_torque_with_residuals(

@@ -121,8 +121,16 @@ def test_saving_interval_from_the_same_parameter_draws(ur5e):
     objective = found.program.result  # the runs' scoring objective is the optimiser's
 
     def saving(moved: kinergy.Robot) -> float:
+        import dataclasses
+
+        def carried(path):  # the path's drive model is built once, for the robot it was made for
+            robots = tuple(
+                moved if p is robot.payload else moved.with_payload(p) for p in path.payloads
+            )
+            return dataclasses.replace(path, robots=robots)
+
         runs = [
-            simulate_path(moved, r.path, standby=moved.standby_power)
+            simulate_path(moved, carried(r.path), standby=moved.standby_power)
             for r in (found.program, found.optimized)
         ]
         return 1.0 - runs[1].result.e_supply / runs[0].result.e_supply

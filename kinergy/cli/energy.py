@@ -79,7 +79,7 @@ def _interval_lines(result: api.LogEnergy) -> list[str]:
         return [f"95 % interval: none: {NO_UNCERTAINTY}."]
     drawn, motors = iv.drawn, iv.motors
     total = result.supply.drawn
-    share = f" (+-{100 * drawn.half_width / total:.1f} %)" if total else ""
+    share = f" (±{100 * drawn.half_width / total:.1f} %)" if total else ""
     joints = ", ".join(
         f"{name} {e.low:.1f}..{e.high:.1f}"
         for name, e in zip(result.joints, iv.e_elec, strict=True)
