@@ -51,13 +51,13 @@ class TimeWindow:
                 raise KinergyError(f"{flag} {value}: not a finite number of seconds")
         if self.start is not None and self.stop is not None and not self.start < self.stop:
             raise KinergyError(
-                f"--from {self.start:g} s is not before --to {self.stop:g} s: the window holds "
+                f"--from {self.start:.12g} s is not before --to {self.stop:.12g} s: the window holds "
                 "no time"
             )
 
     def __str__(self) -> str:
-        parts = [f"--from {self.start:g} s" if self.start is not None else ""]
-        parts += [f"--to {self.stop:g} s" if self.stop is not None else ""]
+        parts = [f"--from {self.start:.12g} s" if self.start is not None else ""]
+        parts += [f"--to {self.stop:.12g} s" if self.stop is not None else ""]
         return " ".join(p for p in parts if p)
 
     def keep(self, t: Array) -> NDArray[np.bool_]:
@@ -106,7 +106,7 @@ class WindowCut:
             start = self.window.start
             if start is not None and start < self.first - self._slack():
                 raise KinergyError(
-                    f"{self.path}: --from {start:g} s is before the log's first sample at "
+                    f"{self.path}: --from {start:.12g} s is before the log's first sample at "
                     f"{self.first:.10g} s (seconds on the log's own time axis)"
                 )
         self.last = float(chunk.t[-1])
@@ -136,7 +136,7 @@ class WindowCut:
         stop = self.window.stop
         if stop is not None and not self.done and stop > self.last + self._slack():
             raise KinergyError(
-                f"{self.path}: --to {stop:g} s is after the log's last sample ({span})"
+                f"{self.path}: --to {stop:.12g} s is after the log's last sample ({span})"
             )
         if self.kept < 2:
             raise KinergyError(
