@@ -4,6 +4,7 @@ and the coverage on the realistic twin (issue 36)."""
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -154,3 +155,52 @@ def test_uncertainty_survives_the_urdf_export(ur5e, tmp_path):
     back = read_robot_file(path)
     assert back.uncertainty is not None
     np.testing.assert_allclose(back.uncertainty.modes, robot.uncertainty.modes)
+
+
+def test_energy_intervals_cover_the_realistic_twin(ur5e, tmp_path):
+    """Coverage on a fast seeded case (issue 36; ``benchmarks/bench_uncertainty.py twin`` is
+    the full one): two realistic true arms, each identified (``--friction auto``) on its logs of
+    test A and of a seeded 20 s Fourier excitation, predict the supply energy of test B and of
+    two UR5e programs they never saw. The 95 % intervals hold at least 5 of the 6 logged
+    supplies, are under 5 % of the energy wide, and their standard deviation is the errors'
+    own size (RMS of error / std between 0.4 and 2: neither a zero-width nor a blanket
+    interval); the calibrated t quantile takes the calibration blocks' degrees of freedom."""
+    from kinergy.experiments.excitation_design import random_feasible
+    from kinergy.experiments.excitation_problem import excitation_problem
+    from kinergy.io.rtde import write_log
+    from kinergy.io.urscript_reader import read_program
+    from kinergy.trajectory.program_motion import program_motion
+    from kinergy.trajectory.program_path import program_path
+    from kinergy.twin import TwinSettings, realistic_truth, simulate
+
+    programs = Path(__file__).resolve().parents[1] / "benchmarks" / "programs"
+    unseen = [paper_trajectory(ur5e, "test-b")]
+    for name in ("ur5e_conveyor_to_tray", "ur5e_sorting"):
+        path = program_path(ur5e, read_program(programs / f"{name}.script"))
+        unseen.append(program_motion(ur5e, path)[0])
+    problem = excitation_problem(ur5e, harmonics=5, period=20.0)
+    held, z, widths = 0, [], []
+    for seed in (0, 1):
+        truth = realistic_truth(ur5e, seed)
+        excitation = random_feasible(problem, np.random.default_rng(seed))[0].motion
+        logs = [
+            simulate(truth, m, TwinSettings.realistic(1000 * seed + k))
+            for k, m in enumerate((paper_trajectory(ur5e, "test-a"), excitation))
+        ]
+        model = kinergy.identify(logs, ur5e, kinergy.IdentifyOptions(friction="auto")).robot
+        u = model.uncertainty
+        assert u is not None and u.calibration >= 1.0
+        if u.calibration > 1.0:
+            assert u.dof > 9 and f"{u.dof} degrees of freedom" in u.method
+        for k, motion in enumerate(unseen):
+            log = simulate(truth, motion, TwinSettings.realistic(1000 * seed + 10 + k))
+            path = tmp_path / f"{seed}-{k}.csv"
+            write_log(path, log.t, log.signals)
+            figures = kinergy.energy(model, path)
+            measured, iv = figures.measured.drawn, figures.intervals.drawn
+            held += iv.holds(measured)
+            z.append((figures.supply.drawn - measured) / iv.std)
+            widths.append(iv.half_width / measured)
+    assert held >= 5
+    assert max(widths) < 0.05
+    assert 0.4 < np.sqrt(np.mean(np.square(z))) < 2.0

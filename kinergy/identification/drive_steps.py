@@ -733,7 +733,7 @@ def current_step(
         fit, choice, blocks = fits[m]
         held.append(float(fit.params.get("holding", 0.0)))
         chosen.append(choice)
-        jackknife = replicates(fit, blocks, joint.drive.torque_constant)
+        jackknife = replicates(fit, blocks, joint.drive.torque_constant) if options.errors else None
         new, stat = _apply_current_fit(m, joint, fit, said, jackknife)
         joints.append(new)
         stats.append(stat)

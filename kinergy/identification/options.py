@@ -119,10 +119,14 @@ class CurrentOptions:
         cross-validated current RMS) or None (each joint's own family); given by name, it is
         resolved here (:func:`friction_option`).
     hold : Hold
+    errors : bool
+        Whether the fitted parameters' errors are found (the delete-one-block jackknife of
+        :mod:`kinergy.identification.uncertainty`); False: the model carries none.
     """
 
     friction: FrictionOption = None
     hold: Hold = Hold.SEARCH
+    errors: bool = True
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "friction", friction_option(self.friction))
@@ -156,6 +160,10 @@ class IdentifyOptions:
         Full method only.
     ridge : float
         The ridge weight (``solver`` ridge), from 0 to :data:`MAX_RIDGE`.
+    errors : bool
+        Sequential method: whether the model carries its parameters' errors (the robot file's
+        ``[uncertainty]``, :mod:`kinergy.identification.uncertainty`); False skips them (what
+        they cost: ``benchmarks/bench_uncertainty.py cost``). Not recorded in the model file.
     """
 
     method: Method = Method.SEQUENTIAL
@@ -163,6 +171,7 @@ class IdentifyOptions:
     target: Target = Target.AUTO
     solver: Solver = Solver.OLS
     ridge: float = 0.0
+    errors: bool = True
 
     def record(self) -> dict[str, str | float]:
         """The options as a model file records them (``friction`` only when given)."""

@@ -275,7 +275,10 @@ def sequential(
         friction_choice=choices if options.auto else None,
     )
     joints = _joints(identified, (rotor, rotor_std), problems, stats)
-    errors = jackknife_uncertainty(identified, rotor_pieces, [j.flags for j in joints], stats)
+    errors = None
+    if options.errors:
+        flags = [j.flags for j in joints]
+        errors = jackknife_uncertainty(identified, rotor_pieces, flags, stats)
     identified = dataclasses.replace(identified, uncertainty=errors)
     return IdentificationResult(identified, "sequential", joints, fit)
 

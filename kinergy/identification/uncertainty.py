@@ -40,16 +40,20 @@ from kinergy.identification.drive_steps import (
     rotor_solution,
 )
 from kinergy.identification.electrics import BLOCK_SECONDS, StandingDrawSums
-from kinergy.identification.result import IDENTIFIED
+from kinergy.identification.result import IDENTIFIED, Validation
 from kinergy.linalg import Reduced
-from kinergy.model.robot import Robot
+from kinergy.model.robot import Robot, transmission_matrix
 from kinergy.model.uncertainty import Uncertainty
+from kinergy.predict import DriveState
 
 __all__ = [
+    "current_shifts",
     "deviations",
+    "fit_residual",
     "fold_gradients",
     "jackknife_uncertainty",
     "supply_calibration",
+    "torque_shifts",
     "with_standing_draw",
 ]
 
@@ -148,36 +152,47 @@ def supply_calibration(
     sums: StandingDrawSums,
     gradients: dict[tuple[int, int], Array],
     standby: float,
-) -> float:
+) -> tuple[float, int]:
     """The factor ``c >= 1`` by which the parameter errors understate the model's error on the
-    logged supply: over the standing draw's blocks ``b`` of the identification logs, the
-    supply energy the model misses (``e_b``: the block's supply less the motors' predicted draw
-    less the standing draw, J) against the spread the parameter errors give it (``s_b = |D
-    g_b|``, ``g_b`` the block's gradient)::
+    logged supply, and the blocks ``B`` it was measured on: over the standing draw's blocks
+    ``b`` of the identification logs, the supply energy the model misses (``e_b``: the block's
+    supply less the motors' predicted draw less the standing draw, J) against the spread the
+    parameter errors give it (``s_b = |D g_b|``, ``g_b`` the block's gradient)::
 
         c^2 = max(1, sum_b e_b^2 / sum_b s_b^2)
 
-    It takes in what the parameters cannot: a friction shape or electrics the model lacks,
-    and the supply's own noise (so it errs wide)."""
+    It takes in what the parameters cannot: a friction shape or electrics the model lacks (the
+    supply's own noise too, but on the twin and on UR logs that is a few mJ a block). A
+    block's ``e_b`` takes its log's sample period (the full blocks' ``BLOCK_SECONDS / n_b``), so
+    that a log's last, shorter block counts its own seconds."""
+    period: dict[int, float] = {}
+    for (segment, _), (_, count) in sums.blocks.items():
+        period[segment] = min(period.get(segment, np.inf), BLOCK_SECONDS / max(count, 1.0))
     errors, spreads = [], []
     for key, (total, count) in sums.blocks.items():
         if key not in gradients or count < 2:
             continue
-        mean_dt = BLOCK_SECONDS / count  # the block's samples span its seconds
-        errors.append((total - count * standby) * mean_dt)
+        errors.append((total - count * standby) * period[key[0]])
         spreads.append(uncertainty.spread(gradients[key]))
     if not errors:
-        return 1.0
+        return 1.0, 0
     ratio = float(np.sum(np.square(errors)) / max(np.sum(np.square(spreads)), 1e-300))
-    return float(np.sqrt(max(ratio, 1.0)))
+    return float(np.sqrt(max(ratio, 1.0))), len(errors)
 
 
 def with_standing_draw(
-    uncertainty: Uncertainty | None, std: float, calibration: float | None = None
+    uncertainty: Uncertainty | None,
+    std: float,
+    calibration: tuple[float, int] | None = None,
 ) -> Uncertainty:
     """``uncertainty`` with the arm's standing draw, its standard error ``std`` (W) independent
     of the drives' errors: one more mode, nonzero in ``standby_power`` alone; and the
-    ``calibration`` factor :func:`supply_calibration` found (None: not calibrated)."""
+    ``calibration`` :func:`supply_calibration` found (None: not calibrated).
+
+    A factor ``c > 1`` sets the variance's scale (``c^2 |D g|^2 = sum_b e_b^2 |D g|^2 / sum_b
+    |D g_b|^2``: the modes' own scale cancels), so the interval's t quantile then takes the
+    degrees of freedom of that estimate, ``B - 1`` (``B`` blocks' misses, less the standing draw
+    fitted from them: batch means), not the jackknife's ``K - 1``."""
     if uncertainty is None:
         return Uncertainty(("standby_power",), np.array([[std]]), 30, "standing-draw batch means")
     k = uncertainty.modes.shape[0]
@@ -185,14 +200,88 @@ def with_standing_draw(
     modes[:k, :-1] = uncertainty.modes
     modes[k, -1] = std
     method = uncertainty.method + "; standing draw from its batch means"
+    factor, dof = uncertainty.calibration, uncertainty.dof
     if calibration is not None:
-        method += (
-            f"; x {calibration:.3g} calibrated on the logged supply's {BLOCK_SECONDS:g} s blocks"
-        )
-    return Uncertainty(
-        (*uncertainty.parameters, "standby_power"),
-        modes,
-        uncertainty.dof,
-        method,
-        calibration if calibration is not None else uncertainty.calibration,
-    )
+        factor, blocks = calibration
+        method += f"; x {factor:.3g} calibrated on the logged supply's {BLOCK_SECONDS:g} s blocks"
+        if factor > 1.0 and blocks > 2:
+            dof = blocks - 1
+            method += f" (t on their {dof} degrees of freedom)"
+    parameters = (*uncertainty.parameters, "standby_power")
+    return Uncertainty(parameters, modes, dof, method, factor, uncertainty.residual)
+
+
+def fit_residual(fit: Validation) -> dict[str, tuple[float, ...]]:
+    """Per joint, the RMS error of the identified model's ``current`` and reference ``torque``
+    on its identification logs (``fit``: its :class:`~kinergy.identification.result.Validation`
+    there; NaN for a joint not compared), for :attr:`Uncertainty.residual`."""
+    out = {}
+    for key in ("current", "torque"):
+        metrics = getattr(fit, key)
+        if metrics is not None:
+            out[key] = tuple(float("nan") if m is None else float(m.rms) for m in metrics)
+    return out
+
+
+def _joint_parameters(u: Uncertainty) -> dict[int, list[tuple[int, str]]]:
+    """Per joint, its parameters in ``u``: (column of ``u.modes``, ``rotor_inertia``,
+    ``torque_constant`` or the friction level's name)."""
+    out: dict[int, list[tuple[int, str]]] = {}
+    for i, name in enumerate(u.parameters):
+        if name.startswith("joints["):
+            j = int(name[7 : name.index("]")])
+            out.setdefault(j, []).append((i, name.split(".", 1)[1].removeprefix("friction.")))
+    return out
+
+
+def current_shifts(robot: Robot, state: DriveState, temperature: Array | None = None) -> Array:
+    """How each error mode of ``robot.uncertainty`` moves the currents it predicts on the motion
+    of ``state`` (UR5e eq 17, ``I = tau_m / k_t``; the calibration factor ``c`` included),
+    (K, N, n) A: ``c sum_i D_ki dI_j/dtheta_i`` over joint j's parameters, with::
+
+        dI/dJ_r = dwm / k_t,   dI/dk_t = -tau_m / k_t^2,   dI/df = column_f / k_t
+
+    (a rotor inertia moves the load torque by ``dJ dwm``; a friction level ``f`` by its
+    regressor column, the friction taken at the nominal load). The standard deviation of the
+    predicted current is ``sqrt(sum_k shifts_k^2)`` (``|D g|`` sample by sample)."""
+    u = robot.uncertainty
+    assert u is not None
+    shifts = np.zeros((u.modes.shape[0], *state.current.shape))
+    for j, params in _joint_parameters(u).items():
+        drive = robot.joints[j].drive
+        kt = drive.torque_constant
+        columns = None
+        for i, what in params:
+            if what == "rotor_inertia":
+                g = state.dwm[:, j] / kt
+            elif what == "torque_constant":
+                g = -state.tau_m[:, j] / kt**2
+            else:
+                if columns is None:
+                    temp = None if temperature is None else temperature[:, j]
+                    columns = drive.friction.model.friction_columns(
+                        drive.friction.params,
+                        state.wm[:, j],
+                        state.tau_load[:, j],
+                        state.dwm[:, j],
+                        temperature=temp,
+                    )
+                g = columns[:, drive.friction.model.linear.index(what)] / kt
+            shifts[:, :, j] += np.outer(u.modes[:, i], g)
+    return u.calibration * shifts
+
+
+def torque_shifts(robot: Robot, dwm: Array) -> Array:
+    """How each error mode of ``robot.uncertainty`` moves the reference torque it predicts
+    (``target_moment``, UR5e eq 7: ``tau_sim = f_link + N^T diag(J) N qdd``) for motor
+    accelerations ``dwm`` (N, n), (K, N, n) N m: ``c sum_j D_kj dwm_j N[j, :]`` over the rotor
+    inertias ``J_j`` (the one parameter of ``robot.uncertainty`` in eq 7)."""
+    u = robot.uncertainty
+    assert u is not None
+    n_mat = transmission_matrix(robot)
+    moved = np.zeros((u.modes.shape[0], dwm.shape[1]))  # dJ per mode and motor
+    for j, params in _joint_parameters(u).items():
+        for i, what in params:
+            if what == "rotor_inertia":
+                moved[:, j] = u.modes[:, i]
+    return u.calibration * np.einsum("kj,nj,ji->kni", moved, dwm, n_mat)

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -53,6 +53,8 @@ __all__ = [
 
 #: the coverage every interval kinergy prints aims at
 LEVEL = 0.95
+#: the signals whose identification residual ``[uncertainty.residual]`` keeps
+RESIDUALS = ("current", "torque")
 _NAME = re.compile(
     r"^(?:standby_power|joints\[(\d+)\]\.(rotor_inertia|torque_constant|friction\.\w+))$"
 )
@@ -74,6 +76,11 @@ class Uncertainty:
         How the modes were made, for the user (``"jackknife over 10 time blocks"``).
     calibration : float
         Factor on every standard deviation (1: the jackknife's own).
+    residual : dict of str to tuple of float
+        What the model misses on its identification logs beyond its parameters' errors, per
+        joint: the RMS error of the predicted ``current`` (A) and reference ``torque`` (N m)
+        there (the prediction band's noise term; NaN where a joint was not compared; empty
+        when not measured).
     """
 
     parameters: tuple[str, ...]
@@ -81,6 +88,7 @@ class Uncertainty:
     dof: int
     method: str
     calibration: float = 1.0
+    residual: Mapping[str, tuple[float, ...]] = dataclasses.field(default_factory=dict)
 
     def __post_init__(self) -> None:
         modes = np.atleast_2d(np.asarray(self.modes, dtype=float))
@@ -100,6 +108,15 @@ class Uncertainty:
             raise KinergyError(f"uncertainty.dof: must be an integer >= 1, got {self.dof!r}")
         if not (np.isfinite(self.calibration) and self.calibration > 0):
             raise KinergyError(f"uncertainty.calibration: must be > 0, got {self.calibration!r}")
+        for key, values in self.residual.items():
+            if key not in RESIDUALS or not all(not v < 0 for v in values):
+                raise KinergyError(
+                    f"uncertainty.residual.{key}: must be one of {', '.join(RESIDUALS)}, an "
+                    "array of RMS errors >= 0 (nan: not compared)"
+                )
+        object.__setattr__(
+            self, "residual", {k: tuple(float(v) for v in vs) for k, vs in self.residual.items()}
+        )
 
     @property
     def covariance(self) -> Array:
@@ -215,7 +232,7 @@ def perturbed(robot: Robot, moves: dict[str, float]) -> Robot:
 
 def uncertainty_to_dict(u: Uncertainty) -> dict[str, Any]:
     """The ``[uncertainty]`` table of a robot file."""
-    return {
+    out: dict[str, Any] = {
         "method": u.method,
         "dof": u.dof,
         "calibration": u.calibration,
@@ -223,6 +240,9 @@ def uncertainty_to_dict(u: Uncertainty) -> dict[str, Any]:
         "std": u.std.tolist(),
         "modes": u.modes.tolist(),
     }
+    if u.residual:
+        out["residual"] = {k: list(v) for k, v in u.residual.items()}
+    return out
 
 
 def uncertainty_from_dict(data: Any) -> Uncertainty:
@@ -231,7 +251,8 @@ def uncertainty_from_dict(data: Any) -> Uncertainty:
     where = "uncertainty"
     if not isinstance(data, dict):
         raise KinergyError(f"{where}: must be a table")
-    unknown = set(data) - {"method", "dof", "calibration", "parameters", "std", "modes"}
+    known = {"method", "dof", "calibration", "parameters", "std", "modes", "residual"}
+    unknown = set(data) - known
     if unknown:
         raise KinergyError(f"{where}: unknown key {sorted(unknown)[0]!r}")
     for key in ("parameters", "modes", "dof"):
@@ -246,10 +267,17 @@ def uncertainty_from_dict(data: Any) -> Uncertainty:
         raise KinergyError(f"{where}.modes: must be an array of arrays of numbers") from None
     if array.ndim != 2:
         raise KinergyError(f"{where}.modes: must be an array of arrays of numbers")
+    residual = data.get("residual", {})
+    if not isinstance(residual, dict) or not all(
+        isinstance(v, list) and all(isinstance(x, int | float) for x in v)
+        for v in residual.values()
+    ):
+        raise KinergyError(f"{where}.residual: must be a table of arrays of numbers")
     return Uncertainty(
         parameters=tuple(params),
         modes=array,
         dof=data["dof"] if isinstance(data["dof"], int) else -1,
         method=str(data.get("method", "")),
         calibration=float(data.get("calibration", 1.0)),
+        residual=residual,
     )

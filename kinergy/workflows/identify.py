@@ -32,6 +32,7 @@ from kinergy.identification.result import IDENTIFIED, IdentificationResult, vali
 from kinergy.identification.sanity import check_motion
 from kinergy.identification.sequential import sequential
 from kinergy.identification.uncertainty import (
+    fit_residual,
     fold_gradients,
     supply_calibration,
     with_standing_draw,
@@ -96,11 +97,17 @@ def identify_chunks(
     standing draw where the logs measure them (:func:`measured_electrics`)."""
     options = options or IdentifyOptions()
     if options.method == Method.SEQUENTIAL:
-        result = sequential(robot, logs, CurrentOptions(options.friction))
+        result = sequential(robot, logs, CurrentOptions(options.friction, errors=options.errors))
     elif options.method == Method.NURSING:
         result = nursing(robot, logs)
     else:
         result = full(robot, logs, options)
+    errors = result.robot.uncertainty
+    if errors is not None:  # the prediction band's noise: what the fit missed
+        errors = dataclasses.replace(errors, residual=fit_residual(result.fit))
+        result = dataclasses.replace(
+            result, robot=dataclasses.replace(result.robot, uncertainty=errors)
+        )
     return measured_electrics(result, logs)
 
 
@@ -268,11 +275,11 @@ def _predicted_currents(robot: Robot, logs: LogChunks) -> list[np.ndarray]:
 
 def _standing_draw(
     robot: Robot, logs: LogChunks, currents: list[np.ndarray] | None
-) -> tuple[StandingDraw, float | None]:
+) -> tuple[StandingDraw, tuple[float, int] | None]:
     """The supply power less the motors' draw (UR5e eq 23 on the ``currents`` ``robot``
     predicts, else on its :func:`~kinergy.predict.drive_state`), folded into
     :class:`~kinergy.identification.electrics.StandingDrawSums`; and, when ``robot`` carries
-    parameter errors, their calibration factor on the same blocks
+    parameter errors, their calibration factor on the same blocks and the blocks' count
     (:func:`~kinergy.identification.uncertainty.supply_calibration`; else None)."""
     n_mat, kt = transmission_matrix(robot), torque_constants(robot)
     held = data_history(robot)
