@@ -29,7 +29,7 @@ from kinergy.identification.validation import (
 from kinergy.logs.reading import LogReading
 from kinergy.model import load_robot
 
-__all__ = ["report_text", "supply_text", "validate", "validation_text"]
+__all__ = ["band_text", "report_text", "supply_text", "validate", "validation_text"]
 
 
 def _r2(m: JointMetrics) -> str:
@@ -105,6 +105,36 @@ def supply_text(report: ValidationReport) -> str:
     )
 
 
+def band_text(report: ValidationReport, names: Sequence[str]) -> str:
+    """The 95 % prediction band per signal and joint: its mean half-width, the share of the
+    measured samples inside it, the RMS error with its spread across the model's error modes;
+    or why there is none."""
+    band = report.band
+    if band is None:
+        return ""
+    if band.note is not None:
+        return f"95 % prediction band: {band.note}"
+    parts = [prose(f"95 % prediction band: {band.method}.")]
+    for key, title, unit in _TABLES:
+        b = getattr(band, key, None)
+        if b is None:
+            continue
+        rows = [
+            [name, f"±{h:.4f}", f"{inside:.1%}", f"{rms:.4f} ± {std:.2g}", f"{r2:.2g}"]
+            for name, h, inside, rms, std, r2 in zip(
+                names, b.half_width, b.inside, b.rms, b.rms_std, b.r2_std, strict=True
+            )
+        ]
+        parts += [
+            f"{title.split(' (')[0]} ({b.samples} samples)",
+            table(
+                ["joint", f"band [{unit}]", "measured inside", f"RMS [{unit}] ± std", "R² std"],
+                rows,
+            ),
+        ]
+    return "\n".join(parts)
+
+
 def report_text(report: ValidationReport, names: Sequence[str]) -> str:
     """``validate``'s text: pooled tables, the supply, the moving and holding segments, and
     each log."""
@@ -118,6 +148,8 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
     ]
     if supply := supply_text(report):
         lines += ["", prose(supply)]
+    if band := band_text(report, names):
+        lines += ["", band]
     for label, part in (("moving", report.moving), ("holding", report.holding)):
         if part is not None and report.moving is not None and report.holding is not None:
             lines += [f"\n--- {label} samples only ---", validation_text(part, names)]

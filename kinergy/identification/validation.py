@@ -36,13 +36,22 @@ from kinergy.identification.metrics import (
     MetricSums,
     SignalMetrics,
 )
+from kinergy.identification.prediction_band import (
+    NO_BAND,
+    BandTally,
+    PredictionBand,
+    band_method,
+    half_widths,
+)
 from kinergy.identification.result import Prediction, Validation, predict
 from kinergy.identification.sanity import check_signals
+from kinergy.identification.uncertainty import current_shifts, torque_shifts
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.jsonable import to_jsonable
 from kinergy.logs.prepare import IdentData
 from kinergy.logs.reading import InputLogs
-from kinergy.model.robot import Robot
+from kinergy.model.robot import Robot, transmission_matrix
+from kinergy.predict import drive_state
 
 __all__ = [
     "EXCITED_RANGE",
@@ -97,25 +106,31 @@ class SupplyValidation:
 class SegmentedValidation(Validation):
     """A :class:`Validation` (of :class:`SignalMetrics`) over ``samples`` samples, with the same
     figures over the ``moving`` and the ``holding`` samples (None when there are none), the
-    share of samples in static holds and, where the logs measure it, the supply's power
-    (:class:`SupplyValidation`; None otherwise)."""
+    share of samples in static holds, where the logs measure it, the supply's power
+    (:class:`SupplyValidation`; None otherwise) and, where the model carries its parameters'
+    errors, the 95 % prediction band of the current and reference torque
+    (:class:`~kinergy.identification.prediction_band.PredictionBand`; for a model without
+    them, the pooled report's says so)."""
 
     samples: int = 0
     holding_fraction: float = 0.0
     moving: Validation | None = None
     holding: Validation | None = None
     supply: SupplyValidation | None = None
+    band: PredictionBand | None = None
 
 
 @dataclass(frozen=True, eq=False)
 class Series:
     """One signal of one log for plots: time from the log's start (N,) s, the measured and the
-    predicted values (N, n), every ``step``-th sample of the log."""
+    predicted values (N, n), every ``step``-th sample of the log, and the 95 % prediction
+    band's half-width (N, n; None: the model carries no errors)."""
 
     t: Array
     measured: Array
     predicted: Array
     step: int = 1
+    band: Array | None = None
 
 
 @dataclass(frozen=True)
@@ -169,6 +184,7 @@ class _Rows:
     q: Array
     qd: Array
     signals: dict[str, tuple[Array, Array]]
+    bands: dict[str, Array] = field(default_factory=dict)
 
     def take(self, rows: slice) -> _Rows:
         return _Rows(
@@ -176,6 +192,7 @@ class _Rows:
             self.q[rows],
             self.qd[rows],
             {k: (m[rows], p[rows]) for k, (m, p) in self.signals.items()},
+            {k: b[rows] for k, b in self.bands.items()},
         )
 
     def then(self, later: _Rows) -> _Rows:
@@ -192,6 +209,7 @@ class _Rows:
                 k: (cat(m, later.signals[k][0]), cat(p, later.signals[k][1]))
                 for k, (m, p) in self.signals.items()
             },
+            {k: cat(b, later.bands[k]) for k, b in self.bands.items() if k in later.bands},
         )
 
 
@@ -313,6 +331,7 @@ class _Sampled:
     def __init__(self, step: int):
         self.step, self.seen, self.t0 = step, 0, 0.0
         self.parts: dict[str, list[tuple[Array, Array, Array]]] = {}
+        self.bands: dict[str, list[Array]] = {}
 
     def add(self, rows: _Rows) -> None:
         if self.seen == 0 and len(rows.t):
@@ -321,12 +340,15 @@ class _Sampled:
         self.seen += len(rows.t)
         for name, (measured, predicted) in rows.signals.items():
             self.parts.setdefault(name, []).append((rows.t[at], measured[at], predicted[at]))
+        for name, band in rows.bands.items():
+            self.bands.setdefault(name, []).append(band[at])
 
     def series(self) -> dict[str, Series]:
         out = {}
         for name, parts in self.parts.items():
             t, measured, predicted = (np.concatenate(x) for x in zip(*parts, strict=True))
-            out[name] = Series(t - self.t0, measured, predicted, self.step)
+            band = np.concatenate(self.bands[name]) if name in self.bands else None
+            out[name] = Series(t - self.t0, measured, predicted, self.step, band)
         return out
 
 
@@ -338,6 +360,39 @@ def _rows(robot: Robot, data: IdentData, pred: Prediction) -> _Rows:
         if measured is not None and predicted is not None:
             signals[name] = (np.asarray(measured), np.asarray(predicted))
     return _Rows(data.t, data.q, data.qd, signals)
+
+
+#: the signals the prediction band covers
+_BANDED = ("current", "torque")
+
+
+def _band_shifts(model: Robot, data: IdentData, skip: int, rows: _Rows) -> dict[str, Array]:
+    """The error modes' shifts (K, N, n) of ``model``'s predictions of ``rows``'s current and
+    reference torque (``data``: the chunk with the ``skip`` rows ahead of it), and the band's
+    half-widths into ``rows.bands``."""
+    u = model.uncertainty
+    assert u is not None
+    shifts: dict[str, Array] = {}
+    if "current" in rows.signals:
+        state = drive_state(model, data.q, data.qd, data.qdd, temperature=data.temperature)
+        shifts["current"] = current_shifts(model, state, data.temperature)[:, skip:]
+    if "torque" in rows.signals:
+        dwm = np.asarray(data.qdd_cmd) @ transmission_matrix(model).T
+        shifts["torque"] = torque_shifts(model, dwm)[:, skip:]
+    for name, moved in shifts.items():
+        rows.bands[name] = half_widths(u, moved, name)
+    return shifts
+
+
+def _band(tallies: dict[str, BandTally] | None, model: Robot) -> PredictionBand | None:
+    if tallies is None:
+        return None
+    assert model.uncertainty is not None
+    return PredictionBand(
+        method=band_method(model.uncertainty),
+        current=tallies["current"].result(),
+        torque=tallies["torque"].result(),
+    )
 
 
 def validation_report(
@@ -370,18 +425,26 @@ def validation_report(
     held = data_history(robot)
     out = []
     pooled_supply = _SupplyTally()
+    errors = robot.uncertainty
+    modes = 0 if errors is None else errors.modes.shape[0]
+    pooled_band = None if errors is None else {s: BandTally(modes, robot.n) for s in _BANDED}
     for k, segment in enumerate(segments):
         tally, holds, supply = _Tally(robot.n), _Holds(), _SupplyTally()
+        bands = None if errors is None else {s: BandTally(modes, robot.n) for s in _BANDED}
         sampled = _Sampled(-(-len(segment) // plot_samples)) if plot_samples > 0 else None
+        model = robot if robots is None else robots[k]
         for chunk in segment.chunks(rows):
             check_signals([chunk])
             data, skip = held.ahead(k, chunk)
-            pred = predict(robot if robots is None else robots[k], data).after(skip)
-            held.update(data, skip)
+            pred = predict(model, data).after(skip)
             if pred.supply is not None:
                 assert chunk.supply_voltage is not None and chunk.supply_current is not None
                 supply.add(chunk.t, pred.supply, chunk.supply_voltage * chunk.supply_current)
             found = _rows(robot, chunk, pred)
+            if bands is not None and model.uncertainty is not None:
+                for name, moved in _band_shifts(model, data, skip, found).items():
+                    bands[name].add(*found.signals[name], moved, found.bands[name])
+            held.update(data, skip)
             if sampled is not None:
                 sampled.add(found)
             decided, holding = holds.feed(found)
@@ -393,7 +456,11 @@ def validation_report(
             pooled.add(last, np.zeros(len(last.t), dtype=bool))
         series = {} if sampled is None else sampled.series()
         pooled_supply.merge(supply)
-        fields = {**tally.fields(), "supply": supply.result()}
+        if bands is not None and pooled_band is not None:
+            for name, part in bands.items():
+                pooled_band[name].merge(part)
+        fields = {**tally.fields(), "supply": supply.result(), "band": _band(bands, model)}
         out.append(LogValidation(**fields, log=str(segment.path), series=series))  # type: ignore[arg-type]
-    fields = {**pooled.fields(), "supply": pooled_supply.result()}
+    band = _band(pooled_band, robot) if errors is not None else PredictionBand(note=NO_BAND)
+    fields = {**pooled.fields(), "supply": pooled_supply.result(), "band": band}
     return ValidationReport(**fields, logs=tuple(out))  # type: ignore[arg-type]

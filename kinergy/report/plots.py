@@ -234,9 +234,11 @@ def time_series(
     unit: str,
     measured_label: str = "measured",
     predicted_label: str = "model",
+    band: ArrayLike | None = None,
 ) -> Figure:
     """Measured against predicted signal per joint over time, with R² per joint and each
-    joint's residual ``measured - predicted`` in a panel below it.
+    joint's residual ``measured - predicted`` in a panel below it; with ``band``, the
+    prediction's 95 % band shaded about it (and about zero under the residual).
 
     One panel per joint (a 3 x 2 grid for six joints) sharing the time axis, the measured signal
     solid and the prediction dashed on top of it, as in UR5e Figs 8-9 (``target_moment`` against
@@ -259,6 +261,8 @@ def time_series(
         Its unit, e.g. ``"N m"`` or ``"A"``.
     measured_label, predicted_label : str
         Legend entries of the two signals.
+    band : array_like, shape (N, n), optional
+        The prediction band's half-width per sample (``validate``'s 95 % band), in ``unit``.
 
     Returns
     -------
@@ -274,10 +278,15 @@ def time_series(
     names, ts, (y, p) = _joint_signals(t, joint_names, measured=measured, predicted=predicted)
     n = len(names)
     r2 = r_squared(y, p)
+    half = None if band is None else _matrix(band, "band", len(ts), n)
 
     fig = _figure(*_grid_size(n))
     axes, below = _residual_grid(fig, n)
     for j, (ax, res) in enumerate(zip(axes, below, strict=True)):
+        if half is not None:
+            low, high = p[:, j] - half[:, j], p[:, j] + half[:, j]
+            ax.fill_between(ts, low, high, color="C1", alpha=0.25, linewidth=0, label="95 %")
+            res.fill_between(ts, -half[:, j], half[:, j], color="C1", alpha=0.25, linewidth=0)
         ax.plot(ts, y[:, j], label=measured_label, **_MEASURED)
         ax.plot(ts, p[:, j], label=predicted_label, **_PREDICTED)
         res.plot(ts, y[:, j] - p[:, j], label=f"{measured_label} - {predicted_label}", **_RESIDUAL)

@@ -148,6 +148,7 @@ def _plots(robot: Robot, logs: Sequence[LogValidation], out: Path) -> None:
                 unit=unit,
                 measured_label=label,
                 predicted_label="model",
+                band=series.band,
             )
             save(fig, out / f"{stem}_{key}.png")
             errors[key][stem] = series.measured - series.predicted
