@@ -146,3 +146,35 @@ def test_a_report_without_plots_folds_the_band_in_any_chunks(ur5e):
     assert whole is not None and pieces is not None
     np.testing.assert_allclose(whole.current.rms_std, pieces.current.rms_std, rtol=1e-9)
     np.testing.assert_allclose(whole.current.inside, pieces.current.inside)
+
+
+def test_energy_plot_shades_the_supply_powers_band(ur5e, tmp_path):
+    """energy --plot's band on the supply power: for a model whose only error is its standing
+    draw (std 2 W), t x 2 W at every sample; for one with drive errors, the band's integral over
+    the motion is at least the energy interval's half-width (|int D g| <= int |D g|); the PNG is
+    written."""
+    from kinergy.accounting.trace import PowerSeries
+    from kinergy.io.rtde import write_log
+    from kinergy.twin import simulate
+    from kinergy.workflows.energy import SupplyBand, energy_of_log
+
+    log = simulate(ur5e, paper_trajectory(ur5e, "test-b"))
+    path = tmp_path / "b.csv"
+    write_log(path, log.t, log.signals)
+    standby = Uncertainty(("standby_power",), np.array([[2.0]]), 9, "test")
+    for robot in (dataclasses.replace(ur5e, uncertainty=standby), _with_errors(ur5e)):
+        series = PowerSeries()
+        figures = energy_of_log(robot, path, band=SupplyBand(robot, series))
+        half = series.predicted
+        assert half.size == series.t.size > 100
+        if robot.uncertainty is standby:
+            np.testing.assert_allclose(half, t_quantile(9) * 2.0)
+        else:
+            integral = float(np.sum(0.5 * np.diff(series.t) * (half[1:] + half[:-1])))
+            assert integral >= figures.intervals.drawn.half_width > 0
+    model = tmp_path / "model.toml"
+    from kinergy.model.toml import save_robot
+
+    save_robot(_with_errors(ur5e), model)
+    kinergy.energy(model, path, plot=tmp_path / "supply.png")
+    assert (tmp_path / "supply.png").stat().st_size > 0

@@ -442,10 +442,12 @@ def supply_power(
     measured: ArrayLike | None = None,
     measured_energy: float | None = None,
     standing: float = 0.0,
+    band: ArrayLike | None = None,
 ) -> Figure:
     """The power the arm draws from its supply over time, predicted (the bus model plus the
     standing draw, :mod:`kinergy.drives.bus`) against measured (``actual_robot_voltage x
-    actual_robot_current``), the legend giving the energy of each over the whole motion.
+    actual_robot_current``), the legend giving the energy of each over the whole motion; with
+    ``band``, the prediction's 95 % band shaded about it.
 
     Parameters
     ----------
@@ -461,6 +463,8 @@ def supply_power(
         J, with ``measured``.
     standing : float
         The model's standing draw, W, drawn as a line where it is above 0.
+    band : array_like, shape (N,), optional
+        The 95 % band's half-width per sample, W (a model with parameter errors).
 
     Raises
     ------
@@ -479,6 +483,12 @@ def supply_power(
             raise KinergyError(f"measured has {meas.size} samples, t has {ts.size}")
         label = "measured" + ("" if measured_energy is None else f": {measured_energy:.1f} J")
         ax.plot(ts - ts[0], meas, label=label, **_MEASURED)
+    if band is not None:
+        half = _vector(band, "band")
+        if half.size != ts.size:
+            raise KinergyError(f"band has {half.size} samples, t has {ts.size}")
+        ax.fill_between(ts - ts[0], pred - half, pred + half, color="C1", alpha=0.25,
+                        linewidth=0, label="predicted: 95 % band")  # fmt: skip
     ax.plot(ts - ts[0], pred, label=f"predicted: {energy:.1f} J", **_PREDICTED)
     if standing > 0.0:
         ax.axhline(standing, color="0.5", linewidth=0.8, linestyle=":", zorder=0,

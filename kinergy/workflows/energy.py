@@ -21,6 +21,7 @@ from kinergy.accounting.trace import (
     supply_predicted,
     trace_format,
 )
+from kinergy.accounting.uncertainty import Sensitivity
 from kinergy.arrays import Array
 from kinergy.files import atomic_open
 from kinergy.io.log import Log
@@ -29,6 +30,7 @@ from kinergy.io.urscript_reader import read_program
 from kinergy.logs.payload import PAYLOAD_SIGNALS, logged_loads
 from kinergy.logs.reading import CheckedLog, InputLogs, LogReading
 from kinergy.model.robot import Robot
+from kinergy.model.uncertainty import t_quantile
 from kinergy.predict import DriveState, drive_by_payload, drive_state, payload_robots
 from kinergy.trajectory.motion import Motion, MotionSource
 from kinergy.trajectory.program_motion import payload_index, program_motion
@@ -41,6 +43,7 @@ __all__ = [
     "ENERGY_ROWS",
     "EnergyOptions",
     "LogEnergy",
+    "SupplyBand",
     "energy_of_log",
     "energy_with_outputs",
     "log_energy_report",
@@ -228,6 +231,25 @@ def unused_payload(robot: Robot, path: str | os.PathLike[str]) -> list[str]:
     ]
 
 
+class SupplyBand:
+    """The 95 % band's half-width of the predicted supply power, sample by sample, for a model
+    that carries errors: ``t c |D g_n|`` with ``g_n`` the sample's gradient of the power the arm
+    draws (:meth:`~kinergy.accounting.uncertainty.Sensitivity.rows` where the bus draws, plus 1
+    for the standing draw), W; handed to ``sink`` as its "predicted" power."""
+
+    def __init__(self, robot: Robot, sink: PowerSink) -> None:
+        self.sensitivity = Sensitivity(robot)
+        u = self.sensitivity.uncertainty
+        self.sink, self.t = sink, t_quantile(u.dof)
+        self.standby = np.array([name == "standby_power" for name in u.parameters], dtype=float)
+
+    def add(self, t: Array, state: DriveState, temperature: Array | None) -> None:
+        s = self.sensitivity
+        g = s.rows(state, temperature)[s.p :] + self.standby[:, None]  # (p, N)
+        half = self.t * s.uncertainty.calibration * np.linalg.norm(s.uncertainty.modes @ g, axis=0)
+        self.sink.add(t, half, None, state.power)
+
+
 def energy_of_log(
     robot: Robot,
     path: str | os.PathLike[str],
@@ -236,6 +258,7 @@ def energy_of_log(
     *,
     rows: int = ENERGY_ROWS,
     sinks: Sequence[PowerSink] = (),
+    band: SupplyBand | None = None,
 ) -> LogEnergy:
     """The energy of the motion in a log or motion file and what the log was (what ``kinergy
     energy`` prints: :class:`LogEnergy`): the log read in one
@@ -249,7 +272,8 @@ def energy_of_log(
     integrated across. A URScript program (``*.script``) is run as the controller would, with
     the loads it sets (:func:`program_energy`). Each of ``sinks`` gets the power of every chunk
     (:class:`~kinergy.accounting.trace.PowerSink`: the supply's, predicted and measured, and each
-    motor's)."""
+    motor's); ``band``, the supply power's 95 % band (:class:`SupplyBand`), each chunk of a
+    log's."""
     options = options or EnergyOptions()
     source, recovery = options.source, options.recovery
     inputs = InputLogs()
@@ -284,6 +308,8 @@ def energy_of_log(
         acc.add(m.t, state, starts=part.starts, measured_power=power, temperature=temperature)
         for sink in sinks:
             sink.add(m.t, supply_predicted(robot, state), power, state.power)
+        if band is not None:
+            band.add(m.t, state, temperature)
         if len(m.t):
             peak = np.maximum(peak, np.abs(state.tau_sim).max(axis=0))
     inputs.add(log)
@@ -334,13 +360,17 @@ def energy_with_outputs(
     """
     fmt = trace_format(trace) if trace is not None else None
     series = PowerSeries() if plot is not None else None
+    halves = PowerSeries() if plot is not None and robot.uncertainty is not None else None
+    band = (
+        None if halves is None else SupplyBand(reading.loaded(robot) if reading else robot, halves)
+    )
     with contextlib.ExitStack() as stack:
         sinks: list[PowerSink] = [] if series is None else [series]
         writer = None
         if trace is not None and fmt is not None:
             writer = TraceWriter(stack.enter_context(atomic_open(trace, binary=True)), robot, fmt)
             sinks.append(writer)
-        result = energy_of_log(robot, path, reading, options, sinks=sinks)
+        result = energy_of_log(robot, path, reading, options, sinks=sinks, band=band)
         if writer is not None:
             writer.close()
     if plot is not None and series is not None:
@@ -354,6 +384,7 @@ def energy_with_outputs(
             measured=series.measured,
             measured_energy=None if measured is None else measured.drawn,
             standing=robot.standby_power,
+            band=None if halves is None or halves.t.size != series.t.size else halves.predicted,
         )
         save(figure, plot)
     return result
