@@ -178,3 +178,19 @@ def test_energy_plot_shades_the_supply_powers_band(ur5e, tmp_path):
     save_robot(_with_errors(ur5e), model)
     kinergy.energy(model, path, plot=tmp_path / "supply.png")
     assert (tmp_path / "supply.png").stat().st_size > 0
+
+
+def test_validate_prints_the_band_or_no_interval(ur5e, tmp_path, capsys):
+    from kinergy.cli import main
+    from kinergy.model.toml import save_robot
+
+    model = tmp_path / "model.toml"
+    save_robot(_with_errors(ur5e), model)
+    assert main(["validate", str(model), "test-b"]) == 0
+    out = capsys.readouterr().out
+    assert "95 % prediction band: t quantile (9 degrees of freedom)" in out
+    assert "measured inside" in out and "RMS [A] ± std" in out
+    assert main(["validate", "ur5e", "test-b"]) == 0
+    out = capsys.readouterr().out
+    assert "95 % prediction band: the model carries no parameter errors" in out
+    assert "no interval" in out

@@ -167,8 +167,8 @@ def report_text(report: ValidationReport, names: Sequence[str]) -> str:
     "plots",
     type=click.Path(file_okay=False),
     default=None,
-    help="Write plots (measured vs predicted, error box plots) to this folder (new, empty, or "
-    "one kinergy wrote: it is replaced whole).",
+    help="Write plots (measured vs predicted with the 95 % band where the model has one, error "
+    "box plots) to this folder (new, empty, or one kinergy wrote: it is replaced whole).",
 )
 @reading_options()
 @writes(folders=("plots",), inputs=("model", "logs"))
@@ -180,6 +180,10 @@ def validate(
     reading: LogReading,
 ) -> None:
     """How well a model predicts logs: torque (UR5e Table V) and current (Table VII) errors and R^2.
+
+    A model identified from logs (its [uncertainty] table) also gets a 95 % prediction band on
+    the current and the reference torque: the share of the measured samples inside it, and the
+    RMS error's spread across the model's error modes; a built-in model says "no interval".
 
     A LOG may also be a built-in motion (test-a, test-b): the log the realistic twin of MODEL
     writes running it (a simulated robot that differs from the model as a real arm does).
