@@ -63,7 +63,6 @@ from kinergy.errors import KinergyError
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
 from kinergy.io.motion import HALO
-from kinergy.io.segments import segment_bounds
 from kinergy.logs.filtering import FILTER_REACH, check_cutoff, default_cutoff, lowpass
 from kinergy.logs.ident_data import SAMPLE_FIELDS, IdentData, Motion3, check_joints, ident_data
 from kinergy.logs.lag import LAG_BATCH_ROWS, batches, delay, lag_samples, lag_search
@@ -82,7 +81,6 @@ __all__ = [
     "commanded_motion",
     "prepare",
     "prepare_segment",
-    "segment_paths",
     "spill_log",
 ]
 
@@ -305,12 +303,3 @@ def prepare(log: Log, n_joints: int, *, cutoff: float | None = None) -> IdentDat
         return prepare_segment(spill, (0, len(log)), log.path, n_joints, cutoff).whole()
     finally:
         spill.close()
-
-
-def segment_paths(spill: LogSpill) -> list[tuple[tuple[int, int], str]]:
-    """The segments of a spilled log (:func:`kinergy.io.segments.segment_bounds`) and the path
-    each is named by (``#k`` when there are several, as :func:`~kinergy.io.segments.split_segments`)."""
-    bounds = segment_bounds(spill.state.t, spill.state.signals.get("segment"))
-    if len(bounds) == 1:
-        return [(bounds[0], spill.path)]
-    return [(ab, f"{spill.path}#{k}") for k, ab in enumerate(bounds)]
