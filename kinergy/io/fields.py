@@ -38,6 +38,7 @@ import difflib
 import re
 
 __all__ = [
+    "CHECKED_SIGNALS",
     "FIELDS",
     "JOINTS",
     "KINERGY_FIELDS",
@@ -169,29 +170,27 @@ KINERGY_FIELDS: dict[str, int | str] = {
 #: every named field: RTDE's and kinergy's, name -> width
 FIELDS: dict[str, int | str] = {**RTDE_FIELDS, **KINERGY_FIELDS}
 
+#: the measured signals kinergy uses, which the log checks read whenever a log has them
+CHECKED_SIGNALS = (
+    *(f"{kind}_{x}" for kind in ("target", "actual") for x in ("q", "qd", "qdd")),
+    "target_moment",
+    "actual_current",
+    "target_current",
+    "actual_joint_torque",
+    "actual_current_as_torque",
+    "actual_joint_voltage",
+    "joint_temperatures",
+    "actual_robot_voltage",
+    "actual_robot_current",
+    "payload",
+    "payload_cog",
+    "payload_inertia",
+)
+
 #: the fields kinergy uses (the others are read only to be passed on): a value in them that is
 #: not a number is a damaged line, where a logger's text in an unused field is ignored
 USED = frozenset(
-    {
-        "timestamp",
-        *(f"{kind}_{x}" for kind in ("target", "actual") for x in ("q", "qd", "qdd")),
-        "target_moment",
-        "target_current",
-        "actual_current",
-        "actual_current_as_torque",
-        "actual_joint_torque",
-        "actual_joint_voltage",
-        "joint_temperatures",
-        "actual_robot_voltage",
-        "actual_robot_current",
-        "robot_mode",
-        "safety_mode",
-        "runtime_state",
-        "payload",
-        "payload_cog",
-        "payload_inertia",
-        "segment",
-    }
+    {"timestamp", *CHECKED_SIGNALS, "robot_mode", "safety_mode", "runtime_state", "segment"}
 )
 
 #: RTDE's numbered registers (scalars): kind -> the numbers there are
