@@ -36,6 +36,11 @@ from __future__ import annotations
 
 import difflib
 import re
+from collections.abc import Mapping
+
+import numpy as np
+
+from kinergy.errors import KinergyError
 
 __all__ = [
     "CHECKED_SIGNALS",
@@ -46,6 +51,7 @@ __all__ = [
     "SAFETY_MOVING",
     "SKIP",
     "USED",
+    "check_widths",
     "closest",
     "is_known",
     "vector_member",
@@ -235,3 +241,12 @@ def closest(name: str, among: list[str] | None = None) -> str | None:
     lowered = {p.lower(): p for p in pool}
     match = difflib.get_close_matches(name.lower(), list(lowered), n=1, cutoff=0.75)
     return lowered[match[0]] if match else None
+
+
+def check_widths(signals: Mapping[str, np.ndarray], n: int, where: str) -> None:
+    """Raise when a field of one value per joint (:data:`JOINTS`) in ``signals`` does not have
+    ``n`` columns (``where: target_q has 7 joints but the robot has 6``)."""
+    for name, x in signals.items():
+        if FIELDS.get(name) == JOINTS and (x.ndim != 2 or x.shape[1] != n):
+            width = 1 if x.ndim == 1 else x.shape[1]
+            raise KinergyError(f"{where}: {name} has {width} joints but the robot has {n}")
