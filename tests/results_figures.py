@@ -595,8 +595,15 @@ RESULTS: tuple[Figure, ...] = (
     ),
     _fig(
         "With the via points kept (`--via keep`) the mean saving is {kept} % ({kept_each} % in "
-        "the table's order;",
+        "the table's order);",
         _only(programs_summary, "kept", "kept_each"),
+        slow=True,
+        script="bench_programs",
+    ),
+    _fig(
+        "With the standing draw in the supply figure ({standing} % of it on these cycles) the "
+        "savings are {ratio} of the motors' alone:",
+        _only(programs_summary, "standing", "ratio"),
         slow=True,
         script="bench_programs",
     ),

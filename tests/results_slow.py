@@ -66,7 +66,18 @@ def programs_summary(runs: Runs) -> dict[str, str]:
         "kept_each": ", ".join(f"{x:.1f}" for x in kept_saving),
         "back": f"{max(abs(x) for x in back):.2f}",
         "programs": f"{len(free)}",
+        "standing": _span([100 * r["standing"] / r["e_program"] for r in free], 0),
+        "ratio": _span([r["saving"] / _motors_saving(r) for r in free], 2),
     }
+
+
+def _motors_saving(row: dict[str, Any]) -> float:
+    """A program's saving of the motors' energy alone (its supply less the standing draw)."""
+    return 1.0 - (row["e_optimized"] - row["standing"]) / (row["e_program"] - row["standing"])
+
+
+def _span(values: list[float], digits: int) -> str:
+    return f"{min(values):.{digits}f}-{max(values):.{digits}f}"
 
 
 def _methods(runs: Runs) -> dict[str, Any]:
