@@ -23,6 +23,7 @@ import numpy as np
 from doc_figures import (
     ROOT,
     UR3E,
+    UR5E_CALIBRATION,
     Figure,
     Runs,
     Table,
@@ -38,6 +39,7 @@ from doc_figures import (
     test_count,
 )
 from results_slow import (
+    bench,
     default_row,
     method_row,
     place_grid,
@@ -255,6 +257,37 @@ def calibration_summary(runs: Runs) -> dict[str, str]:
         "u": f"{100 * worst_u:.1f}",
         "line": f"{100 * min(line):.0f}-{100 * max(line):.0f}",
     }
+
+
+def _powers(runs: Runs) -> list[dict[str, str]]:
+    """Per joint, the power the calibration measured at its fastest point (1.5 U I) against the
+    built-in ``ur5e``'s and the calibrated robot's (``bench_drives.py --part calibration``'s
+    functions; the calibrated robot the one ``robot import-calibration`` wrote)."""
+    _calibration(runs)
+
+    def compute() -> list[dict[str, str]]:
+        b = bench("bench_drives")
+        built_in = b.kinergy.load_robot("ur5e")
+        calibrated = b.kinergy.load_robot(str(runs.folder / "ur5e-cal.toml"))
+        rows = []
+        for j, joint in enumerate(b.read_ur_calibration(UR5E_CALIBRATION).joints):
+            moving = np.abs(joint.speed) >= 0.5
+            speed = joint.speed[moving]
+            measured = b.DQ_VOLTAGE_FACTOR * joint.voltage[moving] * np.abs(joint.current[moving])
+            ours, theirs = (b._point_power(r, j, speed) for r in (built_in, calibrated))
+            fast = int(np.argmax(speed))
+            err = [100 * np.mean(np.abs(x / measured - 1)) for x in (ours, theirs)]
+            rows.append({"measured": f"{measured[fast]:.1f}", "built_in": f"{ours[fast]:.1f}",
+                         "calibrated": f"{theirs[fast]:.1f}", "err": f"{err[0]:.0f}",
+                         "cal_err": f"{err[1]:.1f}"})  # fmt: skip
+        return rows
+
+    rows: list[dict[str, str]] = runs.kept(("powers",), compute)
+    return rows
+
+
+def power_row(j: int) -> Produce:
+    return lambda runs: _powers(runs)[j]
 
 
 def calibration_test_a(runs: Runs) -> dict[str, str]:
@@ -497,6 +530,13 @@ RESULTS: tuple[Figure, ...] = (
         for j, (name, model) in enumerate(
             zip(_UR10E_JOINTS, ["power_law"] * 5 + ["directional_power_law"], strict=True)
         )
+    ),
+    *(
+        _fig(
+            f"| {name} | {{measured}} | {{built_in}} | {{calibrated}} | {{err}} / {{cal_err}} |",
+            power_row(j),
+        )
+        for j, name in enumerate(_UR10E_JOINTS)
     ),
     _fig(
         "With the calibrated friction and motors, test A's electrical energy is {cal} J instead "
