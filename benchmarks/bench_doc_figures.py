@@ -1,9 +1,11 @@
-"""Every figure the README, the recipes and getting-started state, from the commands that print it.
+"""Every figure the README, the recipes, getting-started and the results page state, from the
+commands that print it.
 
-Runs each figure of ``tests/doc_figures.py`` (the test suite runs the fast ones; this script runs
-all of them, the optimisations and placements that take minutes included), prints each one the
-page states differently from what the commands give, and with ``--write`` puts the commands'
-figures into the pages (review the diff, and say why in the commit). Run::
+Runs each figure of ``tests/doc_figures.py`` and ``tests/results_figures.py`` (the test suite
+runs the fast ones; this script runs all of them, the optimisations, placements and benchmark
+tables that take minutes included), prints each one the page states differently from what the
+commands give, and with ``--write`` puts the commands' figures into the pages (review the diff,
+and say why in the commit). Run::
 
     python benchmarks/bench_doc_figures.py [--write] [--fast | --slow] [--work DIR]
 
@@ -15,12 +17,12 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from doc_figures import FIGURES, Missing, Runs
+from doc_figures import FIGURES, Runs, check
+from results_figures import RESULTS
 
 
 def main() -> int:
@@ -31,28 +33,15 @@ def main() -> int:
     which.add_argument("--slow", action="store_true", help="only the slow figures")
     parser.add_argument("--work", type=Path, help="folder for the commands' outputs [a new one]")
     args = parser.parse_args()
-    figures = [f for f in FIGURES if not (args.fast and f.slow) and not (args.slow and not f.slow)]
+    figures = [
+        f
+        for f in (*FIGURES, *RESULTS)
+        if not (args.fast and f.slow) and not (args.slow and not f.slow)
+    ]
     with tempfile.TemporaryDirectory() as tmp:
         work = args.work or Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
-        runs = Runs(work)
-        differ = 0
-        for figure in figures:
-            start = time.perf_counter()
-            try:
-                lines = figure.differences(runs)
-            except Missing as exc:
-                print(f"skipped  {figure.name}: {exc}")
-                continue
-            took = time.perf_counter() - start
-            if not lines:
-                print(f"same     {figure.name} ({took:.0f} s)")
-                continue
-            differ += 1
-            for line in lines:
-                print(f"differs  {line}")
-            if args.write and figure.write(runs):
-                print(f"written  {figure.page}")
+        differ = check(figures, Runs(work), write=args.write)
     return 1 if differ and not args.write else 0
 
 

@@ -34,7 +34,6 @@ import kinergy
 from kinergy.accounting.energy import energy
 from kinergy.drives.electrics import DQ_VOLTAGE_FACTOR, back_emf_constants, winding_resistances
 from kinergy.dynamics.regressor import base_parameters, inertial_parameters
-from kinergy.friction.registry import friction_torque
 from kinergy.identification.full import FullFit, identify_full
 from kinergy.identification.options import AUTO, IdentifyOptions
 from kinergy.identification.result import IdentificationResult, predict
@@ -91,7 +90,7 @@ def _point_power(robot: Robot, j: int, speed: np.ndarray) -> np.ndarray:
     joint = robot.joints[j]
     wm = joint.drive.gear_ratio * speed
     fr = joint.drive.friction
-    tau = friction_torque(fr.model, fr.params, wm, 1e-6 * np.sign(wm), temperature=None)
+    tau = fr.model.friction_torque(fr.params, wm, 1e-6 * np.sign(wm), temperature=None)
     current = tau / joint.drive.torque_constant
     return winding_resistances(robot)[j] * current**2 + back_emf_constants(robot)[j] * wm * current
 

@@ -1,19 +1,26 @@
 """The program optimiser on the URScript benchmark programs (benchmarks/programs/): per lever.
 
 For every program: the supply energy (model-predicted: motor electrical energy summed on the DC
-bus, braking surplus lost, no standby) of the program as written, after each lever in turn (2 pi
+bus, braking surplus lost, plus the robot file's standing draw over the cycle) of the program as
+written, after each lever in turn (2 pi
 wraps, IK configurations, tool symmetry, via points, via-point blends, timing), and of re-timing
 alone, all re-simulated at 500 Hz at the program's own cycle time; the optimised program written
 as URScript, read back and simulated again; limits and targets checked. Where the energy goes
 after optimisation (per joint: friction, copper) and what no lever touches
 (:func:`kinergy.optimize.program_floor.energy_floor`: the friction floor of a joint path at one
 constant speed over the moving time, plus the copper loss of holding the arm against gravity),
-for the program's own path and the optimised one: the **floor** is the lower of the two, the
+for the program's own path and the optimised one: the **floor** is the lower of the two plus the
+standing draw over the cycle, the
 **headroom** one minus the floor over the program's figure, and the **share** the saving over
 the headroom. Each program runs with the via points kept and free (``--via``). Run::
 
     PYTHONPATH=. python benchmarks/bench_programs.py [--via keep|free|both] [--slow F]
-        [--json OUT.json] [NAME ...]
+        [--json OUT.json] [--check | --write] [--rows RUN.json] [NAME ...]
+
+``--check`` compares ``docs/results.md``'s table of the programs (and the figures its text takes
+from it: ``tests/results_figures.py``, the mechanism of ``tests/doc_figures.py``) with this run,
+exit status 1 where they differ; ``--write`` puts this run's figures into the page. ``--rows
+RUN.json`` takes the rows of an earlier ``--json`` run of every program instead of measuring.
 
 ``--slow F`` runs on a host F times slower as the optimiser sees it: every clock of the process
 runs F times fast and every evaluation of the drive model sleeps F - 1 times its own duration.
@@ -27,6 +34,7 @@ import functools
 import json
 import math
 import sys
+import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -154,7 +162,11 @@ def run(name: str, via: str) -> dict[str, Any]:
         "floor_program": _floor(robot, result.program),
         "floor_optimized": _floor(robot, result.optimized),
     }
-    floor = min(out["floor_program"]["untouched"], out["floor_optimized"]["untouched"])
+    # what no lever touches includes the standing draw over the cycle (the robot file's, in the
+    # supply energy the optimiser minimises)
+    standing = result.settings.standby * result.program.result.cycle_time
+    floor = min(out["floor_program"]["untouched"], out["floor_optimized"]["untouched"]) + standing
+    out["standing"] = standing
     out["floor"] = floor
     out["headroom"] = 1.0 - floor / own
     out["share"] = out["saving"] / out["headroom"]
@@ -183,13 +195,88 @@ def _print_floor(row: dict[str, Any]) -> None:
     )
 
 
+def _minus(text: str) -> str:
+    return text.replace("-", "−")
+
+
+def table(rows: list[dict[str, Any]]) -> str:
+    """The page's table of the programs (``docs/results.md``) from the rows of every program
+    with the via points free and kept: per lever the program after it ("–" where it changed
+    nothing, the repair in brackets), the floor, headroom and share, the saving with the via
+    points kept, re-timing alone, limits and targets, the read-back error; then the means."""
+    free = [r for r in rows if r["via"] == "free"]
+    kept = {r["program"]: r for r in rows if r["via"] == "keep"}
+    lines = [
+        "| program | moves | symmetry, IK | cycle [s] | as written [J] | tool symmetry | via points "
+        "| blends | timing | optimised [J] | saving | floor [J] | headroom | share | via kept: "
+        "saving | re-timing alone | limits, targets | read back |",
+        "| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: "
+        "| ---: | ---: | ---: | --- | ---: |",
+    ]
+    for r in free:
+        levers = {lv["name"]: lv for lv in r["levers"]}
+        cells = []
+        for name in ("tool symmetry", "via points", "blends", "timing"):
+            lv = levers.get(name)
+            if lv is None or lv["status"] != "kept":
+                cells.append("–")
+            else:
+                cells.append(f"{lv['e']:.1f}" + (f" ({lv['repaired']})" if lv["repaired"] else ""))
+        yes = ", ".join("yes" if x else "no" for x in (r["within_limits"], r["targets_met"]))
+        alone = _minus(f"{100 * r['timing_only_saving']:.1f}")
+        back = _minus(f"{100 * r['readback_error']:+.2f}")
+        lines.append(
+            f"| `{r['program']}` | {r['moves']} | {r['symmetry']}, {r['configurations']} | "
+            f"{r['cycle_time']:.2f} | {r['e_program']:.1f} | {' | '.join(cells)} | "
+            f"**{r['e_optimized']:.1f}** | **{100 * r['saving']:.1f} %** | {r['floor']:.1f} | "
+            f"{100 * r['headroom']:.1f} % | {100 * r['share']:.0f} % | "
+            f"{100 * kept[r['program']]['saving']:.1f} % | "
+            f"{alone} % | {yes} | {back} % |"
+        )
+
+    def mean(key: str, of: list[dict[str, Any]]) -> float:
+        return 100 * sum(r[key] for r in of) / len(of)
+
+    lines.append(
+        f"| mean | | | | | | | | | | **{mean('saving', free):.1f} %** | | "
+        f"{mean('headroom', free):.1f} % | {mean('share', free):.0f} % | "
+        f"{mean('saving', list(kept.values())):.1f} % | {mean('timing_only_saving', free):.1f} % "
+        "| | |"
+    )
+    return "\n".join(lines) + "\n"
+
+
+def check_page(rows: list[dict[str, Any]] | None, *, write: bool) -> int:
+    """``docs/results.md``'s figures from this script (``--check`` / ``--write``), measured
+    now (``rows`` None) or from ``rows``; the number that differ."""
+    sys.modules.setdefault("bench_programs", sys.modules[__name__])
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from doc_figures import Runs, check
+    from results_figures import RESULTS
+    from results_slow import programs_rows
+
+    with tempfile.TemporaryDirectory() as tmp:
+        runs = Runs(Path(tmp))
+        if rows is not None:
+            runs.kept(("bench_programs",), lambda: rows)
+        programs_rows(runs)
+        return check([f for f in RESULTS if f.script == "bench_programs"], runs, write=write)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("names", nargs="*", default=list(SETTINGS))
     parser.add_argument("--via", choices=["keep", "free", "both"], default="both")
     parser.add_argument("--slow", type=float, default=1.0)
     parser.add_argument("--json")
+    page = parser.add_mutually_exclusive_group()
+    page.add_argument("--check", action="store_true", help="compare docs/results.md with this run")
+    page.add_argument("--write", action="store_true", help="put this run into docs/results.md")
+    parser.add_argument("--rows", type=Path, help="the rows of an earlier --json run")
     args = parser.parse_args()
+    if args.check or args.write:
+        rows = json.loads(args.rows.read_text()) if args.rows else None
+        sys.exit(1 if check_page(rows, write=args.write) and not args.write else 0)
     if args.slow != 1.0:
         slow_host(args.slow)
     rows = []

@@ -23,7 +23,6 @@ import contextlib
 import io
 import json
 import re
-import statistics
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -43,10 +42,10 @@ UR5E_CALIBRATION = DATA / "ur5e-calibration" / "robot_calibration_summary.txt"
 PANDA = DATA / "panda-gaz"
 PROGRAMS = ROOT / "benchmarks" / "programs"
 
-#: a figure: a signed number, thousands with commas
-_NUMBER = r"[-+−]?\d[\d,]*(?:\.\d+)?"
+#: a figure: a signed number, thousands with commas, maybe an exponent (``5.963e-04``)
+_NUMBER = r"[-+−]?\d[\d,]*(?:\.\d+)?(?:e[-+]\d+)?"
 #: a placeholder: one figure or a list of them (``a, b and c``, ``a-b``)
-_FIGURES = rf"{_NUMBER}(?:(?:, | and |-|–){_NUMBER})*"
+_FIGURES = rf"{_NUMBER}(?:(?:,\s+|\s+and\s+|-|–){_NUMBER})*"
 
 
 class Missing(Exception):
@@ -59,6 +58,7 @@ class Runs:
     def __init__(self, folder: Path):
         self.folder = folder
         self._out: dict[tuple[str, ...], str] = {}
+        self._kept: dict[tuple[str, ...], Any] = {}
 
     def text(self, *args: str) -> str:
         """stdout of ``kinergy ARGS`` (in-process, in :attr:`folder`; a failure raises)."""
@@ -86,12 +86,17 @@ class Runs:
         self.text(*args)
         return str(self.folder / name)
 
+    def kept(self, key: tuple[str, ...], compute: Callable[[], Any]) -> Any:
+        """``compute()`` (a benchmark's measurement, not a command), run once per ``key``."""
+        if key not in self._kept:
+            self._kept[key] = compute()
+        return self._kept[key]
+
 
 def need(*paths: Path) -> None:
     """Raise :class:`Missing` unless every path exists."""
-    for path in paths:
-        if not path.exists():
-            raise Missing(f"{path} is not on this machine")
+    for path in (p for p in paths if not p.exists()):
+        raise Missing(f"{path} is not on this machine")
 
 
 @dataclass(frozen=True)
@@ -109,12 +114,19 @@ class Figure:
         ``produce(runs) -> {name: text}``: each figure as the page should print it.
     slow : bool
         Takes minutes: checked by the benchmark, not the test suite.
+    script : str
+        The benchmark script whose ``--check`` / ``--write`` checks it too (its stem,
+        ``"bench_programs"``), or ``""``.
+
+    A ``{name}`` that ``produce`` does not return matches any figure and is not compared (a
+    timing, which depends on the host: its sentence names the command and the date).
     """
 
     page: str
     text: str
     produce: Callable[[Runs], dict[str, str]]
     slow: bool = False
+    script: str = ""
 
     @property
     def name(self) -> str:
@@ -147,14 +159,15 @@ class Figure:
             f"{self.page}: says {match.group(key)!r} for {key} in {self.text!r}; "
             f"the commands give {value!r}"
             for key, value in produced.items()
-            if match.group(key) != value
+            if " ".join(match.group(key).split()) != value
         ]
 
     def write(self, runs: Runs) -> bool:
         """Put the produced figures into the page; True when it changed."""
         path = ROOT / self.page
         text, match, produced = path.read_text(encoding="utf-8"), self.found(), self.produce(runs)
-        spans = sorted(((match.span(k), v) for k, v in produced.items()), reverse=True)
+        moved = {k: v for k, v in produced.items() if " ".join(match.group(k).split()) != v}
+        spans = sorted(((match.span(k), v) for k, v in moved.items()), reverse=True)
         new = text
         for (a, b), value in spans:
             new = new[:a] + value + new[b:]
@@ -173,6 +186,7 @@ class Transcript:
     marker: str
     produce: Callable[[Runs], str]
     slow: bool = False
+    script: str = ""
 
     @property
     def name(self) -> str:
@@ -221,6 +235,73 @@ class Transcript:
         new = text[:a] + "\n".join(lines) + "\n" + text[b:]
         if new != text:
             path.write_text(new, encoding="utf-8")
+        return new != text
+
+
+def check(
+    figures: Sequence[Figure | Transcript | Table],
+    runs: Runs,
+    *,
+    write: bool = False,
+    say: Callable[[str], None] = print,
+) -> int:
+    """Each figure produced and compared with its page, one line each (``same``, ``differs``,
+    ``skipped``, ``written``); with ``write`` the produced figures put into the pages. Returns
+    how many differ."""
+    import time
+
+    differ = 0
+    for figure in figures:
+        start = time.perf_counter()
+        try:
+            lines = figure.differences(runs)
+        except Missing as exc:
+            say(f"skipped  {figure.name}: {exc}")
+            continue
+        took = time.perf_counter() - start
+        if not lines:
+            say(f"same     {figure.name} ({took:.0f} s)")
+            continue
+        differ += 1
+        for line in lines:
+            say(f"differs  {line}")
+        if write and figure.write(runs):
+            say(f"written  {figure.page}")
+    return differ
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table of ``page`` a benchmark measures, whole: the lines from the one that starts with
+    ``marker`` (its header) to the first blank line are ``produce(runs)``, line for line."""
+
+    page: str
+    marker: str
+    produce: Callable[[Runs], str]
+    slow: bool = True
+    script: str = ""
+
+    @property
+    def name(self) -> str:
+        return f"{self.page}: table {self.marker[:60]}"
+
+    def _block(self) -> tuple[str, int, int]:
+        text = (ROOT / self.page).read_text(encoding="utf-8")
+        start = text.index("\n" + self.marker) + 1
+        end = text.find("\n\n", start)
+        return text, start, len(text) if end < 0 else end
+
+    def differences(self, runs: Runs) -> list[str]:
+        text, a, b = self._block()
+        shown, made = text[a:b].splitlines(), self.produce(runs).splitlines()
+        pairs = zip(shown + [""] * len(made), made + [""] * len(shown), strict=False)
+        return [f"{self.page}: shows {x!r}; the benchmark gives {y!r}" for x, y in pairs if x != y]
+
+    def write(self, runs: Runs) -> bool:
+        text, a, b = self._block()
+        new = text[:a] + self.produce(runs).rstrip("\n") + text[b:]
+        if new != text:
+            (ROOT / self.page).write_text(new, encoding="utf-8")
         return new != text
 
 
@@ -527,19 +608,7 @@ def place(runs: Runs) -> dict[str, str]:
     }
 
 
-def benchmark_programs(runs: Runs) -> dict[str, str]:
-    savings = []
-    for program in sorted(PROGRAMS.glob("*.script")):
-        robot = program.name.split("_")[0]
-        result = runs.json("optimize", robot, str(program), "--tool-symmetry", "z")
-        savings.append(_saving(result)[2])
-    return {
-        "mean": f"{statistics.mean(savings):.1f}",
-        "range": f"{min(savings):.1f}-{max(savings):.1f}",
-    }
-
-
-FIGURES: tuple[Figure | Transcript, ...] = (
+FIGURES: tuple[Figure | Transcript | Table, ...] = (
     # README
     Figure(
         "README.md",
