@@ -26,6 +26,7 @@ import enum
 import math
 import multiprocessing
 import os
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, replace
 from typing import Any
@@ -37,8 +38,9 @@ from kinergy.messages import Say, silent
 from kinergy.model.robot import Robot
 from kinergy.optimize.levers import CYCLE_TOLERANCE
 from kinergy.optimize.options import ProgramOptions
-from kinergy.optimize.programs import ProgramOptimization, optimize_program
-from kinergy.trajectory.program_path import program_path
+from kinergy.optimize.programs import ProgramOptimization, optimize_program, program_settings
+from kinergy.optimize.samples import serial
+from kinergy.trajectory.program_path import ProgramPath, program_path
 from kinergy.trajectory.program_placement import BasePlacement, moved_program
 from kinergy.trajectory.robot_program import RobotProgram
 
@@ -288,26 +290,38 @@ def _judged(placement: BasePlacement, result: ProgramOptimization) -> Candidate:
 
 def _reach(
     robot: Robot, program: RobotProgram, placement: BasePlacement
-) -> RobotProgram | Candidate:
-    """The program moved to ``placement`` if every target, line and joint limit holds there;
-    else the candidate marked out of reach with the line that fails."""
+) -> tuple[RobotProgram, ProgramPath] | Candidate:
+    """The program moved to ``placement`` and its path if every target, line and joint limit
+    holds there; else the candidate marked out of reach with the line that fails."""
     try:
         moved = moved_program(robot, program, placement)
-        program_path(robot, moved)
+        path = program_path(robot, moved)
     except KinergyError as exc:
         return Candidate(placement, Reason.OUT_OF_REACH, str(exc))
-    return moved
+    return moved, path
 
 
-def _optimised(
-    robot: Robot, moved: RobotProgram, placement: BasePlacement, options: ProgramOptions
+def _candidate(
+    robot: Robot, program: RobotProgram, placement: BasePlacement, options: ProgramOptions
 ) -> Candidate:
-    """A reachable placement's program optimised at the cycle time and judged."""
+    """One placement: its reach checked (:func:`_reach`), then, if it reaches, its program
+    optimised at the cycle time and judged; everything from the placement and the options
+    alone (one task of :func:`_optimise_all`)."""
+    reached = _reach(robot, program, placement)
+    if isinstance(reached, Candidate):
+        return reached
+    moved, path = reached
     try:
-        result = optimize_program(robot, moved, options)
+        result = optimize_program(robot, moved, options, path=path)
     except KinergyError as exc:
         return Candidate(placement, Reason.CANNOT_RUN, str(exc))
     return _judged(placement, result)
+
+
+def _today(robot: Robot, program: RobotProgram, options: ProgramOptions) -> Candidate:
+    """Today's placement: the program as it stands optimised with ``options`` and judged (it
+    raises, where a candidate is marked, when the program cannot run)."""
+    return _judged(BasePlacement(), optimize_program(robot, program, options))
 
 
 def _refusal(candidates: list[Candidate]) -> KinergyError:
@@ -324,6 +338,7 @@ def _refusal(candidates: list[Candidate]) -> KinergyError:
     )
 
 
+@serial
 def place_program(
     robot: Robot,
     program: RobotProgram,
@@ -335,6 +350,10 @@ def place_program(
 ) -> PlacementSearch:
     """Every placement of ``grid`` and today's, each checked and optimised (module docstring).
 
+    Today's cycle time and caps are resolved first (:func:`kinergy.optimize.programs.
+    program_settings`: the program simulated as written); then today's optimisation and every
+    candidate's reach check and optimisation are tasks on a pool of processes, today's first.
+
     Parameters
     ----------
     robot : Robot
@@ -345,10 +364,11 @@ def place_program(
         The levers (as :func:`kinergy.optimize.programs.optimize_program`); the cycle time and
         caps default to today's program's own and hold for every candidate.
     progress : Say, optional
-        Told each step, and as each candidate is done how many of them are.
+        Told each step, and as each placement is done how many of them are.
     workers : int, optional
-        Processes the candidates are optimised on (default: one per core). Each candidate's
-        optimisation is independent of the others and of the order they run in: the same
+        Processes the placements are optimised on (default: one per core). Each placement's
+        optimisation is independent of the others, of the order they run in and of the process
+        (its linear algebra on one thread: :func:`kinergy.optimize.samples.serial`): the same
         result on any host and with any number of processes.
 
     Raises
@@ -360,30 +380,20 @@ def place_program(
     say = progress if progress is not None else silent
     options = ProgramOptions() if options is None else options
     placements = grid.placements()
-    say(f"checking the reach of {len(placements)} placements")
-    reached = [_reach(robot, program, p) for p in placements]
-    if all(isinstance(r, Candidate) for r in reached):
-        raise _refusal([r for r in reached if isinstance(r, Candidate)])
-    say("today's placement: optimising")
-    today_result = optimize_program(robot, program, options)
-    settings = today_result.settings
+    say("today's placement: simulating the program as written")
+    settings = program_settings(robot, program, options)
     fixed = replace(
         options,
         cycle_time=settings.cycle_time,
         v_max=settings.caps.speed,
         a_max=settings.caps.acceleration,
     )
-    today = _judged(BasePlacement(), today_result)
-    todo = [
-        (i, placement, moved)
-        for i, (placement, moved) in enumerate(zip(placements, reached, strict=True))
-        if not isinstance(moved, Candidate) and not placement.today
-    ]
-    found = _optimise_all(robot, todo, fixed, say, workers)
-    candidates = [
-        r if isinstance(r, Candidate) else today if p.today else found[i]
-        for i, (p, r) in enumerate(zip(placements, reached, strict=True))
-    ]
+    tasks: list[_Task] = [(_today, (robot, program, options))]
+    tasks += [(_candidate, (robot, program, p, fixed)) for p in placements if not p.today]
+    found = _optimise_all(tasks, say, workers)
+    today = found[0]
+    rest = iter(found[1:])
+    candidates = [today if p.today else next(rest) for p in placements]
     if not any(c.reachable for c in candidates):
         raise _refusal(candidates)
     best = today if today.reachable else None
@@ -395,9 +405,13 @@ def place_program(
     return PlacementSearch(today, kept, best, fixed)
 
 
+#: one placement's work: a function of this module and its arguments (picklable: run on a pool)
+_Task = tuple[Callable[..., Candidate], tuple[Any, ...]]
+
+
 def _workers(count: int) -> int:
-    """Processes for ``count`` candidates: one per core this process may use, at most one per
-    candidate (each candidate's result does not depend on which process computes it)."""
+    """Processes for ``count`` tasks: one per core this process may use, at most one per
+    task (each task's result does not depend on which process computes it)."""
     try:
         cores = len(os.sched_getaffinity(0))
     except AttributeError:  # (not on every platform)
@@ -405,35 +419,32 @@ def _workers(count: int) -> int:
     return max(1, min(cores, count))
 
 
-def _optimise_all(
-    robot: Robot,
-    todo: list[tuple[int, BasePlacement, RobotProgram]],
-    options: ProgramOptions,
-    say: Say,
-    workers: int | None,
-) -> dict[int, Candidate]:
-    """Every reachable candidate optimised (:func:`_optimised`), on ``workers`` processes (None:
-    one per core); by index."""
-    count = len(todo)
+def _optimise_all(tasks: list[_Task], say: Say, workers: int | None) -> list[Candidate]:
+    """Every task's candidate, in the order of ``tasks``, computed on ``workers`` processes
+    (None: one per core; one: in this process). A task that raises raises here."""
+    count = len(tasks)
     n = _workers(count) if workers is None else max(1, min(workers, count))
     out: dict[int, Candidate] = {}
     if n <= 1:
-        for done, (i, placement, moved) in enumerate(todo):
-            say(f"placement {placement.label()}", done=done + 1, total=count)
-            out[i] = _optimised(robot, moved, placement, options)
-        return out
-    say(f"optimising {count} placements on {n} processes")
+        for i, (task, args) in enumerate(tasks):
+            say(_label(i, args), done=i, total=count)
+            out[i] = task(*args)
+        say("placements optimised", done=count, total=count)
+        return [out[i] for i in range(count)]
+    say(f"optimising {count} placements on {n} processes", done=0, total=count)
     context = multiprocessing.get_context("spawn")  # no thread of this process is copied
     with ProcessPoolExecutor(max_workers=n, mp_context=context) as pool:
-        futures = {
-            pool.submit(_optimised, robot, moved, placement, options): i
-            for i, placement, moved in todo
-        }
+        futures = {pool.submit(task, *args): i for i, (task, args) in enumerate(tasks)}
         for done, future in enumerate(as_completed(futures)):
             i = futures[future]
             out[i] = future.result()
             say(f"placement {out[i].placement.label()}", done=done + 1, total=count)
-    return out
+    return [out[i] for i in range(count)]
+
+
+def _label(i: int, args: tuple[Any, ...]) -> str:
+    """What task ``i`` (of :func:`place_program`'s list) works on, for the progress line."""
+    return "today's placement" if i == 0 else f"placement {args[2].label()}"
 
 
 def _better(a: Candidate, b: Candidate) -> bool:
