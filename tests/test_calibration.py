@@ -149,6 +149,11 @@ def test_cli_import_calibration_writes_a_calibration_robot(
     )
     assert "bad.txt:9: expected 6 numbers" in capsys.readouterr().err
     assert not (tmp_path / "x.toml").exists()
+    unknown = ["robot", "import-calibration", "ur5e", str(bad), "--friction", "dahl"]
+    assert main([*unknown, "--out", str(tmp_path / "x.toml")]) == 1
+    err = capsys.readouterr().err  # the family is judged before the file is read
+    assert "--friction: must be one of" in err and "got 'dahl'" in err and "bad.txt" not in err
+    assert not (tmp_path / "x.toml").exists()
 
 
 @real

@@ -7,7 +7,10 @@ import os
 
 from kinergy.api.common import PathLike, RobotLike, robot_of
 from kinergy.checks import choice
+from kinergy.errors import KinergyError
 from kinergy.files import check_outputs, check_replaceable
+from kinergy.friction.model import FrictionModel
+from kinergy.identification.options import FrictionSearch, friction_option
 from kinergy.model.export import Export
 from kinergy.model.library import load_robot
 from kinergy.model.urdf import UrdfImport
@@ -44,7 +47,7 @@ def import_calibration(
     calibration: PathLike,
     *,
     out: PathLike,
-    friction: str = "auto",
+    friction: FrictionModel | FrictionSearch | str = "auto",
 ) -> CalibrationImport:
     """``kinergy robot import-calibration``: the drives of ``robot`` (a built-in name or a robot
     file) from a UR joint calibration summary (torque constants, friction as ``friction``: a
@@ -58,7 +61,10 @@ def import_calibration(
     """
     inputs = [os.fspath(calibration)] + ([os.fspath(robot)] if os.path.exists(robot) else [])
     check_outputs([("--out", out)], inputs)
-    return run_import(load_robot(robot), calibration, friction=friction, out=out)
+    family = friction_option(friction)  # the family resolved, once, at the edge
+    if family is None:
+        raise KinergyError("--friction: a calibration import needs a family or auto")
+    return run_import(load_robot(robot), calibration, friction=family, out=out)
 
 
 def export_robot(

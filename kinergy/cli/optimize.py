@@ -139,7 +139,7 @@ def _saving(run: api.OptimizeRun) -> list[str]:
     lines = [
         f"Saving: {100 * result.saving_supply:.1f} % of what the arm draws from its supply per "
         f"cycle ({own.e_supply:.1f} J -> {opt.e_supply:.1f} J: the motors on the DC bus, braking "
-        f"lost in the shunt, plus the standing draw of {result.settings.standby:g} W over the "
+        f"lost in the shunt, plus the standing draw of {result.settings.standby:.1f} W over the "
         f"cycle); {100 * result.saving_motors:.1f} % of the motors' energy alone "
         f"({own.e_elec:.1f} J -> {opt.e_elec:.1f} J); model-predicted",
         f"The written program read back and simulated again: {run.readback:.1f} J "

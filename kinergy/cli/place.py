@@ -103,7 +103,7 @@ def place_text(run: api.PlaceRun) -> str:
             f"best placement: {best.placement.label()}: {_energy(best)} J optimised; its "
             f"written program read back and simulated again: {run.readback:.1f} J, "
             f"{100 * run.saving:.1f} % less than today's placement beyond the program levers "
-            f"(supply energy: the motors and the standing draw of {best.result.settings.standby:g}"
+            f"(supply energy: the motors and the standing draw of {best.result.settings.standby:.1f}"
             f" W over the cycle; the motors' alone {_percent(search.saving_motors)} less)",
         ),
     ]

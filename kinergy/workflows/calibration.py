@@ -37,7 +37,7 @@ from kinergy.identification.friction_curve import (
     fit_curve,
     points_from,
 )
-from kinergy.identification.options import AUTO, FrictionSearch, friction_option
+from kinergy.identification.options import AUTO, FrictionSearch
 from kinergy.io.ur_calibration import JointCalibration, read_ur_calibration
 from kinergy.jsonable import to_jsonable
 from kinergy.model.library import library_names, load_robot
@@ -206,7 +206,7 @@ def import_calibration(
     robot: Robot,
     path: str | os.PathLike[str],
     *,
-    friction: FrictionModel | FrictionSearch | str = AUTO,
+    friction: FrictionModel | FrictionSearch = AUTO,
     out: str | os.PathLike[str] | None = None,
 ) -> CalibrationImport:
     """Import a UR joint calibration summary into ``robot`` (module docstring); write the robot
@@ -218,14 +218,11 @@ def import_calibration(
         A bad calibration file (the line and what was expected), a joint count that differs
         from the robot's, a friction model the points cannot fit.
     """
-    family = friction_option(friction)
-    if family is None:
-        raise KinergyError("--friction: a calibration import needs a family or auto")
     cal = read_ur_calibration(path)
     if len(cal.joints) != robot.n:
         raise KinergyError(f"{cal.path}: {len(cal.joints)} joints but {robot.name} has {robot.n}")
     _check_robot(robot, cal.path, [c.torque_constant for c in cal.joints])
-    joints = [_joint(robot, j, c, family) for j, c in enumerate(cal.joints)]
+    joints = [_joint(robot, j, c, friction) for j, c in enumerate(cal.joints)]
     revision = cal.joints[0].revision
     ref = f"UR joint calibration summary {os.path.basename(cal.path)} (revision {revision})"
     calibrated = _calibrated(robot, joints, ref)
