@@ -302,15 +302,15 @@ def _reach(
 
 
 def _candidate(
-    robot: Robot, program: RobotProgram, placement: BasePlacement, options: ProgramOptions
+    robot: Robot,
+    moved: RobotProgram,
+    path: ProgramPath,
+    placement: BasePlacement,
+    options: ProgramOptions,
 ) -> Candidate:
-    """One placement: its reach checked (:func:`_reach`), then, if it reaches, its program
-    optimised at the cycle time and judged; everything from the placement and the options
-    alone (one task of :func:`_optimise_all`)."""
-    reached = _reach(robot, program, placement)
-    if isinstance(reached, Candidate):
-        return reached
-    moved, path = reached
+    """A reachable placement's program (``moved``, its ``path`` as :func:`_reach` found it)
+    optimised at the cycle time and judged, from its arguments alone (a task of
+    :func:`_optimise_all`)."""
     try:
         result = optimize_program(robot, moved, options, path=path)
     except KinergyError as exc:
@@ -350,9 +350,10 @@ def place_program(
 ) -> PlacementSearch:
     """Every placement of ``grid`` and today's, each checked and optimised (module docstring).
 
-    Today's cycle time and caps are resolved first (:func:`kinergy.optimize.programs.
-    program_settings`: the program simulated as written); then today's optimisation and every
-    candidate's reach check and optimisation are tasks on a pool of processes, today's first.
+    Every placement's reach is checked first (a grid out of reach is refused at once), today's
+    cycle time and caps resolved (:func:`kinergy.optimize.programs.program_settings`: the
+    program simulated as written); then today's optimisation and every reachable candidate's
+    are tasks on a pool of processes, today's first, each candidate's path sent with it.
 
     Parameters
     ----------
@@ -380,6 +381,10 @@ def place_program(
     say = progress if progress is not None else silent
     options = ProgramOptions() if options is None else options
     placements = grid.placements()
+    say(f"checking the reach of {len(placements)} placements")
+    reached = [_reach(robot, program, p) for p in placements]
+    if all(isinstance(r, Candidate) for r in reached):
+        raise _refusal([r for r in reached if isinstance(r, Candidate)])
     say("today's placement: simulating the program as written")
     settings = program_settings(robot, program, options)
     fixed = replace(
@@ -389,11 +394,17 @@ def place_program(
         a_max=settings.caps.acceleration,
     )
     tasks: list[_Task] = [(_today, (robot, program, options))]
-    tasks += [(_candidate, (robot, program, p, fixed)) for p in placements if not p.today]
+    index: dict[int, int] = {}  # placement -> its task
+    for i, (placement, r) in enumerate(zip(placements, reached, strict=True)):
+        if not isinstance(r, Candidate) and not placement.today:
+            index[i] = len(tasks)
+            tasks.append((_candidate, (robot, *r, placement, fixed)))
     found = _optimise_all(tasks, say, workers)
     today = found[0]
-    rest = iter(found[1:])
-    candidates = [today if p.today else next(rest) for p in placements]
+    candidates = [
+        r if isinstance(r, Candidate) else today if p.today else found[index[i]]
+        for i, (p, r) in enumerate(zip(placements, reached, strict=True))
+    ]
     if not any(c.reachable for c in candidates):
         raise _refusal(candidates)
     best = today if today.reachable else None
@@ -435,16 +446,21 @@ def _optimise_all(tasks: list[_Task], say: Say, workers: int | None) -> list[Can
     context = multiprocessing.get_context("spawn")  # no thread of this process is copied
     with ProcessPoolExecutor(max_workers=n, mp_context=context) as pool:
         futures = {pool.submit(task, *args): i for i, (task, args) in enumerate(tasks)}
-        for done, future in enumerate(as_completed(futures)):
-            i = futures[future]
-            out[i] = future.result()
-            say(f"placement {out[i].placement.label()}", done=done + 1, total=count)
+        try:
+            for done, future in enumerate(as_completed(futures)):
+                i = futures[future]
+                out[i] = future.result()
+                say(f"placement {out[i].placement.label()}", done=done + 1, total=count)
+        except BaseException:  # today's program cannot run, Ctrl-C: the rest is not started
+            for future in futures:
+                future.cancel()
+            raise
     return [out[i] for i in range(count)]
 
 
 def _label(i: int, args: tuple[Any, ...]) -> str:
     """What task ``i`` (of :func:`place_program`'s list) works on, for the progress line."""
-    return "today's placement" if i == 0 else f"placement {args[2].label()}"
+    return "today's placement" if i == 0 else f"placement {args[3].label()}"
 
 
 def _better(a: Candidate, b: Candidate) -> bool:
