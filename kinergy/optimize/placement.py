@@ -370,7 +370,7 @@ def place_program(
         Processes the placements are optimised on (default: one per core). Each placement's
         optimisation is independent of the others, of the order they run in and of the process
         (its linear algebra on one thread: :func:`kinergy.optimize.samples.serial`): the same
-        result on any host and with any number of processes.
+        result whatever the host's core count and with any number of processes.
 
     Raises
     ------

@@ -78,7 +78,8 @@ def serial(func: Callable[_P, _R]) -> Callable[_P, _R]:
     whose partial sums add in another order, and the solver's path (SLSQP) follows the last bit.
     Its default is one thread per core of the host (and what an earlier caller left in force in
     the process): the same placement came out 196.0703 J on two BLAS threads and 196.0856 J on
-    one. On one thread the answer is the same on any host, in any process and any worker."""
+    one. On one thread the answer is the same whatever the host's core count, in any process and
+    any worker (a BLAS built for another processor may still differ in the last bits)."""
 
     @functools.wraps(func)
     def wrapper(*args: _P.args, **kwargs: _P.kwargs) -> _R:
