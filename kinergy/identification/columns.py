@@ -305,11 +305,6 @@ class Regression:
         return any(m.needs_load for m in self.models)
 
     @property
-    def needs_flow(self) -> bool:
-        """Whether any friction model depends on the direction of power flow (``power_flow``)."""
-        return any(m in LOAD_DEPENDENT for m in self.models)
-
-    @property
     def own_load(self) -> list[int]:
         """The motors whose friction takes the load torque the fitted model gives itself
         (``load_coulomb``, ``load_thermal_power_law``: the link side's, which friction does

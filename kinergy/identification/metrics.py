@@ -26,14 +26,9 @@ EXCITED_RANGE = 0.02
 
 def r_squared(measured: ArrayLike, predicted: ArrayLike) -> Array:
     """Coefficient of determination per column, ``1 - SS_res / SS_tot``; (N, n) -> (n,). NaN
-    where the measured signal does not vary (``SS_tot`` at round-off of its level)."""
-    y = np.asarray(measured, dtype=float)
-    p = np.asarray(predicted, dtype=float)
-    ss_res = np.sum((y - p) ** 2, axis=0)
-    ss_tot = np.sum((y - y.mean(axis=0)) ** 2, axis=0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        varies = ss_tot > 1e-20 * np.maximum(np.sum(y**2, axis=0), 1e-300)
-        return np.where(varies, 1.0 - ss_res / ss_tot, np.nan)
+    where the measured signal does not vary (``SS_tot`` at round-off of its level): the ``r2``
+    of :func:`fit_metrics`."""
+    return np.array([m.r2 for m in fit_metrics(measured, predicted)])
 
 
 def rmse(measured: ArrayLike, predicted: ArrayLike) -> Array:

@@ -36,8 +36,14 @@ from __future__ import annotations
 
 import difflib
 import re
+from collections.abc import Mapping
+
+import numpy as np
+
+from kinergy.errors import KinergyError
 
 __all__ = [
+    "CHECKED_SIGNALS",
     "FIELDS",
     "JOINTS",
     "KINERGY_FIELDS",
@@ -45,6 +51,7 @@ __all__ = [
     "SAFETY_MOVING",
     "SKIP",
     "USED",
+    "check_widths",
     "closest",
     "is_known",
     "vector_member",
@@ -169,29 +176,27 @@ KINERGY_FIELDS: dict[str, int | str] = {
 #: every named field: RTDE's and kinergy's, name -> width
 FIELDS: dict[str, int | str] = {**RTDE_FIELDS, **KINERGY_FIELDS}
 
+#: the measured signals kinergy uses, which the log checks read whenever a log has them
+CHECKED_SIGNALS = (
+    *(f"{kind}_{x}" for kind in ("target", "actual") for x in ("q", "qd", "qdd")),
+    "target_moment",
+    "actual_current",
+    "target_current",
+    "actual_joint_torque",
+    "actual_current_as_torque",
+    "actual_joint_voltage",
+    "joint_temperatures",
+    "actual_robot_voltage",
+    "actual_robot_current",
+    "payload",
+    "payload_cog",
+    "payload_inertia",
+)
+
 #: the fields kinergy uses (the others are read only to be passed on): a value in them that is
 #: not a number is a damaged line, where a logger's text in an unused field is ignored
 USED = frozenset(
-    {
-        "timestamp",
-        *(f"{kind}_{x}" for kind in ("target", "actual") for x in ("q", "qd", "qdd")),
-        "target_moment",
-        "target_current",
-        "actual_current",
-        "actual_current_as_torque",
-        "actual_joint_torque",
-        "actual_joint_voltage",
-        "joint_temperatures",
-        "actual_robot_voltage",
-        "actual_robot_current",
-        "robot_mode",
-        "safety_mode",
-        "runtime_state",
-        "payload",
-        "payload_cog",
-        "payload_inertia",
-        "segment",
-    }
+    {"timestamp", *CHECKED_SIGNALS, "robot_mode", "safety_mode", "runtime_state", "segment"}
 )
 
 #: RTDE's numbered registers (scalars): kind -> the numbers there are
@@ -236,3 +241,12 @@ def closest(name: str, among: list[str] | None = None) -> str | None:
     lowered = {p.lower(): p for p in pool}
     match = difflib.get_close_matches(name.lower(), list(lowered), n=1, cutoff=0.75)
     return lowered[match[0]] if match else None
+
+
+def check_widths(signals: Mapping[str, np.ndarray], n: int, where: str) -> None:
+    """Raise when a field of one value per joint (:data:`JOINTS`) in ``signals`` does not have
+    ``n`` columns (``where: target_q has 7 joints but the robot has 6``)."""
+    for name, x in signals.items():
+        if FIELDS.get(name) == JOINTS and (x.ndim != 2 or x.shape[1] != n):
+            width = 1 if x.ndim == 1 else x.shape[1]
+            raise KinergyError(f"{where}: {name} has {width} joints but the robot has {n}")

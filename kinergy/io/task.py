@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from kinergy.arrays import Array
+from kinergy.checks import number
 from kinergy.errors import KinergyError
 from kinergy.files import read_text, read_toml
 from kinergy.model.library import library_names, load_robot
@@ -57,15 +58,6 @@ BUILTIN_TASKS = {"test-a": 1, "test-b": 2}
 
 _TOP_KEYS = {"robot", "unit", "speed", "acceleration", "start", "move", "name", "description"}
 _MOVE_KEYS = {"q", "v", "a", "r", "ur_r"}
-
-
-def _number(value: Any, what: str, *, low: float, strict: bool) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise KinergyError(f"{what}: expected a number, got {value!r}")
-    x = float(value)
-    if not math.isfinite(x) or x < low or (strict and x == low):
-        raise KinergyError(f"{what}: must be {'>' if strict else '>='} {low:g}, got {value!r}")
-    return x
 
 
 def _angles(value: Any, what: str, scale: float, n: int | None) -> Array:
@@ -100,10 +92,10 @@ def _move(
     q = _angles(move["q"], f"{where}.q", scale, n)
     return (
         q,
-        _number(move["v"], f"{where}.v", low=0.0, strict=True) if "v" in move else defaults[0],
-        _number(move["a"], f"{where}.a", low=0.0, strict=True) if "a" in move else defaults[1],
-        _number(move.get("r", 0.0), f"{where}.r", low=0.0, strict=False),
-        _number(move.get("ur_r", 0.0), f"{where}.ur_r", low=0.0, strict=False),
+        number(move["v"], f"{where}.v", gt=0.0) if "v" in move else defaults[0],
+        number(move["a"], f"{where}.a", gt=0.0) if "a" in move else defaults[1],
+        number(move.get("r", 0.0), f"{where}.r", ge=0.0),
+        number(move.get("ur_r", 0.0), f"{where}.ur_r", ge=0.0),
     )
 
 
@@ -172,9 +164,9 @@ def task_from_dict(
     scale = math.pi / 180.0 if unit == "deg" else 1.0
     acc_default, speed_default = MOVE_DEFAULTS["movej"]
     speed = data.get("speed")
-    speed = speed_default if speed is None else _number(speed, "speed", low=0.0, strict=True)
+    speed = speed_default if speed is None else number(speed, "speed", gt=0.0)
     acc = data.get("acceleration")
-    acc = acc_default if acc is None else _number(acc, "acceleration", low=0.0, strict=True)
+    acc = acc_default if acc is None else number(acc, "acceleration", gt=0.0)
     moves = data.get("move")
     if moves is None:
         raise KinergyError("no [[move]] entries: a task needs at least one move")

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kinergy.arrays import Array
+from kinergy.checks import number
 from kinergy.errors import KinergyError
 from kinergy.files import atomic_write
 from kinergy.io.urscript_reader import (
@@ -318,13 +319,10 @@ def _servo_steps(t: ArrayLike, q: ArrayLike) -> tuple[Array, Array, float]:
 def _check_servo(
     start_speed: float, start_acceleration: float, lookahead_time: float, gain: float
 ) -> None:
-    for label, value in (("start_speed", start_speed), ("start_acceleration", start_acceleration)):
-        if not (np.isfinite(value) and value > 0.0):
-            raise KinergyError(f"{label}: must be > 0, got {value}")
-    if not 0.03 <= lookahead_time <= 0.2:
-        raise KinergyError(f"lookahead_time: must be in [0.03, 0.2] s, got {lookahead_time}")
-    if not 100.0 <= gain <= 2000.0:
-        raise KinergyError(f"gain: must be in [100, 2000], got {gain}")
+    number(start_speed, "start_speed", gt=0.0)
+    number(start_acceleration, "start_acceleration", gt=0.0)
+    number(lookahead_time, "lookahead_time", ge=0.03, le=0.2)
+    number(gain, "gain", ge=100.0, le=2000.0)
 
 
 def servoj_program(

@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
-from kinergy.io.fields import FIELDS, JOINTS
+from kinergy.io.fields import check_widths
 from kinergy.io.log import Log
 from kinergy.logs.payload import from_columns, payload_columns, payload_problem
 from kinergy.logs.robot_check import LOADS, judge_robot, noise_name, without_effort
@@ -126,7 +126,7 @@ class LogCheck:
         if not len(chunk):
             return
         if self.last is None:
-            self._check_widths(chunk)
+            check_widths(chunk.signals, self.robot.n, self.path)
         if math.isnan(self.period):
             steps = np.diff(chunk.t)
             if steps.size:
@@ -140,13 +140,6 @@ class LogCheck:
         self.samples += len(chunk)
         last = slice(len(chunk) - 1, len(chunk))
         self.last = Log(self.path, chunk.t[last], {k: x[last] for k, x in chunk.signals.items()})
-
-    def _check_widths(self, chunk: Log) -> None:
-        n = self.robot.n
-        for name, x in chunk.signals.items():
-            if FIELDS.get(name) == JOINTS and (x.ndim != 2 or x.shape[1] != n):
-                width = 1 if x.ndim == 1 else x.shape[1]
-                raise KinergyError(f"{self.path}: {name} has {width} joints but the robot has {n}")
 
     def _extremes(self, chunk: Log) -> None:
         for name, x in chunk.signals.items():

@@ -13,7 +13,6 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from kinergy.arrays import Array
-from kinergy.errors import KinergyError
 from kinergy.io.log import Log
 
 __all__ = [
@@ -22,7 +21,6 @@ __all__ = [
     "SAMPLE_FIELDS",
     "IdentData",
     "Motion3",
-    "check_joints",
     "ident_data",
 ]
 
@@ -140,16 +138,6 @@ JOINT_SIGNALS = (
     "joint_temperatures",
     "actual_joint_voltage",
 )
-
-
-def check_joints(log: Log, n_joints: int) -> None:
-    """Raise when a joint signal of ``log`` does not have ``n_joints`` columns."""
-    for name in JOINT_SIGNALS:
-        if name in log and (log[name].ndim != 2 or log[name].shape[1] != n_joints):
-            width = 1 if log[name].ndim == 1 else log[name].shape[1]
-            raise KinergyError(
-                f"{log.path}: {name} has {width} joints but the robot has {n_joints}"
-            )
 
 
 #: (q, qd, qdd), each (N, n)

@@ -60,12 +60,12 @@ from scipy.interpolate import CubicSpline
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
+from kinergy.io.fields import check_widths
 from kinergy.io.formats import CHUNK_ROWS
 from kinergy.io.log import Log
 from kinergy.io.motion import HALO
-from kinergy.io.segments import segment_bounds
 from kinergy.logs.filtering import FILTER_REACH, check_cutoff, default_cutoff, lowpass
-from kinergy.logs.ident_data import SAMPLE_FIELDS, IdentData, Motion3, check_joints, ident_data
+from kinergy.logs.ident_data import SAMPLE_FIELDS, IdentData, Motion3, ident_data
 from kinergy.logs.lag import LAG_BATCH_ROWS, batches, delay, lag_samples, lag_search
 from kinergy.logs.payload import with_logged
 from kinergy.logs.samples import STATE, resample, running_range, uniform_grid
@@ -82,7 +82,6 @@ __all__ = [
     "commanded_motion",
     "prepare",
     "prepare_segment",
-    "segment_paths",
     "spill_log",
 ]
 
@@ -270,7 +269,7 @@ def prepare_segment(
         raise KinergyError(f"{path}: fewer than 2 samples where the program runs")
     grid = uniform_grid(spill.state.t[rows])
     names = spill.names
-    check_joints(spill.head, n_joints)
+    check_widths(spill.head.signals, n_joints, spill.head.path)
     has_actual = {"actual_q", "actual_qd"} <= names
     if {"target_q", "target_qd"} <= names:
         segment = PreparedSegment(path, spill, rows, grid, 0.0, DELAYED)
@@ -305,12 +304,3 @@ def prepare(log: Log, n_joints: int, *, cutoff: float | None = None) -> IdentDat
         return prepare_segment(spill, (0, len(log)), log.path, n_joints, cutoff).whole()
     finally:
         spill.close()
-
-
-def segment_paths(spill: LogSpill) -> list[tuple[tuple[int, int], str]]:
-    """The segments of a spilled log (:func:`kinergy.io.segments.segment_bounds`) and the path
-    each is named by (``#k`` when there are several, as :func:`~kinergy.io.segments.split_segments`)."""
-    bounds = segment_bounds(spill.state.t, spill.state.signals.get("segment"))
-    if len(bounds) == 1:
-        return [(bounds[0], spill.path)]
-    return [(ab, f"{spill.path}#{k}") for k, ab in enumerate(bounds)]

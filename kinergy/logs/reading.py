@@ -32,7 +32,7 @@ from kinergy.io.columns import (
     parse_column_spec,
     printable,
 )
-from kinergy.io.fields import closest
+from kinergy.io.fields import CHECKED_SIGNALS, closest
 from kinergy.io.formats import CHUNK_ROWS, iter_log
 from kinergy.io.log import Log
 from kinergy.io.panda_layout import is_panda_layout, panda_files
@@ -43,30 +43,10 @@ from kinergy.logs.window import TimeWindow, WindowCut
 from kinergy.model.robot import Payload, Robot
 from kinergy.model.toml import parse_payload
 
-__all__ = ["CHECKED_SIGNALS", "MAX_CUTOFF", "CheckedLog", "InputLogs", "LogReading", "Provenance"]
+__all__ = ["MAX_CUTOFF", "CheckedLog", "InputLogs", "LogReading", "Provenance"]
 
 #: Hz: the highest low-pass cutoff ``--cutoff`` takes
 MAX_CUTOFF = 1e6
-
-#: the signals the checks read whenever a log has them (besides those a command asks for)
-CHECKED_SIGNALS = (
-    "target_q",
-    "target_qd",
-    "target_qdd",
-    "actual_q",
-    "actual_qd",
-    "actual_qdd",
-    "target_moment",
-    "actual_current",
-    "target_current",
-    "actual_joint_torque",
-    "actual_current_as_torque",
-    "actual_joint_voltage",
-    "joint_temperatures",
-    "actual_robot_voltage",
-    "actual_robot_current",
-    *PAYLOAD_SIGNALS,
-)
 
 
 @dataclass(frozen=True)

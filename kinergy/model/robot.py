@@ -298,11 +298,6 @@ class Thermal:
         for name in ("capacity", "resistance"):
             object.__setattr__(self, name, _number(getattr(self, name), name, low=0.0))
 
-    @property
-    def time_constant(self) -> float:
-        """``C R_th``, s: how fast the joint approaches its steady temperature."""
-        return self.capacity * self.resistance
-
 
 @dataclass(frozen=True, eq=False)
 class Drive:

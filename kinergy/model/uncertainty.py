@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from kinergy.arrays import Array
+from kinergy.checks import integer, number
 from kinergy.errors import KinergyError
 
 if TYPE_CHECKING:
@@ -96,10 +97,9 @@ class Uncertainty:
                 raise KinergyError(f"uncertainty.parameters: unknown parameter {name!r}")
         if not np.all(np.isfinite(modes)):
             raise KinergyError("uncertainty.modes: must be finite numbers")
-        if not (isinstance(self.dof, int) and self.dof >= 1):
-            raise KinergyError(f"uncertainty.dof: must be an integer >= 1, got {self.dof!r}")
-        if not (np.isfinite(self.calibration) and self.calibration > 0):
-            raise KinergyError(f"uncertainty.calibration: must be > 0, got {self.calibration!r}")
+        object.__setattr__(self, "dof", integer(self.dof, "uncertainty.dof", ge=1))
+        calibration = number(self.calibration, "uncertainty.calibration", gt=0.0)
+        object.__setattr__(self, "calibration", calibration)
 
     @property
     def covariance(self) -> Array:

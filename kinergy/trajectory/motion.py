@@ -6,7 +6,6 @@ import enum
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike
 
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
@@ -109,13 +108,4 @@ class Motion:
         """Samples ``start:stop``."""
         return Motion(
             self.t[start:stop], self.q[start:stop], self.qd[start:stop], self.qdd[start:stop]
-        )
-
-    @classmethod
-    def from_arrays(cls, t: ArrayLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> Motion:
-        return cls(
-            np.asarray(t, float),
-            np.asarray(q, float),
-            np.asarray(qd, float),
-            np.asarray(qdd, float),
         )
