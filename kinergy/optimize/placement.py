@@ -26,6 +26,7 @@ import enum
 import math
 import multiprocessing
 import os
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, replace
 from typing import Any
@@ -37,8 +38,9 @@ from kinergy.messages import Say, silent
 from kinergy.model.robot import Robot
 from kinergy.optimize.levers import CYCLE_TOLERANCE
 from kinergy.optimize.options import ProgramOptions
-from kinergy.optimize.programs import ProgramOptimization, optimize_program
-from kinergy.trajectory.program_path import program_path
+from kinergy.optimize.programs import ProgramOptimization, optimize_program, program_settings
+from kinergy.optimize.samples import serial
+from kinergy.trajectory.program_path import ProgramPath, program_path
 from kinergy.trajectory.program_placement import BasePlacement, moved_program
 from kinergy.trajectory.robot_program import RobotProgram
 
@@ -288,26 +290,38 @@ def _judged(placement: BasePlacement, result: ProgramOptimization) -> Candidate:
 
 def _reach(
     robot: Robot, program: RobotProgram, placement: BasePlacement
-) -> RobotProgram | Candidate:
-    """The program moved to ``placement`` if every target, line and joint limit holds there;
-    else the candidate marked out of reach with the line that fails."""
+) -> tuple[RobotProgram, ProgramPath] | Candidate:
+    """The program moved to ``placement`` and its path if every target, line and joint limit
+    holds there; else the candidate marked out of reach with the line that fails."""
     try:
         moved = moved_program(robot, program, placement)
-        program_path(robot, moved)
+        path = program_path(robot, moved)
     except KinergyError as exc:
         return Candidate(placement, Reason.OUT_OF_REACH, str(exc))
-    return moved
+    return moved, path
 
 
-def _optimised(
-    robot: Robot, moved: RobotProgram, placement: BasePlacement, options: ProgramOptions
+def _candidate(
+    robot: Robot,
+    moved: RobotProgram,
+    path: ProgramPath,
+    placement: BasePlacement,
+    options: ProgramOptions,
 ) -> Candidate:
-    """A reachable placement's program optimised at the cycle time and judged."""
+    """A reachable placement's program (``moved``, its ``path`` as :func:`_reach` found it)
+    optimised at the cycle time and judged, from its arguments alone (a task of
+    :func:`_optimise_all`)."""
     try:
-        result = optimize_program(robot, moved, options)
+        result = optimize_program(robot, moved, options, path=path)
     except KinergyError as exc:
         return Candidate(placement, Reason.CANNOT_RUN, str(exc))
     return _judged(placement, result)
+
+
+def _today(robot: Robot, program: RobotProgram, options: ProgramOptions) -> Candidate:
+    """Today's placement: the program as it stands optimised with ``options`` and judged (it
+    raises, where a candidate is marked, when the program cannot run)."""
+    return _judged(BasePlacement(), optimize_program(robot, program, options))
 
 
 def _refusal(candidates: list[Candidate]) -> KinergyError:
@@ -324,6 +338,7 @@ def _refusal(candidates: list[Candidate]) -> KinergyError:
     )
 
 
+@serial
 def place_program(
     robot: Robot,
     program: RobotProgram,
@@ -335,6 +350,11 @@ def place_program(
 ) -> PlacementSearch:
     """Every placement of ``grid`` and today's, each checked and optimised (module docstring).
 
+    Every placement's reach is checked first (a grid out of reach is refused at once), today's
+    cycle time and caps resolved (:func:`kinergy.optimize.programs.program_settings`: the
+    program simulated as written); then today's optimisation and every reachable candidate's
+    are tasks on a pool of processes, today's first, each candidate's path sent with it.
+
     Parameters
     ----------
     robot : Robot
@@ -345,11 +365,12 @@ def place_program(
         The levers (as :func:`kinergy.optimize.programs.optimize_program`); the cycle time and
         caps default to today's program's own and hold for every candidate.
     progress : Say, optional
-        Told each step, and as each candidate is done how many of them are.
+        Told each step, and as each placement is done how many of them are.
     workers : int, optional
-        Processes the candidates are optimised on (default: one per core). Each candidate's
-        optimisation is independent of the others and of the order they run in: the same
-        result on any host and with any number of processes.
+        Processes the placements are optimised on (default: one per core). Each placement's
+        optimisation is independent of the others, of the order they run in and of the process
+        (its linear algebra on one thread: :func:`kinergy.optimize.samples.serial`): the same
+        result whatever the host's core count and with any number of processes.
 
     Raises
     ------
@@ -364,24 +385,24 @@ def place_program(
     reached = [_reach(robot, program, p) for p in placements]
     if all(isinstance(r, Candidate) for r in reached):
         raise _refusal([r for r in reached if isinstance(r, Candidate)])
-    say("today's placement: optimising")
-    today_result = optimize_program(robot, program, options)
-    settings = today_result.settings
+    say("today's placement: simulating the program as written")
+    settings = program_settings(robot, program, options)
     fixed = replace(
         options,
         cycle_time=settings.cycle_time,
         v_max=settings.caps.speed,
         a_max=settings.caps.acceleration,
     )
-    today = _judged(BasePlacement(), today_result)
-    todo = [
-        (i, placement, moved)
-        for i, (placement, moved) in enumerate(zip(placements, reached, strict=True))
-        if not isinstance(moved, Candidate) and not placement.today
-    ]
-    found = _optimise_all(robot, todo, fixed, say, workers)
+    tasks: list[_Task] = [(_today, (robot, program, options))]
+    index: dict[int, int] = {}  # placement -> its task
+    for i, (placement, r) in enumerate(zip(placements, reached, strict=True)):
+        if not isinstance(r, Candidate) and not placement.today:
+            index[i] = len(tasks)
+            tasks.append((_candidate, (robot, *r, placement, fixed)))
+    found = _optimise_all(tasks, say, workers)
+    today = found[0]
     candidates = [
-        r if isinstance(r, Candidate) else today if p.today else found[i]
+        r if isinstance(r, Candidate) else today if p.today else found[index[i]]
         for i, (p, r) in enumerate(zip(placements, reached, strict=True))
     ]
     if not any(c.reachable for c in candidates):
@@ -395,9 +416,13 @@ def place_program(
     return PlacementSearch(today, kept, best, fixed)
 
 
+#: one placement's work: a function of this module and its arguments (picklable: run on a pool)
+_Task = tuple[Callable[..., Candidate], tuple[Any, ...]]
+
+
 def _workers(count: int) -> int:
-    """Processes for ``count`` candidates: one per core this process may use, at most one per
-    candidate (each candidate's result does not depend on which process computes it)."""
+    """Processes for ``count`` tasks: one per core this process may use, at most one per
+    task (each task's result does not depend on which process computes it)."""
     try:
         cores = len(os.sched_getaffinity(0))
     except AttributeError:  # (not on every platform)
@@ -405,35 +430,37 @@ def _workers(count: int) -> int:
     return max(1, min(cores, count))
 
 
-def _optimise_all(
-    robot: Robot,
-    todo: list[tuple[int, BasePlacement, RobotProgram]],
-    options: ProgramOptions,
-    say: Say,
-    workers: int | None,
-) -> dict[int, Candidate]:
-    """Every reachable candidate optimised (:func:`_optimised`), on ``workers`` processes (None:
-    one per core); by index."""
-    count = len(todo)
+def _optimise_all(tasks: list[_Task], say: Say, workers: int | None) -> list[Candidate]:
+    """Every task's candidate, in the order of ``tasks``, computed on ``workers`` processes
+    (None: one per core; one: in this process). A task that raises raises here."""
+    count = len(tasks)
     n = _workers(count) if workers is None else max(1, min(workers, count))
     out: dict[int, Candidate] = {}
     if n <= 1:
-        for done, (i, placement, moved) in enumerate(todo):
-            say(f"placement {placement.label()}", done=done + 1, total=count)
-            out[i] = _optimised(robot, moved, placement, options)
-        return out
-    say(f"optimising {count} placements on {n} processes")
+        for i, (task, args) in enumerate(tasks):
+            say(_label(i, args), done=i, total=count)
+            out[i] = task(*args)
+        say("placements optimised", done=count, total=count)
+        return [out[i] for i in range(count)]
+    say(f"optimising {count} placements on {n} processes", done=0, total=count)
     context = multiprocessing.get_context("spawn")  # no thread of this process is copied
     with ProcessPoolExecutor(max_workers=n, mp_context=context) as pool:
-        futures = {
-            pool.submit(_optimised, robot, moved, placement, options): i
-            for i, placement, moved in todo
-        }
-        for done, future in enumerate(as_completed(futures)):
-            i = futures[future]
-            out[i] = future.result()
-            say(f"placement {out[i].placement.label()}", done=done + 1, total=count)
-    return out
+        futures = {pool.submit(task, *args): i for i, (task, args) in enumerate(tasks)}
+        try:
+            for done, future in enumerate(as_completed(futures)):
+                i = futures[future]
+                out[i] = future.result()
+                say(f"placement {out[i].placement.label()}", done=done + 1, total=count)
+        except BaseException:  # today's program cannot run, Ctrl-C: the rest is not started
+            for future in futures:
+                future.cancel()
+            raise
+    return [out[i] for i in range(count)]
+
+
+def _label(i: int, args: tuple[Any, ...]) -> str:
+    """What task ``i`` (of :func:`place_program`'s list) works on, for the progress line."""
+    return "today's placement" if i == 0 else f"placement {args[3].label()}"
 
 
 def _better(a: Candidate, b: Candidate) -> bool:

@@ -41,6 +41,7 @@ import numpy as np
 from kinergy.accounting.uncertainty import NO_UNCERTAINTY
 from kinergy.arrays import Array
 from kinergy.errors import KinergyError
+from kinergy.messages import Say, as_say
 from kinergy.model.robot import Robot
 from kinergy.model.uncertainty import Interval, interval
 from kinergy.optimize.levers import (
@@ -54,7 +55,7 @@ from kinergy.optimize.levers import (
     with_timing,
 )
 from kinergy.optimize.objectives import Objective, SupplyEnergy
-from kinergy.optimize.options import ProgramOptions, ViaPoints
+from kinergy.optimize.options import ProgramOptions, ToolSymmetry, ViaPoints
 from kinergy.optimize.problem import Caps
 from kinergy.optimize.repair import Context, at_cycle
 from kinergy.optimize.samples import serial
@@ -71,6 +72,7 @@ __all__ = [
     "ProgramSettings",
     "optimize_program",
     "pareto_front",
+    "program_settings",
 ]
 
 
@@ -298,9 +300,11 @@ def _context(
     program: RobotProgram,
     options: ProgramOptions,
     objective: Objective | None,
+    path: ProgramPath | None = None,
 ) -> tuple[ProgramPath, PathRun, Context]:
-    """The program resolved and run as written, and the context every lever is judged in (the
-    cycle time checked against the fastest possible once, here)."""
+    """The program resolved (``path``, when the caller has it) and run as written, and the
+    context every lever is judged in (the cycle time checked against the fastest possible once,
+    here)."""
     if len(program.moves) > MAX_MOVES:
         raise KinergyError(
             f"{program.path or program.name}: {len(program.moves)} moves; the optimiser takes "
@@ -308,7 +312,7 @@ def _context(
         )
     standby = robot.standby_power if options.standby is None else options.standby
     objective = SupplyEnergy(standby) if objective is None else objective
-    path = program_path(robot, program)
+    path = program_path(robot, program) if path is None else path
     if not np.any(path.travel > 0.0):
         raise KinergyError(
             f"{program.path or program.name}: no move changes the arm's position; nothing to "
@@ -322,6 +326,54 @@ def _context(
     return path, own, ctx
 
 
+class _Steps:
+    """:func:`optimize_program`'s progress: each step it starts, with the steps done of those
+    planned (simulating the program, uniform scaling to a cycle time given, the ``2 pi`` wraps and their estimate, each path lever
+    asked for, blends, timing, timing only, the targets' check: an upper bound, as a lever
+    with no cycle of states or a timing only that repeats the timing says nothing), so that a
+    terminal shows a fraction and the time left (:class:`kinergy.messages.Say`)."""
+
+    def __init__(self, say: Say, options: ProgramOptions) -> None:
+        self.say = say
+        path_levers = sum(
+            (
+                options.configurations.value == "free",
+                options.tool_symmetry is not ToolSymmetry.NONE,
+                options.via is ViaPoints.FREE,
+            )
+        )
+        rescale = int(options.cycle_time is not None)  # uniform scaling to another cycle time
+        self.total = 1 + rescale + 2 + path_levers + int(options.blends) + 3
+        self.done = 0
+
+    def __call__(self, message: str, *, last: bool = False) -> None:
+        """Start a step (``last``: the last one, whatever was skipped before it)."""
+        self.done = self.total - 1 if last else min(self.done, self.total - 1)
+        self.say(message, done=self.done, total=self.total)
+        self.done += 1
+
+
+@serial
+def program_settings(
+    robot: Robot,
+    program: RobotProgram,
+    options: ProgramOptions | None = None,
+    *,
+    objective: Objective | None = None,
+) -> ProgramSettings:
+    """The settings :func:`optimize_program` resolves for ``program`` (its cycle time and caps:
+    the program simulated as written once), without optimising.
+
+    Raises
+    ------
+    KinergyError
+        As :func:`optimize_program`.
+    """
+    options = ProgramOptions() if options is None else options
+    _, _, ctx = _context(robot, program, options, objective)
+    return ProgramSettings(options, ctx.standby, ctx.caps, ctx.budget)
+
+
 @serial
 def optimize_program(
     robot: Robot,
@@ -329,7 +381,8 @@ def optimize_program(
     options: ProgramOptions | None = None,
     *,
     objective: Objective | None = None,
-    progress: Callable[[str], None] | None = None,
+    progress: Say | Callable[[str], None] | None = None,
+    path: ProgramPath | None = None,
 ) -> ProgramOptimization:
     """The energy-optimal program doing the same job at a cycle time (module docstring).
 
@@ -342,8 +395,10 @@ def optimize_program(
         kept, no tool symmetry, blends, the program's own cycle time and peaks).
     objective : Objective, optional
         What to minimise (default :class:`SupplyEnergy` with the standing draw).
-    progress : callable, optional
-        Called with a line before each long step.
+    progress : Say or callable, optional
+        Told each step as it starts, with the steps done of those planned (:class:`_Steps`).
+    path : ProgramPath, optional
+        ``program_path(robot, program)``, when the caller has it (not computed again).
 
     Raises
     ------
@@ -352,9 +407,9 @@ def optimize_program(
         possible (naming the program line), more than :data:`MAX_MOVES` moves.
     """
     options = ProgramOptions() if options is None else options
-    say = progress if progress is not None else (lambda _: None)
+    say = _Steps(as_say(progress), options)
     say(f"{program.name}: simulating the program at 500 Hz")
-    path, own, ctx = _context(robot, program, options, objective)
+    path, own, ctx = _context(robot, program, options, objective, path)
     search = LeverSearch(ctx, own)
     if abs(ctx.budget - own.result.cycle_time) > 1e-9:
         say("uniform scaling to the cycle time")
@@ -373,7 +428,7 @@ def optimize_program(
     timed(search, say)
     _timing_only(search, path, say)
     optimized = search.best
-    say("checking the targets")
+    say("checking the targets", last=True)
     targets = target_errors(
         robot, path, optimized, symmetry=options.tool_symmetry, left_out=search.left_out
     )
@@ -396,7 +451,7 @@ def pareto_front(
     *,
     points: int = 8,
     cycle_times: Sequence[float] | None = None,
-    progress: Callable[[str], None] | None = None,
+    progress: Say | Callable[[str], None] | None = None,
 ) -> tuple[ParetoPoint, ...]:
     """Energy against cycle time: the optimised path re-timed (:func:`kinergy.optimize.timing.
     retime`, within the same caps) and the program as written uniformly scaled, at each cycle
@@ -408,7 +463,7 @@ def pareto_front(
     tuple of ParetoPoint
         By increasing cycle time.
     """
-    say = progress if progress is not None else (lambda _: None)
+    say = as_say(progress)
     settings = result.settings
     ctx = Context(
         robot,
@@ -430,7 +485,7 @@ def pareto_front(
     out = []
     written = result.program.path
     for i, budget in enumerate(times):
-        say(f"Pareto front: cycle time {budget:.3f} s ({i + 1}/{len(times)})")
+        say(f"Pareto front: cycle time {budget:.3f} s", done=i, total=len(times))
         uniform = at_cycle(replace(ctx, budget=budget), written, "uniform").result
         try:
             timed_run, _ = retime(checks, budget, share_budget=ctx.share_budget)

@@ -28,6 +28,7 @@ from typing import ParamSpec, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
+from threadpoolctl import threadpool_limits
 
 from kinergy.arrays import Array
 from kinergy.dynamics.threads import kernel_threads
@@ -71,11 +72,18 @@ _R = TypeVar("_R")
 def serial(func: Callable[_P, _R]) -> Callable[_P, _R]:
     """Decorate a public entry point: its dynamics run on the calling thread only
     (:func:`kinergy.dynamics.threads.kernel_threads`; small batches evaluated many times run
-    faster serially)."""
+    faster serially), and so does its linear algebra (BLAS on one thread, restored after).
+
+    The BLAS thread count changes the result: a threaded BLAS splits some sums over its threads,
+    whose partial sums add in another order, and the solver's path (SLSQP) follows the last bit.
+    Its default is one thread per core of the host (and what an earlier caller left in force in
+    the process): the same placement came out 196.0703 J on two BLAS threads and 196.0856 J on
+    one. On one thread the answer is the same whatever the host's core count, in any process and
+    any worker (a BLAS built for another processor may still differ in the last bits)."""
 
     @functools.wraps(func)
     def wrapper(*args: _P.args, **kwargs: _P.kwargs) -> _R:
-        with kernel_threads(1):
+        with kernel_threads(1), threadpool_limits(limits=1, user_api="blas"):
             return func(*args, **kwargs)
 
     return wrapper

@@ -25,6 +25,7 @@ from kinergy.io.rtde import write_log
 from kinergy.io.task import load_task
 from kinergy.io.urscript import move_statement, program_script, write_script
 from kinergy.io.urscript_reader import parse_program, read_program
+from kinergy.messages import Say
 from kinergy.model.robot import Robot
 from kinergy.optimize.options import ProgramOptions
 from kinergy.optimize.programs import ProgramOptimization, optimize_program, pareto_front
@@ -147,7 +148,7 @@ def run_optimize(
     urscript: str | os.PathLike[str] | None = None,
     motions: str | os.PathLike[str] | None = None,
     plot: str | os.PathLike[str] | None = None,
-    progress: Callable[[str], None] | None = None,
+    progress: Say | Callable[[str], None] | None = None,
 ) -> OptimizeRun:
     """``kinergy optimize ROBOT PROGRAM``: read (:func:`read_any_program`), optimise with
     ``options`` (:func:`kinergy.optimize.programs.optimize_program`), the Pareto front at
